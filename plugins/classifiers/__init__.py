@@ -1,0 +1,1 @@
+"""Built-in state and sign classifiers: one module per method."""

@@ -1,0 +1,1 @@
+"""Built-in dataset formats: one reader (and writer) per annotation format."""

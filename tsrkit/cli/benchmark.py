@@ -1,0 +1,2 @@
+"""``tsrkit benchmark`` and ``compare``."""
+COMMANDS = []

@@ -1,0 +1,2 @@
+"""``tsrkit datasets``."""
+COMMANDS = []

@@ -1,0 +1,60 @@
+"""The ``tsrkit`` click group: built-in verbs plus those plugins add via ``register_commands``."""
+from __future__ import annotations
+
+import click
+
+from tsrkit.cli.common import UserError
+from tsrkit.errors import TsrkitError
+from tsrkit.registry import PluginFailure, get_registry
+
+
+class TsrkitGroup(click.Group):
+    """A click group that reports :class:`TsrkitError` as one line and exit status 2."""
+
+    def invoke(self, ctx: click.Context):
+        try:
+            return super().invoke(ctx)
+        except TsrkitError as exc:
+            raise UserError(str(exc)) from None
+
+
+@click.group(cls=TsrkitGroup, invoke_without_command=True,
+             context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(package_name="tsrkit")
+@click.pass_context
+def cli(ctx: click.Context) -> None:
+    """Traffic signal recognition: detect, classify, track and benchmark methods side by side.
+
+    With no verb, compares the built-in detectors on the bundled synthetic sample.
+    """
+    if ctx.invoked_subcommand is None:
+        from tsrkit.cli.benchmark import run_default
+
+        ctx.invoke(run_default)
+
+
+def _add_builtin_commands() -> None:
+    from tsrkit.cli import benchmark, datasets, detect, plugins_cmd, train
+
+    for module in (plugins_cmd, detect, train, datasets, benchmark):
+        for command in module.COMMANDS:
+            cli.add_command(command)
+
+
+def _add_plugin_commands() -> None:
+    registry = get_registry()
+    for impl in registry.pm.hook.register_commands.get_hookimpls():
+        try:
+            impl.function(cli=cli)
+        except Exception as exc:  # one broken plugin must not break the command line
+            registry.failures.append(PluginFailure(
+                impl.plugin_name, "?", f"register_commands: {type(exc).__name__}: {exc}"))
+
+
+_add_builtin_commands()
+_add_plugin_commands()
+
+
+def main() -> None:
+    """Console-script entry point."""
+    cli.main(prog_name="tsrkit")

@@ -1,0 +1,36 @@
+"""``tsrkit plugins``: what is installed, and what failed to load."""
+from __future__ import annotations
+
+import json
+
+import click
+from rich.console import Console
+from rich.table import Table
+
+import tsrkit
+
+
+@click.command("plugins")
+@click.option("--json", "as_json", is_flag=True, help="Print JSON (with parameter schemas).")
+@click.option("--kind", type=click.Choice(["detector", "classifier", "tracker", "format"]),
+              default=None, help="Only plugins of this kind.")
+def plugins_command(as_json: bool, kind: str | None) -> None:
+    """List installed plugins: name, kind, package, version and summary."""
+    found = tsrkit.plugins(kind)
+    if as_json:
+        click.echo(json.dumps(found, indent=2))
+        return
+    table = Table(title="tsrkit plugins")
+    for column in ("name", "kind", "package", "version", "summary"):
+        table.add_column(column)
+    for item in found:
+        if item["kind"] == "failed":
+            table.add_row(item["name"], "[red]failed[/red]", item["package"], "",
+                          f"[red]{item['error']}[/red]")
+        else:
+            table.add_row(item["name"], item["kind"], item["package"], item["version"],
+                          item["summary"])
+    Console().print(table)
+
+
+COMMANDS = [plugins_command]

@@ -1,0 +1,36 @@
+"""``tsrkit train``: fit a trainable plugin on a dataset and save its model."""
+from __future__ import annotations
+
+import click
+from rich.console import Console
+
+from tsrkit.params import parse_assignments
+from tsrkit.training import train
+
+
+@click.command("train")
+@click.argument("plugin")
+@click.option("--dataset", "dataset_ref", required=True,
+              help="Registry name or path of the training data.")
+@click.option("--format", "format_name", default=None, help="Dataset format when a path is "
+              "ambiguous.")
+@click.option("--images", default=None, type=click.Path(file_okay=False),
+              help="Root that image paths inside the annotation file resolve against.")
+@click.option("--split", default=None, help="Use only this split (e.g. train).")
+@click.option("--param", "-p", "params", multiple=True, metavar="KEY=VALUE",
+              help="Plugin parameter; repeatable.")
+@click.option("--out", required=True, type=click.Path(dir_okay=False),
+              help="Model path (writes MODEL.npz and MODEL.json).")
+def train_command(plugin, dataset_ref, format_name, images, split, params, out) -> None:
+    """Fit PLUGIN (a trainable detector or classifier) and save the model for --param model=."""
+    from tsrkit.datasets import open_dataset
+
+    dataset = open_dataset(dataset_ref, format=format_name, images=images)
+    if split:
+        dataset = dataset.split(split)
+    path = train(plugin, dataset, out, parse_assignments(params))
+    Console(stderr=True).print(f"trained {plugin} on {len(dataset)} samples of "
+                               f"{dataset.name} -> {path}")
+
+
+COMMANDS = [train_command]

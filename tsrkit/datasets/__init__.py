@@ -1,0 +1,1 @@
+"""Dataset registry, opening datasets by name or path, and the synthetic sample."""

@@ -1,0 +1,237 @@
+"""Typed parameter schemas: what a plugin accepts, and validation of what a user gives.
+
+A plugin lists :class:`Param` objects; values arrive as Python objects (API, YAML) or as
+``key=value`` strings (``--param``) and are checked against the schema. Every failure is a
+:class:`ParamError` whose message names the plugin, the key and what is allowed.
+"""
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from tsrkit.errors import TsrkitError
+
+import yaml
+
+#: Parameter types and what they accept.
+TYPES = {
+    "int": "an integer",
+    "float": "a number",
+    "bool": "true or false",
+    "str": "a string",
+    "path": "a file or folder path",
+    "ints": "a list of integers, e.g. 1,2,3 or 1..10",
+    "floats": "a list of numbers, e.g. 1,1,2",
+}
+
+_TRUE = {"1", "true", "yes", "on"}
+_FALSE = {"0", "false", "no", "off"}
+
+
+class ParamError(TsrkitError):
+    """A parameter value that its plugin's schema does not allow."""
+
+
+@dataclass(frozen=True)
+class Param:
+    """One parameter of a plugin.
+
+    Parameters
+    ----------
+    name : str
+        Key used in ``--param name=value``, YAML configs and the Python API.
+    type : str
+        One of :data:`TYPES`.
+    default : object
+        Value used when the user gives none (``None`` means "not set").
+    help : str
+        One line for ``tsrkit plugins`` and error messages.
+    min, max : float, optional
+        Inclusive bounds, checked on every element for list types.
+    choices : tuple, optional
+        Allowed values.
+    length : int, optional
+        Required number of elements for list types.
+    section : str
+        The document section or table the default comes from.
+    """
+
+    name: str
+    type: str
+    default: Any = None
+    help: str = ""
+    min: float | None = None
+    max: float | None = None
+    choices: tuple | None = None
+    length: int | None = None
+    section: str = ""
+
+    def __post_init__(self):
+        if self.type not in TYPES:
+            raise ValueError(f"parameter {self.name!r}: unknown type {self.type!r}")
+
+    def allowed(self) -> str:
+        """Describe the allowed values in words."""
+        text = TYPES[self.type]
+        if self.choices is not None:
+            text = "one of " + ", ".join(map(str, self.choices))
+        if self.length is not None:
+            text += f" of length {self.length}"
+        if self.min is not None and self.max is not None:
+            text += f" in [{self.min}, {self.max}]"
+        elif self.min is not None:
+            text += f" >= {self.min}"
+        elif self.max is not None:
+            text += f" <= {self.max}"
+        return text
+
+    def to_json(self) -> dict[str, Any]:
+        """The schema entry as plain JSON data."""
+        out = {"name": self.name, "type": self.type, "default": _jsonable(self.default),
+               "help": self.help}
+        for key in ("min", "max", "length", "section"):
+            if getattr(self, key) not in (None, ""):
+                out[key] = getattr(self, key)
+        if self.choices is not None:
+            out["choices"] = list(self.choices)
+        return out
+
+    def coerce(self, value: Any, owner: str) -> Any:
+        """Convert ``value`` (object or string) to this parameter's type and check it."""
+        if value is None:
+            return None
+
+        def fail(reason: str = "") -> ParamError:
+            why = f" ({reason})" if reason else ""
+            return ParamError(f"{owner}: parameter '{self.name}' must be {self.allowed()}; "
+                              f"got {value!r}{why}")
+
+        try:
+            out = _convert(self.type, value)
+        except (TypeError, ValueError) as exc:
+            raise fail(str(exc) if not isinstance(exc, ParamError) else "") from None
+        items = out if isinstance(out, tuple) else (out,)
+        if self.length is not None and isinstance(out, tuple) and len(out) != self.length:
+            raise fail(f"{len(out)} elements")
+        if self.type in ("ints", "floats") and not out:
+            raise fail("empty list")
+        if self.choices is not None and out not in self.choices:
+            raise fail()
+        if self.type in ("int", "float", "ints", "floats"):
+            for item in items:
+                if (self.min is not None and item < self.min) or \
+                        (self.max is not None and item > self.max):
+                    raise fail("out of range")
+        return out
+
+
+def _jsonable(value: Any) -> Any:
+    return list(value) if isinstance(value, tuple) else value
+
+
+def _convert(kind: str, value: Any) -> Any:
+    if kind == "bool":
+        if isinstance(value, bool):
+            return value
+        text = str(value).strip().lower()
+        if text in _TRUE:
+            return True
+        if text in _FALSE:
+            return False
+        raise ValueError("not a boolean")
+    if kind == "int":
+        if isinstance(value, bool) or (isinstance(value, float) and not value.is_integer()):
+            raise ValueError("not an integer")
+        return int(str(value).strip()) if isinstance(value, str) else int(value)
+    if kind == "float":
+        if isinstance(value, bool):
+            raise ValueError("not a number")
+        return float(value)
+    if kind in ("str", "path"):
+        if not isinstance(value, str):
+            raise ValueError("not a string")
+        return value
+    element = "int" if kind == "ints" else "float"
+    if isinstance(value, str):
+        text = value.strip().strip("()[]")
+        if kind == "ints" and ".." in text:
+            lo, hi = (int(part) for part in text.split(".."))
+            return tuple(range(lo, hi + 1))
+        value = [part for part in text.replace(" ", ",").split(",") if part]
+    if not isinstance(value, Sequence):
+        value = [value]
+    return tuple(_convert(element, item) for item in value)
+
+
+def validate(schema: Sequence[Param], given: Mapping[str, Any], owner: str) -> dict[str, Any]:
+    """Check ``given`` against ``schema`` and return every parameter with its final value.
+
+    Parameters
+    ----------
+    schema : sequence of Param
+        The plugin's parameters.
+    given : mapping
+        User values, as objects or strings.
+    owner : str
+        How to name the plugin in messages, e.g. ``"detector 'conspicuity'"``.
+
+    Raises
+    ------
+    ParamError
+        For an unknown key, a wrong type or an out-of-range value.
+
+    Examples
+    --------
+    >>> validate([Param("h_peak", "float", 0.9, min=0, max=1)], {"h_peak": "0.8"}, "d")
+    {'h_peak': 0.8}
+    """
+    by_name = {p.name: p for p in schema}
+    unknown = sorted(set(given) - set(by_name))
+    if unknown:
+        allowed = ", ".join(sorted(by_name)) or "none"
+        raise ParamError(f"{owner}: unknown parameter '{unknown[0]}' (allowed: {allowed})")
+    return {name: p.coerce(given.get(name, p.default), owner) for name, p in by_name.items()}
+
+
+def parse_assignments(items: Iterable[str]) -> dict[str, str]:
+    """Turn ``["a=1", "b=x"]`` into ``{"a": "1", "b": "x"}``; raise ParamError on bad syntax."""
+    out = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        if not sep or not key.strip():
+            raise ParamError(f"--param expects key=value; got {item!r}")
+        out[key.strip()] = value.strip()
+    return out
+
+
+def load_config(path: str) -> dict[str, Any]:
+    """Read a YAML run configuration.
+
+    The file is a mapping whose optional keys ``detector``, ``classifier`` and ``tracker`` are
+    each either a plugin name or ``{"name": ..., "params": {...}}``; other keys are kept.
+
+    Raises
+    ------
+    ParamError
+        When the file cannot be read or does not have that shape.
+    """
+    try:
+        with open(path, encoding="utf-8") as fh:
+            data = yaml.safe_load(fh) or {}
+    except (OSError, yaml.YAMLError) as exc:
+        raise ParamError(f"config {path}: {exc}") from None
+    if not isinstance(data, dict):
+        raise ParamError(f"config {path}: expected a mapping at the top level")
+    for kind in ("detector", "classifier", "tracker"):
+        entry = data.get(kind)
+        if isinstance(entry, str):
+            data[kind] = {"name": entry, "params": {}}
+        elif entry is not None:
+            if not isinstance(entry, dict) or "name" not in entry:
+                raise ParamError(f"config {path}: '{kind}' must be a name or have a 'name' key")
+            params = entry.get("params") or {}
+            if not isinstance(params, dict):
+                raise ParamError(f"config {path}: '{kind}.params' must be a mapping")
+            data[kind] = {"name": entry["name"], "params": params}
+    return data

@@ -1,0 +1,119 @@
+"""Base classes a plugin subclasses: Detector, Classifier, Tracker and DatasetFormat.
+
+A subclass sets the class attributes ``name``, ``summary``, ``section`` (the document section it
+implements) and ``params`` (a tuple of :class:`tsrkit.params.Param`), then implements the one
+method of its kind. The core validates parameters before calling ``__init__``, so
+``self.params`` always holds every declared key with a checked value.
+"""
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from collections.abc import Iterable, Sequence
+from pathlib import Path
+from typing import ClassVar
+
+from tsrkit.params import Param
+from tsrkit.types import Candidate, Dataset, Detection, Frame, Sample
+
+
+class Plugin(ABC):
+    """Common part of every plugin kind."""
+
+    kind: ClassVar[str] = ""
+    name: ClassVar[str] = ""
+    summary: ClassVar[str] = ""
+    section: ClassVar[str] = ""
+    params: ClassVar[tuple[Param, ...]] = ()
+    #: Set when the plugin's own version differs from its distribution's.
+    version: ClassVar[str | None] = None
+
+    def __init__(self, **params):
+        self.params = params
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}({self.params!r})"
+
+
+class Detector(Plugin):
+    """Finds candidate lit lenses in a frame. Detectors are stateless between frames.
+
+    A trainable detector also defines ``fit(samples) -> tsrkit.models.Model`` and reads a saved
+    model from its ``model`` parameter.
+    """
+
+    kind = "detector"
+
+    @abstractmethod
+    def detect(self, frame: Frame) -> list[Candidate]:
+        """Return the candidates of ``frame``, best first."""
+
+
+class Classifier(Plugin):
+    """Assigns a state to each candidate of a frame.
+
+    A trainable classifier defines ``fit(samples) -> tsrkit.models.Model`` and reads a saved
+    model from its ``model`` parameter (falling back to a default model it ships).
+    """
+
+    kind = "classifier"
+    #: The states this classifier can output (besides ``"unknown"``).
+    states: ClassVar[tuple[str, ...]] = ("red", "yellow", "green")
+
+    @abstractmethod
+    def classify(self, frame: Frame, candidates: Sequence[Candidate]) -> list[Detection]:
+        """Return one :class:`Detection` per candidate, in the same order."""
+
+
+class Tracker(Plugin):
+    """Carries detections through the frames of one video."""
+
+    kind = "tracker"
+
+    @abstractmethod
+    def reset(self) -> None:
+        """Forget every track (a new video starts)."""
+
+    def needs_detection(self) -> bool:
+        """Whether the detector must run on the next frame (False while tracking suffices)."""
+        return True
+
+    @abstractmethod
+    def update(self, frame: Frame, detections: Sequence[Detection]) -> list[Detection]:
+        """Take this frame's detections; return what is reported for the frame.
+
+        Tracked objects come back with ``origin="tracked"`` and a ``track_id``.
+        """
+
+
+class DatasetFormat(Plugin):
+    """Reads (and optionally writes) one annotation format."""
+
+    kind = "format"
+    #: Whether :meth:`write` is implemented.
+    writable: ClassVar[bool] = False
+
+    @abstractmethod
+    def sniff(self, path: Path) -> bool:
+        """True when ``path`` (file or folder) is unambiguously in this format."""
+
+    @abstractmethod
+    def read(self, path: Path, images: Path | None = None) -> Dataset:
+        """Read the annotations at ``path``; image paths resolve against ``images`` if given.
+
+        Raises
+        ------
+        tsrkit.datasets.DatasetError
+            Naming the file, the line or entry, and the problem.
+        """
+
+    def write(self, dataset: Dataset, out: Path) -> None:
+        """Write ``dataset`` in this format at ``out`` (only when ``writable``)."""
+        raise TypeError(f"format '{self.name}' cannot be written")
+
+
+def is_trainable(cls: type[Plugin]) -> bool:
+    """True when the plugin class can be fitted with ``tsrkit train``."""
+    return callable(getattr(cls, "fit", None))
+
+
+TrainingSamples = Iterable[Sample]

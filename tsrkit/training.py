@@ -1,0 +1,54 @@
+"""Fitting a trainable plugin on a dataset and saving its model (``tsrkit train``)."""
+from __future__ import annotations
+
+import hashlib
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from tsrkit.errors import TsrkitError
+from tsrkit.models import save_model
+from tsrkit.plugin import is_trainable
+from tsrkit.registry import PluginInfo, get_registry
+from tsrkit.types import Dataset
+
+
+def trainable_plugin(name: str) -> PluginInfo:
+    """The trainable detector or classifier called ``name``."""
+    registry = get_registry()
+    candidates = [info for info in registry.plugins() if info.name == name
+                  and info.kind in ("detector", "classifier")]
+    if not candidates:
+        known = sorted(i.name for i in registry.plugins() if is_trainable(i.cls))
+        raise TsrkitError(f"no trainable plugin called '{name}' (trainable: "
+                          f"{', '.join(known) or 'none installed'})")
+    info = candidates[0]
+    if not is_trainable(info.cls):
+        raise TsrkitError(f"{info.kind} '{name}' is not trainable")
+    return info
+
+
+def dataset_checksum(dataset: Dataset) -> str:
+    """sha256 over every sample's image bytes and annotations, in dataset order."""
+    digest = hashlib.sha256()
+    for sample in dataset:
+        if sample.image is not None:
+            digest.update(sample.image.tobytes())
+        else:
+            with open(sample.source, "rb") as fh:
+                for block in iter(lambda: fh.read(1 << 20), b""):
+                    digest.update(block)
+        for ann in sample.annotations:
+            digest.update(repr((tuple(round(v, 3) for v in ann.bbox), ann.state)).encode())
+    return digest.hexdigest()
+
+
+def train(name: str, dataset: Dataset, out: str | Path, params: Mapping[str, Any]) -> Path:
+    """Fit plugin ``name`` on ``dataset`` with ``params``; write the model; return its path."""
+    info = trainable_plugin(name)
+    plugin = info.create(**params)
+    model = plugin.fit(dataset)
+    training = {"dataset": dataset.name, "samples": len(dataset),
+                "checksum": dataset_checksum(dataset)}
+    return save_model(out, model, plugin=info.name, plugin_version=info.version,
+                      params=plugin.params, training=training)

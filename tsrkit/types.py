@@ -1,0 +1,193 @@
+"""The small immutable values that flow between tsrkit's stages.
+
+Images are NumPy arrays, BGR uint8, as OpenCV reads them. Coordinates are pixels, x right and
+y down; boxes are ``(x_min, y_min, x_max, y_max)``. See ``shared/DESIGN.md`` for the data path.
+"""
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+#: The signal states every classifier and dataset reader maps its labels onto.
+STATES = ("red", "yellow", "green", "off", "unknown")
+
+Box = tuple[float, float, float, float]
+
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """A place a detector believes holds a lit lens.
+
+    Parameters
+    ----------
+    x, y : float
+        Centre in pixels.
+    radius : float
+        Lens radius in pixels.
+    bbox : tuple of float
+        ``(x_min, y_min, x_max, y_max)``.
+    score : float
+        The detector's confidence or saliency; higher is more likely (scale is the detector's).
+    state : str or None
+        A state the detector itself can tell (e.g. TL-recognizer's colour filters), else None.
+    """
+
+    x: float
+    y: float
+    radius: float
+    bbox: Box
+    score: float
+    state: str | None = None
+
+    @classmethod
+    def from_circle(cls, x: float, y: float, radius: float, score: float,
+                    state: str | None = None) -> Candidate:
+        """Build a candidate whose box circumscribes the circle ``(x, y, radius)``."""
+        return cls(float(x), float(y), float(radius),
+                   (float(x - radius), float(y - radius), float(x + radius), float(y + radius)),
+                   float(score), state)
+
+    @classmethod
+    def from_box(cls, bbox: Sequence[float], score: float, state: str | None = None) -> Candidate:
+        """Build a candidate centred in ``bbox`` with the radius of its inscribed circle."""
+        x0, y0, x1, y1 = (float(v) for v in bbox)
+        return cls((x0 + x1) / 2, (y0 + y1) / 2, min(x1 - x0, y1 - y0) / 2,
+                   (x0, y0, x1, y1), float(score), state)
+
+
+@dataclass(frozen=True)
+class Detection:
+    """A candidate with its classified state.
+
+    ``origin`` is ``"detected"`` for a detector's output and ``"tracked"`` when a tracker
+    carried it over from earlier frames; ``track_id`` links the records of one tracked object.
+    """
+
+    candidate: Candidate
+    state: str
+    state_scores: Mapping[str, float] = field(default_factory=dict)
+    origin: str = "detected"
+    track_id: int | None = None
+
+    def to_record(self) -> dict[str, Any]:
+        """The JSON object ``tsrkit detect`` writes for this detection."""
+        c = self.candidate
+        record = {
+            "x": round(c.x, 3), "y": round(c.y, 3), "radius": round(c.radius, 3),
+            "bbox": [round(v, 3) for v in c.bbox], "score": float(c.score),
+            "state": self.state,
+            "state_scores": {k: float(v) for k, v in self.state_scores.items()},
+            "origin": self.origin,
+        }
+        if self.track_id is not None:
+            record["track_id"] = self.track_id
+        return record
+
+
+@dataclass(frozen=True)
+class Annotation:
+    """A ground-truth box with its state and any reader-specific attributes."""
+
+    bbox: Box
+    state: str
+    attributes: Mapping[str, Any] = field(default_factory=dict)
+
+    @property
+    def center(self) -> tuple[float, float]:
+        """Centre of the box."""
+        x0, y0, x1, y1 = self.bbox
+        return (x0 + x1) / 2, (y0 + y1) / 2
+
+
+@dataclass(frozen=True, eq=False)
+class Frame:
+    """One image, with where it came from.
+
+    ``index`` is the frame number inside a video (0 for a still image); ``timestamp`` is in
+    seconds when known. ``metadata`` carries optional camera facts that some methods use
+    (``focal_px``, ``pitch_deg``, ``roll_deg``, ``distance_m``, ``lighting``...).
+    """
+
+    image: np.ndarray
+    source: str
+    index: int = 0
+    timestamp: float | None = None
+    metadata: Mapping[str, Any] = field(default_factory=dict)
+
+    @property
+    def height(self) -> int:
+        """Image height in pixels."""
+        return int(self.image.shape[0])
+
+    @property
+    def width(self) -> int:
+        """Image width in pixels."""
+        return int(self.image.shape[1])
+
+
+@dataclass(frozen=True)
+class Skipped:
+    """An input that could not be used, and why."""
+
+    source: str
+    reason: str
+
+
+@dataclass(frozen=True)
+class Sample:
+    """One annotated image of a dataset; the pixels are read only when :meth:`load` is called.
+
+    ``image`` may hold the pixels directly (generated or in-memory data); otherwise ``source`` is
+    the path to read. ``split`` is ``"train"``, ``"valid"``, ``"test"`` or None.
+    """
+
+    source: str
+    annotations: tuple[Annotation, ...] = ()
+    width: int | None = None
+    height: int | None = None
+    split: str | None = None
+    metadata: Mapping[str, Any] = field(default_factory=dict)
+    image: np.ndarray | None = field(default=None, repr=False, compare=False)
+
+    def load(self) -> Frame:
+        """Read the image (BGR uint8) and return it as a :class:`Frame`.
+
+        Raises
+        ------
+        tsrkit.inputs.ImageReadError
+            When the file is missing or not a decodable image.
+        """
+        from tsrkit.inputs import read_image
+
+        image = self.image if self.image is not None else read_image(self.source)
+        return Frame(image=image, source=self.source, metadata=self.metadata)
+
+
+@dataclass(frozen=True)
+class Dataset:
+    """An ordered collection of annotated samples plus facts about where it came from.
+
+    ``info`` holds registry facts (licence, citation, box convention: ``"lens"`` or
+    ``"housing"``...). Images are not held in memory; iterate and call ``Sample.load``.
+    """
+
+    name: str
+    samples: tuple[Sample, ...]
+    format: str = ""
+    root: str = ""
+    info: Mapping[str, Any] = field(default_factory=dict)
+
+    def __len__(self) -> int:
+        return len(self.samples)
+
+    def __iter__(self):
+        return iter(self.samples)
+
+    def split(self, name: str) -> Dataset:
+        """The samples of one split (``train``, ``valid``, ``test``) as a new dataset."""
+        chosen = tuple(s for s in self.samples if s.split == name)
+        return Dataset(f"{self.name}:{name}", chosen, self.format, self.root, self.info)
