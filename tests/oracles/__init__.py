@@ -1,0 +1,1 @@
+"""Straightforward reference implementations kept as test oracles for the fast maps."""
