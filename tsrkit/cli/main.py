@@ -58,3 +58,7 @@ _add_plugin_commands()
 def main() -> None:
     """Console-script entry point."""
     cli.main(prog_name="tsrkit")
+
+
+if __name__ == "__main__":
+    main()

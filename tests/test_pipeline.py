@@ -1,0 +1,71 @@
+"""The pipeline: detector alone, with a classifier, and a tracker that pauses detection."""
+import numpy as np
+
+import tsrkit
+from tsrkit.types import Candidate, Detection, Frame
+
+
+class Fixed(tsrkit.Detector):
+    name = "fixed"
+
+    def __init__(self, **params):
+        super().__init__(**params)
+        self.calls = 0
+
+    def detect(self, frame):
+        self.calls += 1
+        return [Candidate.from_circle(5, 6, 2, 0.9, state="red"), Candidate.from_circle(1, 1, 1, 0.1)]
+
+
+class Greenify(tsrkit.Classifier):
+    name = "greenify"
+
+    def classify(self, frame, candidates):
+        return [Detection(c, "green", {"green": 1.0}) for c in candidates]
+
+
+class Sticky(tsrkit.Tracker):
+    """Detects on the first frame of a video, then reports the same object as tracked."""
+
+    name = "sticky"
+
+    def reset(self):
+        self.kept = None
+
+    def needs_detection(self):
+        return self.kept is None
+
+    def update(self, frame, detections):
+        if self.kept is None:
+            self.kept = detections[0]
+            return list(detections)
+        return [Detection(self.kept.candidate, self.kept.state, origin="tracked", track_id=1)]
+
+
+def frame(source="v.mp4", index=0):
+    return Frame(np.zeros((12, 12, 3), np.uint8), source, index)
+
+
+def test_detector_alone_keeps_its_own_states():
+    result = tsrkit.Pipeline(Fixed()).process(frame())
+    assert [d.state for d in result.detections] == ["red", "unknown"]
+    record = result.to_record()
+    assert set(record) == {"source", "frame", "width", "height", "ms", "detections"}
+    assert record["detections"][0]["bbox"] == [3.0, 4.0, 7.0, 8.0]
+    assert record["ms"] >= 0
+
+
+def test_classifier_sets_states():
+    result = tsrkit.Pipeline(Fixed(), Greenify()).process(frame())
+    assert [d.state for d in result.detections] == ["green", "green"]
+    assert result.detections[0].state_scores == {"green": 1.0}
+
+
+def test_tracker_pauses_detection_and_resets_per_video():
+    detector = Fixed()
+    pipeline = tsrkit.Pipeline(detector, tracker=Sticky())
+    origins = [[d.origin for d in pipeline.process(frame("a.mp4", i)).detections] for i in range(3)]
+    assert origins == [["detected", "detected"], ["tracked"], ["tracked"]]
+    assert detector.calls == 1
+    pipeline.process(frame("b.mp4", 0))
+    assert detector.calls == 2  # a new video resets the tracker
