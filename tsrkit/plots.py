@@ -1,0 +1,92 @@
+"""PNG plots of a benchmark (matplotlib, Agg backend): Figure 5-1 bubbles, bars and the PR curve.
+
+``bubble_plot`` follows Zheng 2016 Figure 5-1: one panel per lighting x max-radius category,
+recall against FPR = 1 - precision, circle area proportional to the share of the category's
+frames, bluer towards (FPR 0, recall 1) and redder away from it, ``N = frames`` in grey.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402  (the backend must be chosen first)
+
+from tsrkit.atomic import atomic_open  # noqa: E402
+
+
+def _save(fig, path: Path) -> str:
+    with atomic_open(path, "wb") as fh:
+        fig.savefig(fh, format="png", dpi=110)
+    plt.close(fig)
+    return path.name
+
+
+def bubble_plot(rows: list[dict], path: Path) -> str:
+    """Figure 5-1: recall vs FPR bubbles per category (rows of ``report["categories"]``)."""
+    panels = [r for r in rows if r["max_radius"] is not None] or rows
+    cols = min(4, max(1, len(panels)))
+    nrows = max(1, math.ceil(len(panels) / cols))
+    fig, axes = plt.subplots(nrows, cols, figsize=(3 * cols, 3 * nrows), squeeze=False,
+                             sharex=True, sharey=True)
+    cmap = plt.get_cmap("coolwarm")
+    for ax, row in zip(axes.flat, panels):
+        fpr = [b["fpr"] for b in row["bubbles"]]
+        recall = [b["recall"] for b in row["bubbles"]]
+        share = [b["frames"] / row["frames"] for b in row["bubbles"]]
+        badness = [(f + (1 - r)) / 2 for f, r in zip(fpr, recall)]
+        ax.scatter(fpr, recall, s=[2000 * s for s in share], c=badness, cmap=cmap, vmin=0,
+                   vmax=1, alpha=0.7, edgecolors="k", linewidths=0.3)
+        ax.set_title(f"{row['lighting']} - r {row['max_radius']}", fontsize=9)
+        ax.text(0.95, 0.05, f"N = {row['frames']}", color="grey", ha="right",
+                transform=ax.transAxes, fontsize=8)
+        ax.set_xlim(-0.1, 1.1)
+        ax.set_ylim(-0.1, 1.1)
+    for ax in list(axes.flat)[len(panels):]:
+        ax.axis("off")
+    fig.supxlabel("false positive rate (1 - precision)")
+    fig.supylabel("recall")
+    fig.tight_layout()
+    return _save(fig, path)
+
+
+def category_bars(rows: list[dict], path: Path) -> str:
+    """Per-category bars of mean recall, mean precision and hit-frame fraction."""
+    labels = [r["lighting"] if r["max_radius"] is None else f"{r['lighting']}-{r['max_radius']}"
+              for r in rows]
+    fig, ax = plt.subplots(figsize=(max(5, 0.6 * len(rows) + 2), 3.5))
+    width = 0.27
+    for k, key in enumerate(("recall_mean", "precision_mean", "hit_frame_fraction")):
+        ax.bar([i + (k - 1) * width for i in range(len(rows))],
+               [r[key] or 0.0 for r in rows], width, label=key)
+    ax.set_xticks(range(len(rows)), labels, rotation=45, ha="right", fontsize=8)
+    ax.set_ylim(0, 1)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    return _save(fig, path)
+
+
+def pr_curve(curve: dict | None, ap: float | None, path: Path) -> str:
+    """COCOeval's interpolated precision-recall curve at IoU 0.5."""
+    fig, ax = plt.subplots(figsize=(4, 4))
+    if curve:
+        precision = [max(p, 0.0) for p in curve["precision"]]
+        ax.plot(curve["recall"], precision)
+    ax.set_xlabel("recall")
+    ax.set_ylabel("precision")
+    ax.set_xlim(0, 1)
+    ax.set_ylim(0, 1.02)
+    ax.set_title(f"IoU 0.5, AP = {ap:.3f}" if ap is not None else "IoU 0.5")
+    fig.tight_layout()
+    return _save(fig, path)
+
+
+def write_plots(folder: Path, report: dict, curve: dict | None) -> list[str]:
+    """Write the three plots into ``folder``; return their paths relative to the report."""
+    folder.mkdir(parents=True, exist_ok=True)
+    names = [bubble_plot(report["categories"], folder / "recall_fpr_bubbles.png"),
+             category_bars(report["categories"], folder / "categories.png"),
+             pr_curve(curve, report["iou50"]["ap"], folder / "pr_curve.png")]
+    return [f"{folder.name}/{name}" for name in names]
