@@ -1,0 +1,25 @@
+"""Image width and height from the file header, without decoding the pixels."""
+from __future__ import annotations
+
+import os
+
+from PIL import Image, UnidentifiedImageError
+
+from tsrkit.datasets.errors import DatasetError
+
+
+def image_size(path: str | os.PathLike) -> tuple[int, int]:
+    """``(width, height)`` of the image at ``path``, read from its header by Pillow.
+
+    Raises
+    ------
+    DatasetError
+        When the file is missing or not an image Pillow recognises.
+    """
+    try:
+        with Image.open(path) as image:
+            return int(image.width), int(image.height)
+    except FileNotFoundError:
+        raise DatasetError(path, "image not found (needed for its size)") from None
+    except (UnidentifiedImageError, OSError) as exc:
+        raise DatasetError(path, f"cannot read image size ({exc})") from None

@@ -1,0 +1,134 @@
+"""Opening a dataset by registry name, by the bundled ``sample`` name, or by path.
+
+The format comes from the registry entry, from the caller, or from the format plugins'
+``sniff`` when exactly one of them recognises the path.
+"""
+from __future__ import annotations
+
+import dataclasses
+import os
+from collections.abc import Mapping
+from pathlib import Path
+
+from tsrkit.datasets.errors import DatasetError
+from tsrkit.datasets.registry import DatasetEntry, load_registry
+from tsrkit.datasets.states import check_mapping, to_state
+from tsrkit.errors import TsrkitError
+from tsrkit.registry import get_registry
+from tsrkit.types import Annotation, Dataset
+
+SAMPLE = "sample"
+
+
+def open_dataset(ref: str | os.PathLike, format: str | None = None,
+                 images: str | os.PathLike | None = None,
+                 states: Mapping[str, str] | None = None) -> Dataset:
+    """Read a dataset: a registry name, ``"sample"``, or a path to a file or folder.
+
+    Parameters
+    ----------
+    ref : str or path-like
+        A name from ``datasets.yaml`` (see :func:`tsrkit.datasets.load_registry`), the name
+        ``"sample"`` (the bundled synthetic sample, generated on first use), or a path.
+    format : str, optional
+        A format plugin name; detected with the plugins' ``sniff`` when omitted.
+    images : path-like, optional
+        Folder that image paths inside the annotation file resolve against (default: the
+        annotation file's folder).
+    states : mapping, optional
+        ``{raw label: state}`` overriding the registry entry's and the reader's mapping.
+
+    Returns
+    -------
+    Dataset
+        ``info`` carries the registry entry (licence, citation, ``box``, ``task``...) when
+        opened by name.
+
+    Raises
+    ------
+    TsrkitError
+        Unknown name, missing path, or a format that cannot be decided (naming the candidates).
+    DatasetError
+        A malformed annotation file (naming file, line or entry, and the problem).
+    """
+    images = Path(images) if images is not None else None
+    entry = _registry_entry(ref)
+    if entry is None:
+        path = _sample_path() if str(ref) == SAMPLE else Path(ref)
+        dataset = read_dataset(path, format or detect_format(path), images)
+        if str(ref) == SAMPLE:
+            dataset = dataclasses.replace(dataset, name=SAMPLE)
+    else:
+        dataset = read_dataset(entry.annotation_path(), format or entry.format, images)
+        dataset = dataclasses.replace(dataset, name=entry.name,
+                                      info={**dataset.info, **entry.to_info()})
+        states = {**entry.states, **(states or {})}
+    return relabel(dataset, check_mapping(states, "states")) if states else dataset
+
+
+def read_dataset(path: Path, format: str, images: Path | None = None) -> Dataset:
+    """Read ``path`` with the format plugin called ``format``."""
+    reader = get_registry().create("format", format)
+    return reader.read(Path(path), images)
+
+
+def detect_format(path: Path) -> str:
+    """The one format plugin whose ``sniff`` accepts ``path``.
+
+    Raises
+    ------
+    TsrkitError
+        When none or several match, naming them and asking for ``--format``.
+    """
+    matched = [info.name for info in get_registry().plugins("format")
+               if info.create().sniff(Path(path))]
+    if len(matched) == 1:
+        return matched[0]
+    every = ", ".join(info.name for info in get_registry().plugins("format"))
+    if matched:
+        raise TsrkitError(f"{path}: several formats match ({', '.join(matched)}); "
+                          f"pass --format (format=...) to choose")
+    raise TsrkitError(f"{path}: no format recognises it; pass --format (format=...), "
+                      f"one of: {every}")
+
+
+def relabel(dataset: Dataset, states: Mapping[str, str]) -> Dataset:
+    """Re-map every annotation whose raw ``attributes["label"]`` is a key of ``states``."""
+    def remap(ann: Annotation) -> Annotation:
+        label = ann.attributes.get("label")
+        if label is None or label not in states:
+            return ann
+        return dataclasses.replace(ann, state=to_state(label, states))
+
+    samples = tuple(dataclasses.replace(s, annotations=tuple(map(remap, s.annotations)))
+                    for s in dataset.samples)
+    return dataclasses.replace(dataset, samples=samples)
+
+
+def write_dataset(dataset: Dataset, format: str, out: str | os.PathLike) -> Path:
+    """Write ``dataset`` with the format plugin ``format`` at ``out`` (file or folder)."""
+    writer = get_registry().create("format", format)
+    if not writer.writable:
+        writable = ", ".join(i.name for i in get_registry().plugins("format") if i.cls.writable)
+        raise TsrkitError(f"format '{format}' has no writer (writable: {writable})")
+    writer.write(dataset, Path(out))
+    return Path(out)
+
+
+def _registry_entry(ref: str | os.PathLike) -> DatasetEntry | None:
+    """The registry entry ``ref`` names, None for a path; an error for neither."""
+    if isinstance(ref, os.PathLike) or Path(ref).exists():
+        return None
+    registry = load_registry()
+    if ref in registry:
+        return registry[ref]
+    if ref == SAMPLE:
+        return None
+    names = ", ".join(registry) or "none"
+    raise TsrkitError(f"'{ref}' is neither a registered dataset ({names}) nor an existing path")
+
+
+def _sample_path() -> Path:
+    from tsrkit.datasets import synth
+
+    return Path(synth.sample_path())
