@@ -1,0 +1,131 @@
+"""Accuracy, per-class recall, confusion and single-thread speed of the state classifiers
+(ab-hist, hsi-backprojection) on the real sets, each trained on udacity_mit_tl_crops train.
+
+Run: /work/venv/bin/python benchmarks/bench_classifiers.py [--repeats 5]
+"""
+from __future__ import annotations
+
+import os
+
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ[_var] = "1"
+
+import argparse  # noqa: E402
+import csv  # noqa: E402
+import json  # noqa: E402
+import statistics  # noqa: E402
+import tempfile  # noqa: E402
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import cv2  # noqa: E402
+
+from tsrkit.registry import get_registry  # noqa: E402
+from tsrkit.training import train as train_model  # noqa: E402
+from tsrkit.types import Annotation, Candidate, Dataset, Sample  # noqa: E402
+
+DATA = Path(os.environ.get("TSRKIT_DATA_DIR", Path(__file__).resolve().parents[2] / "shared"
+                           / "datasets"))
+CLASSIFIERS = ("ab-hist", "hsi-backprojection")
+STATES = ("red", "yellow", "green")
+
+
+def crop_samples(name: str, column: str, value: str) -> Dataset:
+    """The crops of ``name`` whose ``labels.csv`` column equals ``value`` (folder = label)."""
+    root = DATA / name
+    samples = []
+    with open(root / "labels.csv", newline="") as fh:
+        for row in csv.DictReader(fh):
+            if row[column] != value:
+                continue
+            image = cv2.imread(str(root / row["file"]))
+            h, w = image.shape[:2]
+            samples.append(Sample(str(root / row["file"]),
+                                  (Annotation((0.0, 0.0, float(w), float(h)), row["label"]),),
+                                  w, h, image=image))
+    return Dataset(f"{name}:{value}", tuple(samples))
+
+
+def box_samples(name: str) -> Dataset:
+    """The annotated scenes of a detection set (normalised ``annotations.json``)."""
+    root = DATA / name
+    samples = []
+    for entry in json.loads((root / "annotations.json").read_text()):
+        anns = tuple(Annotation((b["x_min"], b["y_min"], b["x_max"], b["y_max"]), b["label"])
+                     for b in entry["boxes"])
+        samples.append(Sample(str(root / entry["file"]), anns, entry["width"], entry["height"],
+                              image=cv2.imread(str(root / entry["file"]))))
+    return Dataset(name, tuple(samples))
+
+
+def evaluate(classifier, dataset: Dataset) -> dict:
+    """Accuracy, per-class recall and confusion (true -> predicted) over red/yellow/green."""
+    confusion: dict[str, dict[str, int]] = {s: {} for s in STATES}
+    for sample in dataset:
+        anns = [a for a in sample.annotations if a.state in STATES]
+        if not anns:
+            continue
+        frame = sample.load()
+        found = classifier.classify(frame, [Candidate.from_box(a.bbox, 1.0) for a in anns])
+        for ann, det in zip(anns, found):
+            row = confusion[ann.state]
+            row[det.state] = row.get(det.state, 0) + 1
+    totals = {s: sum(confusion[s].values()) for s in STATES}
+    correct = sum(confusion[s].get(s, 0) for s in STATES)
+    return {"n": sum(totals.values()), "accuracy": correct / max(sum(totals.values()), 1),
+            "recall": {s: (confusion[s].get(s, 0) / totals[s] if totals[s] else None)
+                       for s in STATES},
+            "counts": totals, "confusion": confusion}
+
+
+def crops_per_second(classifier, dataset: Dataset, repeats: int) -> float:
+    """Median over ``repeats`` of crops classified per second (images already decoded)."""
+    frames = [(s.load(), [Candidate.from_box(s.annotations[0].bbox, 1.0)]) for s in dataset]
+    rates = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        for frame, cands in frames:
+            classifier.classify(frame, cands)
+        rates.append(len(frames) / (time.perf_counter() - start))
+    return statistics.median(rates)
+
+
+def show(name: str, result: dict) -> None:
+    recall = " ".join(f"{s}={'-' if r is None else f'{r:.3f}'}"
+                      for s, r in result["recall"].items())
+    print(f"  {name:<22} n={result['n']:<4} acc={result['accuracy']:.3f}  recall {recall}")
+    for state, row in result["confusion"].items():
+        print(f"      {state:<7} -> {dict(sorted(row.items()))}")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--param", action="append", default=[],
+                        help="CLASSIFIER:KEY=VALUE passed to that classifier")
+    args = parser.parse_args()
+    cv2.setNumThreads(1)
+    registry = get_registry()
+    train = crop_samples("udacity_mit_tl_crops", "split", "train")
+    sets = {"mit test": crop_samples("udacity_mit_tl_crops", "split", "test"),
+            "vgis day": crop_samples("lisa_vgis_bulb_crops", "condition", "day"),
+            "vgis night": crop_samples("lisa_vgis_bulb_crops", "condition", "night"),
+            "kr boxes": box_samples("roboflow_traffic_light_kr"),
+            "cinta boxes": box_samples("roboflow_cinta_v2_id")}
+    tmp = tempfile.mkdtemp(prefix="bench_classifiers_")
+    for name in CLASSIFIERS:
+        given = dict(p.split(":", 1)[1].split("=", 1) for p in args.param
+                     if p.split(":", 1)[0] == name)
+        start = time.perf_counter()
+        path = train_model(name, train, Path(tmp) / name, given)
+        fit_s = time.perf_counter() - start
+        classifier = registry.create("classifier", name, {**given, "model": str(path)})
+        print(f"{name} {given or ''} trained on {len(train)} MIT train crops in {fit_s:.1f} s")
+        for set_name, dataset in sets.items():
+            show(set_name, evaluate(classifier, dataset))
+        rate = crops_per_second(classifier, sets["mit test"], args.repeats)
+        print(f"  speed: {rate:.0f} crops/s (MIT test, single thread, median of {args.repeats})")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,146 @@
+"""Pixel regions the state classifiers read: the lens disk A1 and annulus A3 around a candidate
+(Zheng 3.3, Eq. 3.17), and the lit lens inside a box that holds the whole signal housing.
+
+A housing box (KR, cinTA and MIT sets) is searched along its long axis for the disk with the
+highest mean HSV saturation x value, i.e. the most saturated bright disk: the lit lens.
+"""
+from __future__ import annotations
+
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from tsrkit.params import Param
+from tsrkit.types import Candidate, Frame, Sample
+
+#: How a candidate's box is read: as the lens itself, as a housing to search, or decided by shape.
+REGIONS = ("lens", "housing", "auto")
+
+REGION_PARAMS = (
+    Param("region", "str", "auto", choices=REGIONS,
+          help="lens: the candidate is the lit lens; housing: search its box for the lit lens; "
+               "auto: housing when the box is elongated (see elongation)"),
+    Param("elongation", "float", 1.5, min=1.0,
+          help="auto region: a box whose long/short side ratio reaches this is a housing"),
+    Param("lens_fraction", "float", 0.4, min=0.05, max=0.5,
+          help="lens radius in a housing box, as a fraction of the box's short side"),
+)
+
+
+@dataclass(frozen=True)
+class Rings:
+    """A patch of the image around a lens with the masks of its disk and annulus.
+
+    ``disk`` is A1 (distance <= r) and ``annulus`` is A3 (r < distance <= 2r), Zheng Eq. 3.17,
+    both clipped to the image.
+    """
+
+    patch: np.ndarray
+    disk: np.ndarray
+    annulus: np.ndarray
+
+
+def clip_box(bbox, width: int, height: int) -> tuple[int, int, int, int]:
+    """Integer pixel box ``(x0, y0, x1, y1)`` (exclusive end) clipped to the image.
+
+    Raises
+    ------
+    ValueError
+        When the box does not overlap the image.
+    """
+    x0, y0, x1, y1 = bbox
+    box = (max(int(np.floor(x0)), 0), max(int(np.floor(y0)), 0),
+           min(int(np.ceil(x1)), width), min(int(np.ceil(y1)), height))
+    if box[2] <= box[0] or box[3] <= box[1]:
+        raise ValueError(f"box {tuple(bbox)} lies outside the {width}x{height} image")
+    return box
+
+
+def rings(image: np.ndarray, x: float, y: float, radius: float) -> Rings:
+    """The patch of ``image`` within ``2 * radius`` of ``(x, y)`` with its A1 and A3 masks.
+
+    Pixel centres sit at integer coordinates + 0.5, so a box ``(0, 0, 20, 20)`` centres at 10.
+
+    Examples
+    --------
+    >>> r = rings(np.zeros((9, 9, 3), np.uint8), 4.5, 4.5, 2)
+    >>> int(r.disk.sum()), int(r.annulus.sum())
+    (12, 36)
+    """
+    if radius <= 0:
+        raise ValueError(f"lens radius must be positive; got {radius}")
+    h, w = image.shape[:2]
+    outer = 2 * radius
+    x0, y0, x1, y1 = clip_box((x - outer, y - outer, x + outer, y + outer), w, h)
+    yy, xx = np.mgrid[y0:y1, x0:x1]
+    dist2 = (xx + 0.5 - x) ** 2 + (yy + 0.5 - y) ** 2
+    disk = dist2 <= radius ** 2
+    annulus = ~disk & (dist2 <= outer ** 2)
+    return Rings(image[y0:y1, x0:x1], disk, annulus)
+
+
+def lit_map(bgr: np.ndarray) -> np.ndarray:
+    """Per-pixel HSV saturation x value in [0, 1]: high on a lit, coloured lens."""
+    hsv = cv2.cvtColor(bgr, cv2.COLOR_BGR2HSV)
+    return hsv[..., 1].astype(np.float32) * hsv[..., 2].astype(np.float32) / 255.0 ** 2
+
+
+def disk_kernel(radius: float) -> np.ndarray:
+    """A normalised disk (sums to 1) of the given radius, at least one pixel."""
+    half = max(int(np.floor(radius)), 0)
+    yy, xx = np.mgrid[-half:half + 1, -half:half + 1]
+    kernel = (xx ** 2 + yy ** 2 <= max(radius, 0.5) ** 2).astype(np.float32)
+    return kernel / kernel.sum()
+
+
+def find_lens(image: np.ndarray, bbox, lens_fraction: float = 0.4) -> Candidate:
+    """The lit lens inside a housing box: the disk of radius ``lens_fraction * short side``
+    with the highest mean saturation x value, its centre on the box's long axis.
+
+    Returns a lens candidate whose score is that mean (in [0, 1]).
+    """
+    x0, y0, x1, y1 = clip_box(bbox, image.shape[1], image.shape[0])
+    crop = image[y0:y1, x0:x1]
+    radius = max(lens_fraction * min(x1 - x0, y1 - y0), 0.5)
+    mean = cv2.filter2D(lit_map(crop), -1, disk_kernel(radius), borderType=cv2.BORDER_CONSTANT)
+    vertical = (y1 - y0) >= (x1 - x0)
+    line = mean[:, mean.shape[1] // 2] if vertical else mean[mean.shape[0] // 2, :]
+    best = int(np.argmax(line))
+    cx, cy = ((x1 - x0) / 2, best + 0.5) if vertical else (best + 0.5, (y1 - y0) / 2)
+    return Candidate.from_circle(x0 + cx, y0 + cy, radius, float(line[best]))
+
+
+def is_housing(candidate: Candidate, region: str, elongation: float) -> bool:
+    """Whether ``candidate``'s box is read as a housing under the ``region`` setting."""
+    if region not in REGIONS:
+        raise ValueError(f"region must be one of {', '.join(REGIONS)}; got {region!r}")
+    if region != "auto":
+        return region == "housing"
+    x0, y0, x1, y1 = candidate.bbox
+    short, long = sorted((x1 - x0, y1 - y0))
+    return short > 0 and long / short >= elongation
+
+
+def lens_of(image: np.ndarray, candidate: Candidate, params) -> Candidate:
+    """The lens to classify for ``candidate``, following the plugin's region parameters."""
+    if is_housing(candidate, params["region"], params["elongation"]):
+        return find_lens(image, candidate.bbox, params["lens_fraction"])
+    return candidate
+
+
+def labelled_lenses(samples: Iterable[Sample], states: tuple[str, ...],
+                    params) -> Iterator[tuple[str, Frame, Candidate]]:
+    """``(state, frame, lens)`` for every annotation of ``samples`` whose state is in ``states``.
+
+    Crop samples have one annotation covering the image; detection samples give one lens per
+    annotated box. Other labels (arrows, off) are passed over.
+    """
+    for sample in samples:
+        wanted = [a for a in sample.annotations if a.state in states]
+        if not wanted:
+            continue
+        frame = sample.load()
+        for ann in wanted:
+            yield ann.state, frame, lens_of(frame.image, Candidate.from_box(ann.bbox, 1.0), params)
