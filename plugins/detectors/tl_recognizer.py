@@ -1,0 +1,239 @@
+"""TL-recognizer (Mascetti et al. 2016): HSV range filters, contour pruning, template validation.
+
+Per colour pass (green and "yellowRed", 4.1) the frame reduced by the resize factor (4.2) is range
+filtered in HSV (3.3, Table 6), its contours are levelled by the horizon roll and pruned by size
+(3.4), and each survivor's full-resolution patch is compared with a template by NCC (3.5).
+"""
+from __future__ import annotations
+
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from tsrkit.hookspecs import hookimpl
+from tsrkit.models import Model, load_model
+from tsrkit.params import Param
+from tsrkit.plugin import Detector
+from tsrkit.types import Candidate, Frame
+
+from tsrkit_plugins.detectors import tl_geometry as geo
+from tsrkit_plugins.detectors.tl_templates import extract_patch, load_templates, ncc
+
+#: Filters of the ranges array: rows of ``ranges[k] = [[h, s, v]_min, [h, s, v]_max]``.
+FILTERS = ("green", "yellowred_first", "yellowred_second")
+#: The colour passes of 4.1 and the filter rows each one ORs together.
+PASSES = {"green": (0,), "yellowred": (1, 2)}
+
+
+def table6_ranges(green_h, yellowred_h, s_range, v_range) -> np.ndarray:
+    """The range-filter bounds of Table 6 as a (3, 2, 3) array (filter, min/max, H/S/V)."""
+    hues = ((green_h[0], green_h[1]), (yellowred_h[0], yellowred_h[1]),
+            (yellowred_h[2], yellowred_h[3]))
+    return np.array([[[lo, s_range[0], v_range[0]], [hi, s_range[1], v_range[1]]]
+                     for lo, hi in hues], dtype=np.float64)
+
+
+def range_mask(hsv: np.ndarray, ranges: np.ndarray, rows: tuple[int, ...]) -> np.ndarray:
+    """Binary image of the pixels inside any of the filters ``rows`` (3.3, Algorithm 1 line 4)."""
+    mask = cv2.inRange(hsv, ranges[rows[0], 0], ranges[rows[0], 1])
+    for row in rows[1:]:
+        mask |= cv2.inRange(hsv, ranges[row, 0], ranges[row, 1])
+    return mask
+
+
+def reduced_hsv(image: np.ndarray, factor: int) -> np.ndarray:
+    """The frame divided by ``factor`` on both sides (area averaging), in HSV (4.2)."""
+    small = image if factor == 1 else cv2.resize(
+        image, (max(1, image.shape[1] // factor), max(1, image.shape[0] // factor)),
+        interpolation=cv2.INTER_AREA)
+    return cv2.cvtColor(small, cv2.COLOR_BGR2HSV)
+
+
+def extract_contours(mask: np.ndarray) -> list[np.ndarray]:
+    """Outer contours of the white blobs (Suzuki-Abe border following, 3.3 / Algorithm 1 line 5)."""
+    contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
+    return list(contours)
+
+
+def red_or_yellow(patch_bgr: np.ndarray, s_min: float, v_min: float, red_h: tuple[int, int],
+                  yellow_h: tuple[int, int]) -> str:
+    """Red when the lit pixels of a patch hold more red hues than yellow ones, else yellow (4.1).
+
+    Only pixels with S >= ``s_min`` and V >= ``v_min`` are counted (our reading: the hue of the
+    dark background screen is noise).
+    """
+    hsv = cv2.cvtColor(patch_bgr, cv2.COLOR_BGR2HSV)
+    lit = (hsv[..., 1] >= s_min) & (hsv[..., 2] >= v_min)
+    hue = hsv[..., 0][lit]
+    reds = np.count_nonzero((hue >= red_h[0]) & (hue <= red_h[1]))
+    yellows = np.count_nonzero((hue >= yellow_h[0]) & (hue <= yellow_h[1]))
+    return "red" if reds > yellows else "yellow"
+
+
+@dataclass(frozen=True)
+class Camera:
+    """What pruning knows of the camera: focal length (None: unknown), pitch and roll (radians)."""
+
+    focal_px: float | None
+    pitch: float
+    roll: float
+
+
+class TlRecognizer(Detector):
+    name = "tl-recognizer"
+    summary = "HSV range filters, contour pruning and template NCC validation; assigns the state"
+    section = "Mascetti 2016, 3.2-3.5, 4.1-4.2, 5.2, Table 6"
+    params = (
+        Param("green_h", "ints", (70, 95), min=0, max=180, length=2,
+              help="hue range of the green filter (OpenCV scale)", section="Table 6"),
+        Param("yellowred_h", "ints", (0, 25, 166, 180), min=0, max=180, length=4,
+              help="the two hue ranges of the yellowRed filter", section="Table 6, 4.1"),
+        Param("s_range", "ints", (100, 255), min=0, max=255, length=2,
+              help="saturation range of every filter", section="Table 6"),
+        Param("v_range", "ints", (80, 255), min=0, max=255, length=2,
+              help="value range of every filter", section="Table 6"),
+        Param("red_h", "ints", (160, 179), min=0, max=180, length=2,
+              help="pure red hues counted for the red/yellow split", section="4.1"),
+        Param("yellow_h", "ints", (10, 30), min=0, max=180, length=2,
+              help="pure yellow hues counted for the red/yellow split", section="4.1"),
+        Param("threshold", "float", 0.586, min=-1, max=1,
+              help="NCC above which a patch is a lit lens (T)", section="3.5, 5.2"),
+        Param("resize_factor", "int", 3, min=1, max=16,
+              help="extraction and pruning on the frame reduced by this factor", section="4.2"),
+        Param("template_size", "int", 32, min=4, max=256,
+              help="side of the square templates in pixels", section="3.5"),
+        Param("templates", "path", None,
+              help="folder with red.*, yellow.*, green.* template images (default: lit discs)",
+              section="3.5"),
+        Param("focal_px", "float", None, min=1,
+              help="focal length in pixels, if frames lack metadata 'focal_px'", section="3.4"),
+        Param("pitch_deg", "float", 0.0, min=-90, max=90,
+              help="camera pitch (up positive), if frames lack 'pitch_deg'", section="Property 1"),
+        Param("roll_deg", "float", 0.0, min=-180, max=180,
+              help="camera roll, if frames lack 'roll_deg'", section="Property 1"),
+        Param("lens_m", "float", 0.2, min=0.01,
+              help="lens height and width in metres", section="2.4, Property 2"),
+        Param("horizontal_m", "floats", (2.5, 20.0), min=0, length=2,
+              help="allowed horizontal distance to the light", section="2.4, Property 2"),
+        Param("vertical_m", "floats", (0.5, 4.0), length=2,
+              help="allowed height of the light above the camera", section="2.4, Property 2"),
+        Param("max_rotation_deg", "float", 45.0, min=0, max=89,
+              help="maximum rotation distance of a light towards the user", section="2.4, Prop. 3"),
+        Param("width_slack", "float", 0.15, min=0, max=1,
+              help="relative tolerance of the width test for pixel quantisation (not in the paper)"),
+        Param("size_px", "floats", (3.0, 400.0), min=0, length=2,
+              help="lens height range in full-resolution pixels when focal_px is unknown"),
+        Param("min_aspect", "float", 0.5, min=0.01, max=1,
+              help="smallest width/height (and height/width) ratio when focal_px is unknown"),
+        Param("threads", "int", 1, min=1, max=2,
+              help="threads for the colour passes (2 runs green and yellowRed together)",
+              section="4.2"),
+        Param("fit_coverage", "float", 1.0, min=0.5, max=1,
+              help="training: share of annotated lens pixels the derived ranges include",
+              section="5.2, Figure 16"),
+        Param("model", "path", None,
+              help="model from 'tsrkit train tl-recognizer' (ranges and T)", section="5.2"),
+    )
+
+    def __init__(self, **params):
+        super().__init__(**params)
+        p = self.params
+        self.ranges = table6_ranges(p["green_h"], p["yellowred_h"], p["s_range"], p["v_range"])
+        self.threshold = p["threshold"]
+        if p["model"] is not None:
+            model = load_model(p["model"], plugin=self.name)
+            self.ranges = np.asarray(model.arrays["ranges"], dtype=np.float64)
+            self.threshold = float(model.arrays["threshold"])
+        self.templates = load_templates(p["templates"], p["template_size"])
+
+    def camera(self, frame: Frame) -> Camera:
+        """Focal length, pitch and roll from the frame's metadata, else from the parameters."""
+        meta, p = frame.metadata, self.params
+        focal = meta.get("focal_px", p["focal_px"])
+        return Camera(None if focal is None else float(focal),
+                      float(np.radians(meta.get("pitch_deg", p["pitch_deg"]))),
+                      float(np.radians(meta.get("roll_deg", p["roll_deg"]))))
+
+    def detect(self, frame: Frame) -> list[Candidate]:
+        """Lit lenses whose NCC exceeds T, best first; ``state`` is red, yellow or green."""
+        return [c for c in self.scored(frame) if c.score > self.threshold]
+
+    def scored(self, frame: Frame) -> list[Candidate]:
+        """Every contour that survives pruning, scored by NCC but not thresholded, best first."""
+        image = frame.image
+        hsv = reduced_hsv(image, self.params["resize_factor"])
+        camera = self.camera(frame)
+        jobs = [(hsv, image, colour, camera) for colour in PASSES]
+        if self.params["threads"] > 1:
+            with ThreadPoolExecutor(self.params["threads"]) as pool:
+                found = list(pool.map(lambda job: self._colour_pass(*job), jobs))
+        else:
+            found = [self._colour_pass(*job) for job in jobs]
+        return sorted((c for part in found for c in part), key=lambda c: -c.score)
+
+    def _colour_pass(self, hsv: np.ndarray, image: np.ndarray, colour: str,
+                     camera: Camera) -> list[Candidate]:
+        """Extraction, pruning and validation for one colour (Algorithm 1, lines 3-16)."""
+        mask = range_mask(hsv, self.ranges, PASSES[colour])
+        scale = (image.shape[1] / hsv.shape[1], image.shape[0] / hsv.shape[0])
+        centre = ((image.shape[1] - 1) / 2, (image.shape[0] - 1) / 2)
+        out = []
+        for contour in extract_contours(mask):
+            box_uv = self._levelled_box(contour, scale, camera.roll, centre)
+            if not self._passes_pruning(box_uv, camera):
+                continue
+            out.append(self._validate(image, box_uv, colour, camera.roll, centre))
+        return out
+
+    @staticmethod
+    def _levelled_box(contour: np.ndarray, scale: tuple[float, float], roll: float,
+                      centre: tuple[float, float]) -> tuple[float, float, float, float]:
+        """Pixel-edge extents ``(u0, v0, u1, v1)`` of a reduced-frame contour, levelled (line 8)."""
+        pts = contour.reshape(-1, 2).astype(np.float64)
+        pts = (pts + 0.5) * scale - 0.5
+        uv = geo.level_coordinates(pts, roll, centre)
+        (u0, v0), (u1, v1) = uv.min(axis=0), uv.max(axis=0)
+        pad_u, pad_v = scale[0] / 2, scale[1] / 2
+        return u0 - pad_u, v0 - pad_v, u1 + pad_u, v1 + pad_v
+
+    def _passes_pruning(self, box_uv, camera: Camera) -> bool:
+        """Property 2 and 3 with a known focal length, else pixel size and aspect bounds (3.4)."""
+        u0, v0, u1, v1 = box_uv
+        width, height = u1 - u0, v1 - v0
+        p = self.params
+        if camera.focal_px is None:
+            aspect = width / height
+            return (p["size_px"][0] <= height <= p["size_px"][1]
+                    and p["min_aspect"] <= aspect <= 1 / p["min_aspect"])
+        return geo.passes_distance_and_width(
+            v0, v1, width, focal_px=camera.focal_px, pitch=camera.pitch, lens_m=p["lens_m"],
+            horizontal_m=p["horizontal_m"], vertical_m=p["vertical_m"],
+            max_rotation=np.radians(p["max_rotation_deg"]), width_slack=p["width_slack"])
+
+    def _validate(self, image: np.ndarray, box_uv, colour: str, roll: float,
+                  centre: tuple[float, float]) -> Candidate:
+        """Patch, red/yellow split and NCC with the colour's template (3.5, 4.1)."""
+        patch = extract_patch(image, box_uv, roll, centre, self.params["template_size"])
+        state = colour
+        if colour == "yellowred":
+            state = red_or_yellow(patch, self.ranges[1, 0, 1], self.ranges[1, 0, 2],
+                                  self.params["red_h"], self.params["yellow_h"])
+        score = ncc(patch, self.templates[state])
+        u0, v0, u1, v1 = box_uv
+        corners = geo.image_coordinates(np.array([[u0, v0], [u1, v0], [u1, v1], [u0, v1]]),
+                                        roll, centre)
+        (x0, y0), (x1, y1) = corners.min(axis=0), corners.max(axis=0)
+        return Candidate.from_box((x0, y0, x1, y1), score, state)
+
+    def fit(self, samples) -> Model:
+        """Derive range bounds (Figure 16) and T (5.2) from annotated samples."""
+        from tsrkit_plugins.detectors.tl_tuning import fit_model
+
+        return fit_model(self, samples)
+
+
+@hookimpl
+def register_detectors(register):
+    register(TlRecognizer)
