@@ -100,14 +100,14 @@ class AbHist(Classifier):
     params = (
         Param("model", "path", None, help="trained model (.npz); unset: the shipped default "
               "trained on udacity_mit_tl_crops train"),
-        Param("bins", "int", 16, min=2, max=256, help="bins per axis of the a-b histogram "
+        Param("bins", "int", 32, min=2, max=256, help="bins per axis of the a-b histogram "
               "(used when training; a loaded model brings its own)", section="Eq. 3.18"),
         Param("mode", "str", "saturation", choices=MODES, help="Eq. 3.19 reading: max over "
               "A1/A3, or the more saturated area", section="Eq. 3.19"),
-        Param("min_chroma", "float", 0.0, min=0.0, max=180.0, help="leave pixels of lower "
+        Param("min_chroma", "float", 10.0, min=0.0, max=180.0, help="leave pixels of lower "
               "CIELab chroma (grey housing, white-hot centres) out of the histograms; 0 keeps "
               "every pixel as Zheng does"),
-        Param("smooth", "float", 0.0, min=0.0, max=16.0, help="Gaussian sigma, in bins, "
+        Param("smooth", "float", 3.0, min=0.0, max=16.0, help="Gaussian sigma, in bins, "
               "applied to every histogram before matching; 0 matches raw histograms as Zheng "
               "does"),
         Param("min_ratio", "float", 0.0, min=0.0, max=1.0, help="discriminative ratio below "

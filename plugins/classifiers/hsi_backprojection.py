@@ -99,7 +99,7 @@ class HsiBackprojection(Classifier):
               "trained on udacity_mit_tl_crops train"),
         Param("pixels_per_sample", "int", 0, min=0, help="lit pixels taken from each training "
               "sample; 0: the smallest lens of the training set (Lee 5.3.3)", section="5.3.3"),
-        Param("hue_smooth", "float", 0.0, min=0.0, max=30.0, help="circular Gaussian sigma, "
+        Param("hue_smooth", "float", 5.0, min=0.0, max=30.0, help="circular Gaussian sigma, "
               "in hue bins, applied to the trained hue histograms (0: Lee's raw histograms)"),
         Param("threshold", "float", 0.0, min=0.0, max=1.0, help="unknown when the best state's "
               "probability is below this (t of 5.3.4)", section="5.3.4"),

@@ -2,7 +2,7 @@
 (Zheng 3.3, Eq. 3.17), and the lit lens inside a box that holds the whole signal housing.
 
 A housing box (KR, cinTA and MIT sets) is searched along its long axis for the disk with the
-highest mean HSV saturation x value, i.e. the most saturated bright disk: the lit lens.
+highest mean HSV saturation x value^2, i.e. the most saturated bright disk: the lit lens.
 """
 from __future__ import annotations
 
@@ -82,9 +82,11 @@ def rings(image: np.ndarray, x: float, y: float, radius: float) -> Rings:
 
 
 def lit_map(bgr: np.ndarray) -> np.ndarray:
-    """Per-pixel HSV saturation x value in [0, 1]: high on a lit, coloured lens."""
+    """Per-pixel HSV saturation x value^2 in [0, 1]: high on a lit, coloured lens (the squared
+    value keeps a bright lens ahead of a saturated but dimmer sky or housing)."""
     hsv = cv2.cvtColor(bgr, cv2.COLOR_BGR2HSV)
-    return hsv[..., 1].astype(np.float32) * hsv[..., 2].astype(np.float32) / 255.0 ** 2
+    v = hsv[..., 2].astype(np.float32) / 255.0
+    return hsv[..., 1].astype(np.float32) / 255.0 * v * v
 
 
 def disk_kernel(radius: float) -> np.ndarray:
@@ -97,7 +99,7 @@ def disk_kernel(radius: float) -> np.ndarray:
 
 def find_lens(image: np.ndarray, bbox, lens_fraction: float = 0.4) -> Candidate:
     """The lit lens inside a housing box: the disk of radius ``lens_fraction * short side``
-    with the highest mean saturation x value, its centre on the box's long axis.
+    with the highest mean :func:`lit_map`, its centre on the box's long axis.
 
     Returns a lens candidate whose score is that mean (in [0, 1]).
     """
