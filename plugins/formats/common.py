@@ -125,3 +125,13 @@ def sniff_json(path: Path, test) -> bool:
         return bool(test(read_json(path)))
     except DatasetError:
         return False
+
+
+def unique_path(path: Path, used: set[Path]) -> Path:
+    """``path``, or ``stem_N.suffix`` when an earlier sample already took that name."""
+    candidate, n = path, 1
+    while candidate in used:
+        candidate = path.with_name(f"{path.stem}_{n}{path.suffix}")
+        n += 1
+    used.add(candidate)
+    return candidate

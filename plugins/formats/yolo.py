@@ -23,7 +23,8 @@ from tsrkit.hookspecs import hookimpl
 from tsrkit.inputs import IMAGE_EXTENSIONS
 from tsrkit.plugin import DatasetFormat
 from tsrkit.types import Dataset, Sample
-from tsrkit_plugins.formats.common import annotation, class_names, numbers, raw_label
+from tsrkit_plugins.formats.common import (annotation, class_names, numbers, raw_label,
+                                           unique_path)
 
 DATA_YAML = "data.yaml"
 SPLIT_KEYS = {"train": "train", "val": "valid", "test": "test"}
@@ -119,7 +120,7 @@ class Yolo(DatasetFormat):
         for sample in dataset:
             split = sample.split if sample.split in ("train", "valid", "test") else "train"
             splits.add(split)
-            image = _free_name(out / split / "images" / Path(sample.source).name, used)
+            image = unique_path(out / split / "images" / Path(sample.source).name, used)
             _place_image(Path(sample.source), image)
             size = ((sample.width, sample.height) if sample.width and sample.height
                     else image_size(sample.source))
@@ -176,16 +177,6 @@ def _label_line(class_id: int, bbox, width: int, height: int) -> str:
     values = ((x0 + x1) / 2 / width, (y0 + y1) / 2 / height, (x1 - x0) / width,
               (y1 - y0) / height)
     return " ".join([str(class_id), *(f"{v:.8f}" for v in values)])
-
-
-def _free_name(path: Path, used: set[Path]) -> Path:
-    """``path``, or ``stem_N.suffix`` when another sample already took that name."""
-    candidate, n = path, 1
-    while candidate in used:
-        candidate = path.with_name(f"{path.stem}_{n}{path.suffix}")
-        n += 1
-    used.add(candidate)
-    return candidate
 
 
 def _place_image(source: Path, target: Path) -> None:
