@@ -66,7 +66,8 @@ def base_report(dataset: Dataset, detector: dict | None, classifier: dict | None
     return {
         "dataset": {"name": dataset.name, "format": dataset.format, "root": dataset.root,
                     "samples": len(dataset),
-                    "box_convention": dataset.info.get("box_convention", "unknown")},
+                    "box_convention": (dataset.info.get("box") or dataset.info.get("box_convention")
+                                       or "unknown")},
         "detector": detector, "classifier": classifier,
         "params": {kind: plugin["params"] for kind, plugin in
                    (("detector", detector), ("classifier", classifier)) if plugin},

@@ -282,3 +282,38 @@ def benchmark(dataset: Dataset, detector: Detector | None, classifier: Classifie
                          scheduler=scheduler, out=out, cache=cache, cache_dir=cache_dir,
                          progress=progress, iou_threshold=iou_threshold)
     return report
+
+
+def compare(dataset: Dataset, detectors: list[Detector], classifier: Classifier | None = None,
+            *, out: str | os.PathLike | None = None, **options: Any) -> dict[str, Any]:
+    """Benchmark several detectors on the same frames and test each pair.
+
+    Each run writes its outputs to ``OUT/<detector>/``; ``OUT/compare.json`` and
+    ``OUT/compare.md`` hold the reports side by side and, for every pair, a Wilcoxon
+    signed-rank test on per-frame recall over the ground-truth frames both evaluated.
+    Other keyword options are those of :func:`benchmark`.
+    """
+    from tsrkit.eval.stats import paired_test
+    from tsrkit.report import write_compare
+
+    names = [d.name for d in detectors]
+    if len(set(names)) != len(names) or len(names) < 2:
+        raise BenchmarkError(f"compare needs at least two different detectors; got {names}")
+    reports, recalls = [], []
+    for detector in detectors:
+        sub = Path(out) / detector.name if out is not None else None
+        report, evaluation = evaluate(dataset, detector, classifier, out=sub, **options)
+        reports.append(report)
+        recalls.append({i: s.recall for i, s in evaluation.scores.items() if s.n_gt})
+    tests = []
+    for a in range(len(detectors)):
+        for b in range(a + 1, len(detectors)):
+            common = sorted(recalls[a].keys() & recalls[b].keys())
+            test = paired_test([recalls[a][i] for i in common], [recalls[b][i] for i in common],
+                               names[a], names[b])
+            tests.append({"a": names[a], "b": names[b], "metric": "per-frame recall", **test})
+    comparison = {"dataset": dataset.name, "detectors": names, "reports": reports,
+                  "paired_tests": tests}
+    if out is not None:
+        write_compare(Path(out), comparison)
+    return comparison
