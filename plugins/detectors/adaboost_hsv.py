@@ -15,6 +15,7 @@ from sklearn.ensemble import AdaBoostClassifier
 from sklearn.tree import DecisionTreeClassifier
 
 from tsrkit.errors import TsrkitError
+from tsrkit.eval.matching import iou_matrix
 from tsrkit.hookspecs import hookimpl
 from tsrkit.models import Model, load_model
 from tsrkit.params import Param
@@ -203,16 +204,6 @@ def blob_boxes(binary: np.ndarray,
     return boxes, (keep + 1), label_image
 
 
-def box_iou(box: np.ndarray, others: np.ndarray) -> np.ndarray:
-    """Intersection over union of ``box`` with each row of ``others``."""
-    wx = np.clip(np.minimum(box[2], others[:, 2]) - np.maximum(box[0], others[:, 0]), 0, None)
-    wy = np.clip(np.minimum(box[3], others[:, 3]) - np.maximum(box[1], others[:, 1]), 0, None)
-    inter = wx * wy
-    area = (box[2] - box[0]) * (box[3] - box[1])
-    areas = (others[:, 2] - others[:, 0]) * (others[:, 3] - others[:, 1])
-    return inter / (area + areas - inter)
-
-
 def largest_first_nms(boxes: np.ndarray, overlap: float, limit: int) -> np.ndarray:
     """Indices of boxes kept by non-maximum suppression that prefers the larger box (3.2)."""
     areas = (boxes[:, 2] - boxes[:, 0]) * (boxes[:, 3] - boxes[:, 1])
@@ -220,7 +211,7 @@ def largest_first_nms(boxes: np.ndarray, overlap: float, limit: int) -> np.ndarr
     for i in np.argsort(-areas, kind="stable"):
         if len(kept) == limit:
             break
-        if not kept or box_iou(boxes[i], boxes[kept]).max() <= overlap:
+        if not kept or iou_matrix(boxes[i:i + 1], boxes[kept]).max() <= overlap:
             kept.append(int(i))
     return np.array(kept, np.intp)
 
