@@ -46,7 +46,7 @@ def similarity(h: np.ndarray, h_ref: np.ndarray) -> float:
     if norm == 0:
         return 0.0
     cosine = float(np.clip(np.sum(h * h_ref) / norm, -1.0, 1.0))
-    return 1.0 - 2.0 * np.arccos(cosine) / np.pi
+    return float(1.0 - 2.0 * np.arccos(cosine) / np.pi)
 
 
 def mean_saturation(hsv: np.ndarray, mask: np.ndarray) -> float:

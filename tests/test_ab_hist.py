@@ -1,0 +1,122 @@
+"""ab-hist (Zheng 3.3): histograms, Eq. 3.20 similarity, training, decisions, model files."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import cv2
+
+from oracles.lamps import COLOURS, crop_sample, lamp, training_set
+from tsrkit.models import ModelError, load_model, save_model
+from tsrkit.registry import get_registry
+from tsrkit.types import Candidate, Frame
+from tsrkit_plugins.classifiers.ab_hist import ab_histogram, similarity
+from tsrkit_plugins.classifiers.decision import discriminative_ratio
+
+
+def make(**params):
+    return get_registry().create("classifier", "ab-hist", params)
+
+
+@pytest.fixture(scope="module")
+def model_path(tmp_path_factory):
+    classifier = make(smooth=0, min_chroma=0)
+    path = tmp_path_factory.mktemp("ab") / "model"
+    save_model(path, classifier.fit(training_set()), plugin="ab-hist", plugin_version="t",
+               params=classifier.params, training={})
+    return path
+
+
+def test_histogram_matches_numpy_histogram2d():
+    rng = np.random.default_rng(3)
+    lab = rng.integers(0, 256, (12, 15, 3), dtype=np.uint8)
+    mask = rng.random((12, 15)) < 0.6
+    expected, _, _ = np.histogram2d(lab[..., 1][mask], lab[..., 2][mask], bins=8,
+                                    range=[[0, 256], [0, 256]])
+    got = ab_histogram(lab, mask, 8)
+    assert np.allclose(got, expected / mask.sum())
+    assert got.sum() == pytest.approx(1.0)
+    assert not ab_histogram(lab, np.zeros_like(mask), 8).any()
+
+
+def test_similarity_is_one_for_equal_and_zero_for_disjoint_histograms():
+    h = np.array([[1.0, 2.0], [0.0, 0.0]], np.float32)
+    other = np.array([[0.0, 0.0], [0.0, 5.0]], np.float32)
+    assert similarity(h, 3 * h) == pytest.approx(1.0)
+    assert similarity(h, other) == pytest.approx(0.0)
+    assert similarity(h, np.zeros_like(h)) == 0.0
+    half = np.array([[1.0, 0.0], [0.0, 1.0]], np.float32)
+    assert similarity(np.array([[1.0, 0.0], [0.0, 0.0]], np.float32), half) == pytest.approx(0.5)
+
+
+@pytest.mark.parametrize("state", ["red", "yellow", "green"])
+@pytest.mark.parametrize("mode", ["max", "saturation"])
+def test_pure_disks_get_their_state_with_a_ratio_near_one(model_path, state, mode):
+    classifier = make(model=str(model_path), smooth=0, min_chroma=0, mode=mode)
+    image = lamp(COLOURS[state], size=40, radius=8, seed=11)
+    det = classifier.classify(Frame(image, "t"), [Candidate.from_circle(20, 20, 8, 1.0)])[0]
+    assert det.state == state
+    assert discriminative_ratio(det.state_scores) > 0.8
+
+
+def test_night_halo_is_classified_by_its_annulus(model_path):
+    white = (250, 250, 250)
+    image = lamp(COLOURS["red"], size=48, radius=12, core=white, seed=5)
+    classifier = make(model=str(model_path), smooth=0, min_chroma=0, mode="saturation")
+    det = classifier.classify(Frame(image, "t"), [Candidate.from_circle(24, 24, 6, 1.0)])[0]
+    assert det.state == "red"
+    plain = lamp(white, size=48, radius=6, seed=5)
+    assert classifier.classify(Frame(plain, "t"), [Candidate.from_circle(24, 24, 6, 1.0)])[0] \
+        .state_scores["red"] < det.state_scores["red"]
+
+
+def test_low_discriminative_ratio_gives_unknown(model_path):
+    grey = lamp((128, 128, 128), size=24, radius=8)
+    classifier = make(model=str(model_path), smooth=0, min_chroma=0, min_ratio=0.99)
+    assert classifier.classify(Frame(grey, "t"), [Candidate.from_box((4, 4, 20, 20), 1)])[0] \
+        .state == "unknown"
+
+
+def test_training_is_deterministic_and_averages_histograms():
+    first = make(smooth=0).fit(training_set())
+    second = make(smooth=0).fit(training_set())
+    assert np.array_equal(first.arrays["histograms"], second.arrays["histograms"])
+    assert first.arrays["counts"].tolist() == [4, 4, 4]
+    assert first.arrays["histograms"].sum(axis=(1, 2)) == pytest.approx([1, 1, 1], rel=1e-3)
+
+
+def test_training_needs_every_colour():
+    with pytest.raises(ValueError, match="yellow"):
+        make().fit([s for s in training_set() if s.annotations[0].state != "yellow"])
+
+
+def test_model_round_trip_and_wrong_models(tmp_path, model_path):
+    model = load_model(model_path, plugin="ab-hist")
+    image = lamp(COLOURS["green"], size=30, radius=9)
+    frame, cands = Frame(image, "t"), [Candidate.from_box((6, 6, 24, 24), 1.0)]
+    assert make(model=str(model_path), smooth=0, min_chroma=0).classify(frame, cands)[0] \
+        .state_scores == make(model=str(model_path), smooth=0, min_chroma=0).classify(
+            frame, cands)[0].state_scores
+    assert model.arrays["histograms"].shape == (3, 32, 32)
+    other = tmp_path / "other"
+    save_model(other, model, plugin="hsi-backprojection", plugin_version="t", params={},
+               training={})
+    with pytest.raises(ModelError, match="hsi-backprojection"):
+        make(model=str(other)).classify(frame, cands)
+    (tmp_path / "bad.npz").write_bytes(b"not a zip")
+    (tmp_path / "bad.json").write_text(model_path.with_suffix(".json").read_text())
+    with pytest.raises(ModelError, match="corrupt"):
+        make(model=str(tmp_path / "bad")).classify(frame, cands)
+
+
+def test_shipped_model_classifies_real_mit_crops(shared_datasets):
+    classifier = make()
+    root = shared_datasets / "udacity_mit_tl_crops" / "test"
+    right = total = 0
+    for state in ("red", "green"):
+        for path in sorted((root / state).glob("*.jpg"))[:40]:
+            image = cv2.imread(str(path))
+            box = (0, 0, image.shape[1], image.shape[0])
+            right += classifier.classify(Frame(image, str(path)),
+                                         [Candidate.from_box(box, 1.0)])[0].state == state
+            total += 1
+    assert total == 80 and right / total >= 0.85
