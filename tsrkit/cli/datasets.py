@@ -1,2 +1,116 @@
-"""``tsrkit datasets``."""
-COMMANDS = []
+"""``tsrkit datasets``: the registry in ``datasets.yaml`` — list, info, verify, convert."""
+from __future__ import annotations
+
+import json
+from collections import Counter
+from pathlib import Path
+
+import click
+from rich.console import Console
+from rich.table import Table
+
+from tsrkit.datasets import (DatasetError, load_registry, open_dataset, registry_path,
+                             verify_manifest, write_dataset)
+from tsrkit.datasets.registry import GENERATED_SAMPLE
+from tsrkit.errors import TsrkitError
+
+
+@click.group("datasets")
+def datasets_group() -> None:
+    """The dataset registry (datasets.yaml): list, info NAME, verify NAME, convert SRC."""
+
+
+@datasets_group.command("list")
+@click.option("--json", "as_json", is_flag=True, help="Print JSON.")
+def list_command(as_json: bool) -> None:
+    """Registered datasets: name, format, task, box convention, licence, and whether present."""
+    rows = []
+    for entry in load_registry().values():
+        rows.append({**entry.to_info(), "present": _present(entry)})
+    if as_json:
+        click.echo(json.dumps(rows, indent=2))
+        return
+    table = Table(title=f"tsrkit datasets ({registry_path()})")
+    for column in ("name", "format", "task", "box", "licence", "present"):
+        table.add_column(column)
+    for row in rows:
+        table.add_row(row["name"], row["format"], row["task"], row["box"], row["licence"],
+                      row["present"] if row["present"] != "no" else "[red]no[/red]")
+    Console().print(table)
+
+
+@datasets_group.command("info")
+@click.argument("name")
+@click.option("--json", "as_json", is_flag=True, help="Print JSON.")
+def info_command(name: str, as_json: bool) -> None:
+    """Registry facts of NAME plus counts of samples, boxes, splits and states."""
+    dataset = open_dataset(name)
+    states = Counter(a.state for s in dataset for a in s.annotations)
+    labels = Counter(a.attributes.get("label", a.state) for s in dataset for a in s.annotations)
+    facts = {**dataset.info, "name": dataset.name, "format": dataset.format,
+             "samples": len(dataset), "annotations": sum(states.values()),
+             "splits": dict(Counter(s.split or "-" for s in dataset)),
+             "states": dict(states.most_common()), "labels": dict(labels.most_common())}
+    if as_json:
+        click.echo(json.dumps(facts, indent=2, default=str))
+        return
+    table = Table(title=f"dataset {dataset.name}", show_header=False)
+    for key, value in facts.items():
+        if value not in (None, "", [], {}):
+            table.add_row(key, ", ".join(f"{k}: {v}" for k, v in value.items())
+                          if isinstance(value, dict) else str(value))
+    Console().print(table)
+
+
+@datasets_group.command("verify")
+@click.argument("name")
+@click.pass_context
+def verify_command(ctx: click.Context, name: str) -> None:
+    """Check every file of NAME against its sha256 manifest; exit 1 if any is missing/altered."""
+    registry = load_registry()
+    if name not in registry:
+        raise TsrkitError(f"no registered dataset '{name}' (known: {', '.join(registry)})")
+    entry = registry[name]
+    if not entry.manifest:
+        raise TsrkitError(f"dataset '{name}' has no checksum manifest to verify against")
+    root = entry.annotation_path() if entry.path == "." else entry.root_path()
+    result = verify_manifest(root, root / entry.manifest)
+    for label, files in (("missing", result.missing), ("altered", result.altered)):
+        for file in files:
+            click.echo(f"{label}: {file}")
+    summary = (f"{name}: {result.checked} files checked, {len(result.missing)} missing, "
+               f"{len(result.altered)} altered, {len(result.unlisted)} not in the manifest")
+    click.echo(summary)
+    if not result.ok:
+        ctx.exit(1)
+
+
+@datasets_group.command("convert")
+@click.argument("src")
+@click.option("--to", "to_format", required=True, help="Format plugin to write.")
+@click.option("--out", required=True, type=click.Path(path_type=Path),
+              help="Output file (coco, normalized) or folder (yolo, voc).")
+@click.option("--format", "src_format", default=None,
+              help="Format of SRC (detected when unambiguous).")
+@click.option("--images", type=click.Path(path_type=Path), default=None,
+              help="Folder that image paths in SRC resolve against.")
+def convert_command(src: str, to_format: str, out: Path, src_format: str | None,
+                    images: Path | None) -> None:
+    """Read SRC (registry name or path) and write it in another format at --out."""
+    dataset = open_dataset(src, format=src_format, images=images)
+    write_dataset(dataset, to_format, out)
+    boxes = sum(len(s.annotations) for s in dataset)
+    click.echo(f"wrote {len(dataset)} images, {boxes} boxes as {to_format} to {out}")
+
+
+def _present(entry) -> str:
+    """``yes``, ``no`` or ``generated`` (made on first use), without generating anything."""
+    if entry.root == GENERATED_SAMPLE:
+        return "generated"
+    try:
+        return "yes" if entry.annotation_path().exists() else "no"
+    except DatasetError:
+        return "no"
+
+
+COMMANDS = [datasets_group]
