@@ -1,11 +1,13 @@
 """Lens/annulus regions, the lit-lens search in a housing box, and the shared decisions."""
 from __future__ import annotations
 
+import cv2
 import numpy as np
 import pytest
 
 from oracles.lamps import COLOURS, crop_sample, housing, lamp
-from tsrkit.types import Annotation, Candidate, Sample
+from tsrkit.registry import get_registry
+from tsrkit.types import Annotation, Candidate, Frame, Sample
 from tsrkit_plugins.classifiers.decision import best_state, discriminative_ratio, fuse_lights
 from tsrkit_plugins.classifiers.regions import (clip_box, disk_kernel, find_lens, is_housing,
                                                 labelled_lenses, lens_of, rings)
@@ -101,3 +103,17 @@ def test_fuse_lights_consensus_then_most_probable_then_unknown():
     assert fuse_lights([("red", 0.3), ("green", 0.8)], threshold=0.5) == "green"
     assert fuse_lights([("red", 0.3), ("green", 0.4)], threshold=0.5) == "unknown"
     assert fuse_lights([], threshold=0.5) == "unknown"
+
+
+@pytest.mark.parametrize("name", ["ab-hist", "hsi-backprojection"])
+def test_shipped_models_classify_real_mit_housing_crops(shared_datasets, name):
+    classifier = get_registry().create("classifier", name, {})
+    root = shared_datasets / "udacity_mit_tl_crops" / "test"
+    right = total = 0
+    for state in ("red", "green"):
+        for path in sorted((root / state).glob("*.jpg"))[:40]:
+            image = cv2.imread(str(path))
+            box = Candidate.from_box((0, 0, image.shape[1], image.shape[0]), 1.0)
+            right += classifier.classify(Frame(image, str(path)), [box])[0].state == state
+            total += 1
+    assert total == 80 and right / total >= 0.85
