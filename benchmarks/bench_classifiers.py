@@ -11,8 +11,6 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ[_var] = "1"
 
 import argparse  # noqa: E402
-import csv  # noqa: E402
-import json  # noqa: E402
 import statistics  # noqa: E402
 import tempfile  # noqa: E402
 import time  # noqa: E402
@@ -20,42 +18,20 @@ from pathlib import Path  # noqa: E402
 
 import cv2  # noqa: E402
 
+from tsrkit.datasets import open_dataset  # noqa: E402
 from tsrkit.registry import get_registry  # noqa: E402
 from tsrkit.training import train as train_model  # noqa: E402
-from tsrkit.types import Annotation, Candidate, Dataset, Sample  # noqa: E402
+from tsrkit.types import Candidate, Dataset  # noqa: E402
 
-DATA = Path(os.environ.get("TSRKIT_DATA_DIR", Path(__file__).resolve().parents[2] / "shared"
-                           / "datasets"))
 CLASSIFIERS = ("ab-hist", "hsi-backprojection")
 STATES = ("red", "yellow", "green")
 
 
-def crop_samples(name: str, column: str, value: str) -> Dataset:
-    """The crops of ``name`` whose ``labels.csv`` column equals ``value`` (folder = label)."""
-    root = DATA / name
-    samples = []
-    with open(root / "labels.csv", newline="") as fh:
-        for row in csv.DictReader(fh):
-            if row[column] != value:
-                continue
-            image = cv2.imread(str(root / row["file"]))
-            h, w = image.shape[:2]
-            samples.append(Sample(str(root / row["file"]),
-                                  (Annotation((0.0, 0.0, float(w), float(h)), row["label"]),),
-                                  w, h, image=image))
-    return Dataset(f"{name}:{value}", tuple(samples))
-
-
-def box_samples(name: str) -> Dataset:
-    """The annotated scenes of a detection set (normalised ``annotations.json``)."""
-    root = DATA / name
-    samples = []
-    for entry in json.loads((root / "annotations.json").read_text()):
-        anns = tuple(Annotation((b["x_min"], b["y_min"], b["x_max"], b["y_max"]), b["label"])
-                     for b in entry["boxes"])
-        samples.append(Sample(str(root / entry["file"]), anns, entry["width"], entry["height"],
-                              image=cv2.imread(str(root / entry["file"]))))
-    return Dataset(name, tuple(samples))
+def by_lighting(dataset: Dataset, lighting: str) -> Dataset:
+    """The samples of ``dataset`` whose metadata ``lighting`` is ``lighting`` (day, night)."""
+    chosen = tuple(s for s in dataset if s.metadata.get("lighting") == lighting)
+    return Dataset(f"{dataset.name}:{lighting}", chosen, dataset.format, dataset.root,
+                   dataset.info)
 
 
 def evaluate(classifier, dataset: Dataset) -> dict:
@@ -106,12 +82,13 @@ def main() -> None:
     args = parser.parse_args()
     cv2.setNumThreads(1)
     registry = get_registry()
-    train = crop_samples("udacity_mit_tl_crops", "split", "train")
-    sets = {"mit test": crop_samples("udacity_mit_tl_crops", "split", "test"),
-            "vgis day": crop_samples("lisa_vgis_bulb_crops", "condition", "day"),
-            "vgis night": crop_samples("lisa_vgis_bulb_crops", "condition", "night"),
-            "kr boxes": box_samples("roboflow_traffic_light_kr"),
-            "cinta boxes": box_samples("roboflow_cinta_v2_id")}
+    mit = open_dataset("udacity_mit_tl_crops", format="crops")
+    vgis = open_dataset("lisa_vgis_bulb_crops", format="crops")
+    train = mit.split("train")
+    sets = {"mit test": mit.split("test"),
+            "vgis day": by_lighting(vgis, "day"), "vgis night": by_lighting(vgis, "night"),
+            "kr boxes": open_dataset("roboflow_traffic_light_kr"),
+            "cinta boxes": open_dataset("roboflow_cinta_v2_id")}
     tmp = tempfile.mkdtemp(prefix="bench_classifiers_")
     for name in CLASSIFIERS:
         given = dict(p.split(":", 1)[1].split("=", 1) for p in args.param
