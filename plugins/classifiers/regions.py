@@ -67,7 +67,7 @@ def rings(image: np.ndarray, x: float, y: float, radius: float) -> Rings:
     --------
     >>> r = rings(np.zeros((9, 9, 3), np.uint8), 4.5, 4.5, 2)
     >>> int(r.disk.sum()), int(r.annulus.sum())
-    (12, 36)
+    (13, 36)
     """
     if radius <= 0:
         raise ValueError(f"lens radius must be positive; got {radius}")
