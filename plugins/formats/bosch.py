@@ -9,7 +9,8 @@ The 14 raw labels map onto states by their colour word (:data:`LABELS`). Known b
 repaired and counted in ``Dataset.info["repaired"]``: swapped corners (x_min > x_max or
 y_min > y_max) are swapped back, and boxes reaching outside the image (``width`` x ``height``
 parameters, 1280x720 for BSTLD) are clipped to it; a box with no area left is dropped and
-counted in ``info["dropped"]``.
+counted in ``info["dropped"]``. The YAML files write the label ``off`` unquoted, which YAML 1.1
+loads as boolean False; it is read back as ``off``.
 """
 from __future__ import annotations
 
@@ -100,7 +101,7 @@ class Bosch(DatasetFormat):
         annotations = []
         for j, box in enumerate(field(entry, "boxes", list, file, where)):
             at = f"{where} box {j}"
-            label = field(box, "label", str, file, at)
+            label = _label(field(box, "label", (str, bool), file, at))
             if label not in LABELS:
                 raise DatasetError(file, f"unknown label {label!r} (expected one of "
                                          f"{', '.join(LABELS)})", at)
@@ -114,6 +115,11 @@ class Bosch(DatasetFormat):
                                           occluded=bool(box.get("occluded", False))))
         return Sample(_image(file, field(entry, "path", str, file, where), images),
                       tuple(annotations), width, height)
+
+
+def _label(value: str | bool) -> str:
+    """The raw label; the unquoted ``off`` of the YAML files loads as boolean False."""
+    return "off" if value is False else str(value)
 
 
 def _image(file: Path, written: str, images: Path | None) -> str:

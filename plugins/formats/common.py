@@ -111,7 +111,8 @@ def field(record: Any, key: str, kind: type | tuple[type, ...], path: Path, wher
     if key not in record:
         raise DatasetError(path, f"missing '{key}'", where)
     value = record[key]
-    if not isinstance(value, kind) or isinstance(value, bool):
+    kinds = kind if isinstance(kind, tuple) else (kind,)
+    if not isinstance(value, kinds) or (isinstance(value, bool) and bool not in kinds):
         names = kind.__name__ if isinstance(kind, type) else " or ".join(k.__name__ for k in kind)
         raise DatasetError(path, f"'{key}' must be {names}, got {value!r}", where)
     return value

@@ -21,7 +21,7 @@ from tsrkit_plugins.formats.common import annotation, resolve_image
 
 LABELS = "labels.csv"
 SPLITS = {"train": "train", "valid": "valid", "val": "valid", "test": "test"}
-#: Files whose presence at the root means the folder is an annotated dataset, not crops.
+#: Files whose presence anywhere below means the folder is an annotated dataset, not crops.
 ANNOTATION_SUFFIXES = {".json", ".yaml", ".yml", ".xml", ".csv", ".txt"}
 
 
@@ -41,7 +41,7 @@ def _image_files(root: Path) -> list[Path]:
 
 
 def _looks_like_label_folders(root: Path) -> bool:
-    if any(p.suffix.lower() in ANNOTATION_SUFFIXES for p in root.iterdir() if p.is_file()):
+    if any(p.suffix.lower() in ANNOTATION_SUFFIXES for p in root.rglob("*")):
         return False
     images = _image_files(root)
     return bool(images) and all(len(p.relative_to(root).parts) in (2, 3) for p in images)
