@@ -11,6 +11,7 @@ from rich.table import Table
 
 from tsrkit.datasets import (DatasetError, load_registry, open_dataset, registry_path,
                              verify_manifest, write_dataset)
+from tsrkit.cli.synth import synth_command
 from tsrkit.datasets.registry import GENERATED_SAMPLE
 from tsrkit.errors import TsrkitError
 
@@ -112,5 +113,7 @@ def _present(entry) -> str:
     except DatasetError:
         return "no"
 
+
+datasets_group.add_command(synth_command)
 
 COMMANDS = [datasets_group]
