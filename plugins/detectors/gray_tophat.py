@@ -1,0 +1,51 @@
+"""GRAY-TOPHAT baseline (de Charette & Nashashibi, as Zheng 2016 5.2.2 implemented it).
+
+The white top-hat (image minus its morphological opening) of the grayscale frame highlights
+small bright spots; Zheng's localization (3.2.2, ``localization.py``) then extracts candidates
+from it exactly as from a conspicuity map. The top-hat has no radius map, so each component's
+DRMShift window keeps the radius of the disk with the component's area.
+"""
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+from tsrkit.hookspecs import hookimpl
+from tsrkit.params import Param
+from tsrkit.plugin import Detector
+from tsrkit.types import Candidate, Frame
+from tsrkit_plugins.detectors.localization import LOCALIZATION_PARAMS, localize, region_of_interest
+
+
+def white_tophat(image: np.ndarray, se_size: int) -> np.ndarray:
+    """White top-hat of the grayscale of a BGR uint8 image with an elliptic (disk) structuring
+    element ``se_size`` pixels across, as float32 (5.2.2)."""
+    if se_size < 1:
+        raise ValueError(f"se_size must be >= 1; got {se_size}")
+    gray = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY)
+    element = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (se_size, se_size))
+    return cv2.morphologyEx(gray, cv2.MORPH_TOPHAT, element).astype(np.float32)
+
+
+class GrayTophat(Detector):
+    """White top-hat on grayscale, then Zheng's localization (5.2.2)."""
+
+    name = "gray-tophat"
+    summary = "White top-hat on grayscale + Zheng's localization (GRAY-TOPHAT baseline)"
+    section = "Zheng 2016, 5.2.2 (de Charette & Nashashibi) with 3.2.2"
+    params = (
+        Param("se_size", "int", 21, min=3, max=201, section="5.2.2 (size not given; ours)",
+              help="structuring-element diameter in pixels; wider than the largest lens"),
+        Param("roi_top", "float", 1.0, min=0.01, max=1.0, section="5.2.1",
+              help="search only the upper fraction of the frame (the thesis used 0.6)"),
+    ) + LOCALIZATION_PARAMS
+
+    def detect(self, frame: Frame) -> list[Candidate]:
+        """Candidates, best first, scored by the top-hat value (0..255) at their centre."""
+        roi = region_of_interest(frame.image, self.params["roi_top"])
+        return localize(white_tophat(roi, self.params["se_size"]), self.params)
+
+
+@hookimpl
+def register_detectors(register):
+    register(GrayTophat)

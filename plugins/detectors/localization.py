@@ -1,0 +1,263 @@
+"""Zheng's candidate localization (2016, 3.2.2, Figure 3-10, Eq. 3.13-3.15, Algorithm 3-1).
+
+Turns a saliency map (conspicuity, or GRAY-TOPHAT's top-hat values) into circular candidates by
+iterating: normalise, threshold at h_peak, open, take 8-connected components, filter them by
+shape, refine each with DRMShift, drop overlaps, check the stop rules, and clear what was found.
+
+Reading choices: DRMShift runs on the working map (found regions already cleared) and rounds
+its fractional centre to the nearest pixel to pick the window and the radius; pixels outside the
+image weigh nothing. A new candidate that intersects or touches one found in an earlier (more
+conspicuous) iteration is dropped; among new ones the larger is kept. Without a radius map
+(GRAY-TOPHAT) each component keeps the fixed radius of the disk of its own area (the plain mean
+shift that Algorithm 3-1 extends). Candidate centres are reported in pixel coordinates with pixel
+``(i, j)`` centred at ``(j + 0.5, i + 0.5)``.
+"""
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import cv2
+import numpy as np
+
+from tsrkit.params import Param
+from tsrkit.types import Candidate
+
+#: The localization parameters both detectors expose (Table 5-1 defaults where it gives one).
+LOCALIZATION_PARAMS = (
+    Param("h_peak", "float", 0.9, min=0.0, max=1.0, section="Table 5-1, Eq. 3.14",
+          help="threshold on the normalised working map for peak pixels"),
+    Param("n_top", "int", 10, min=1, section="Table 5-1",
+          help="number of top candidates to locate per frame"),
+    Param("n_pi", "int", 20, min=1, section="Table 5-1",
+          help="stop when one iteration brings more new candidates than this"),
+    Param("asp_min", "float", 0.6, min=0.0, max=1.0, section="Table 5-1",
+          help="minimum short/long side ratio of a component's bounding box (step 2.2)"),
+    Param("pd_min", "float", 0.0, min=0.0, max=1.0, section="Table 5-1",
+          help="minimum share of peak pixels in a component's bounding box (step 2.2)"),
+    Param("shift_tol", "float", 0.5, min=0.0, section="Algorithm 3-1 (h_c; no default given)",
+          help="DRMShift stops when the centre moves less than this (pixels)"),
+    Param("shift_iter", "int", 10, min=1, section="Algorithm 3-1 (n_max; no default given)",
+          help="DRMShift iteration limit"),
+    Param("max_iter", "int", 50, min=1, section="Figure 3-10 (a safety bound of ours)",
+          help="limit on localization iterations"),
+)
+
+#: Structuring element of Eq. 3.15: the disk of radius 1.
+DISK_1 = cv2.getStructuringElement(cv2.MORPH_CROSS, (3, 3))
+
+
+def region_of_interest(image: np.ndarray, top: float) -> np.ndarray:
+    """The upper ``top`` fraction of the frame (at least one row), as a view."""
+    if not 0 < top <= 1:
+        raise ValueError(f"roi_top must be in (0, 1]; got {top}")
+    return image[:max(1, int(round(image.shape[0] * top)))]
+
+
+def normalise(wcm: np.ndarray) -> np.ndarray:
+    """Eq. 3.13: divide the working map by its maximum (unchanged when the maximum is 0)."""
+    peak = float(wcm.max())
+    return wcm / np.float32(peak) if peak > 0 else wcm
+
+
+def peak_mask(wcm: np.ndarray, h_peak: float) -> np.ndarray:
+    """Eq. 3.14: 1 where the normalised working map exceeds ``h_peak`` (uint8 mask)."""
+    return (wcm > h_peak).astype(np.uint8)
+
+
+def denoise(mask: np.ndarray) -> np.ndarray:
+    """Eq. 3.15: morphological opening with the radius-1 disk."""
+    return cv2.morphologyEx(mask, cv2.MORPH_OPEN, DISK_1)
+
+
+@dataclass(frozen=True)
+class Components:
+    """8-connected components (step 2.1): bounding boxes, areas and centroids ``(x, y)``."""
+
+    boxes: np.ndarray
+    areas: np.ndarray
+    centroids: np.ndarray
+
+
+def components(mask: np.ndarray) -> Components:
+    """Step 2.1: 8-connected components of a binary mask (background excluded)."""
+    _, _, stats, centroids = cv2.connectedComponentsWithStats(mask, connectivity=8)
+    return Components(stats[1:, :4], stats[1:, cv2.CC_STAT_AREA], centroids[1:])
+
+
+def shape_filter(found: Components, asp_min: float, pd_min: float) -> np.ndarray:
+    """Step 2.2: keep components whose box aspect ratio (short/long side) >= ``asp_min`` and
+    pixel density (component pixels over box pixels) >= ``pd_min``; returns a boolean mask."""
+    width, height = found.boxes[:, 2], found.boxes[:, 3]
+    aspect = np.minimum(width, height) / np.maximum(width, height)
+    density = found.areas / (width * height)
+    return (aspect >= asp_min) & (density >= pd_min)
+
+
+def nearest_cells(centres: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
+    """Fractional ``(row, col)`` centres rounded to the nearest pixel inside ``shape``."""
+    cells = np.rint(centres).astype(np.int64)
+    cells[:, 0] = cells[:, 0].clip(0, shape[0] - 1)
+    cells[:, 1] = cells[:, 1].clip(0, shape[1] - 1)
+    return cells
+
+
+def _window_offsets(reach: int) -> tuple[np.ndarray, np.ndarray]:
+    dy, dx = np.mgrid[-reach:reach + 1, -reach:reach + 1]
+    return dy.ravel(), dx.ravel()
+
+
+def drmshift(cm: np.ndarray, starts: np.ndarray, radius_map: np.ndarray | None = None,
+             radii: np.ndarray | None = None, tol: float = 0.5,
+             n_max: int = 10) -> tuple[np.ndarray, np.ndarray]:
+    """Algorithm 3-1 (dynamic radius mean shift) for many start points at once.
+
+    Parameters
+    ----------
+    cm : ndarray
+        Non-negative weights (the conspicuity map), shape (H, W).
+    starts : ndarray
+        Start centres ``(row, col)``, shape (N, 2), float.
+    radius_map : ndarray, optional
+        The radius map RM; the window radius is read at each rounded centre (line 9).
+    radii : ndarray, optional
+        Fixed window radii, shape (N,), used when ``radius_map`` is None.
+    tol : float
+        Converge threshold ``h_c``: stop when the centre moves less than this.
+    n_max : int
+        Maximum number of iterations.
+
+    Returns
+    -------
+    centres : ndarray
+        Final ``(row, col)``, shape (N, 2).
+    radius : ndarray
+        Final window radius per point, shape (N,).
+    """
+    centres = np.asarray(starts, dtype=np.float64).reshape(-1, 2).copy()
+    if radius_map is None:
+        if radii is None:
+            raise ValueError("drmshift needs a radius_map or fixed radii")
+        fixed = np.asarray(radii, dtype=np.int64).reshape(-1)
+        reach = int(fixed.max(initial=0))
+    else:
+        reach = int(radius_map.max(initial=0))
+    padded = np.pad(cm.astype(np.float64), reach)
+    dy, dx = _window_offsets(reach)
+    active = np.ones(len(centres), bool)
+    radius = np.zeros(len(centres), np.int64)
+    for _ in range(n_max):
+        idx = np.flatnonzero(active)
+        if idx.size == 0:
+            break
+        cell = nearest_cells(centres[idx], cm.shape)
+        r = fixed[idx] if radius_map is None else radius_map[cell[:, 0], cell[:, 1]]
+        radius[idx] = r
+        inside = dy * dy + dx * dx <= (r * r)[:, None]
+        rows = cell[:, :1] + dy
+        cols = cell[:, 1:] + dx
+        weight = padded[rows + reach, cols + reach] * inside
+        m00 = weight.sum(axis=1)
+        moved = m00 > 0
+        new = np.stack([(weight * rows).sum(axis=1), (weight * cols).sum(axis=1)], axis=1)
+        new[moved] /= m00[moved, None]
+        new[~moved] = centres[idx][~moved]
+        shift = np.hypot(*(new - centres[idx]).T)
+        centres[idx] = new
+        active[idx] = moved & (shift >= tol)
+    if radius_map is not None:
+        final = nearest_cells(centres, cm.shape)
+        radius = radius_map[final[:, 0], final[:, 1]].astype(np.int64)
+    return centres, radius
+
+
+def non_overlapping(centres: np.ndarray, radius: np.ndarray, kept_centres: np.ndarray,
+                    kept_radius: np.ndarray) -> np.ndarray:
+    """Indices of new circles that intersect or touch neither each other nor kept ones.
+
+    Larger new circles win; a new circle touching a kept (earlier) one is dropped (3.2.2).
+    """
+    order = np.argsort(-radius, kind="stable")
+    chosen: list[int] = []
+    others_c = [tuple(c) for c in kept_centres]
+    others_r = list(kept_radius)
+    for i in order:
+        if others_c:
+            gap = np.hypot(*(np.asarray(others_c) - centres[i]).T)
+            if np.any(gap <= np.asarray(others_r) + radius[i]):
+                continue
+        chosen.append(int(i))
+        others_c.append(tuple(centres[i]))
+        others_r.append(radius[i])
+    return np.asarray(sorted(chosen), dtype=np.int64)
+
+
+def too_many(new_count: int, found_count: int, n_pi: int) -> bool:
+    """The two stop checks before step 4.2: more than ``N_pi`` new candidates (absolute), or
+    more new candidates than all found so far (relative)."""
+    return new_count > n_pi or (found_count > 0 and new_count > found_count)
+
+
+def clear_found(wcm: np.ndarray, raw_peaks: np.ndarray, centres: np.ndarray,
+                radius: np.ndarray) -> None:
+    """Steps 3.1-3.2: zero the raw peak pixels and the new candidate disks in the working map."""
+    wcm[raw_peaks > 0] = 0
+    disks = np.zeros(wcm.shape, np.uint8)
+    for (row, col), r in zip(np.rint(centres).astype(int), radius):
+        cv2.circle(disks, (int(col), int(row)), int(r), 1, -1)
+    wcm[disks > 0] = 0
+
+
+def localize(cm: np.ndarray, params: Mapping[str, Any],
+             radius_map: np.ndarray | None = None) -> list[Candidate]:
+    """Figure 3-10: the iterative extraction of candidates from a saliency map.
+
+    Parameters
+    ----------
+    cm : ndarray
+        The (aggregated) conspicuity map or any non-negative saliency map, shape (H, W).
+    params : mapping
+        ``h_peak, n_top, n_pi, asp_min, pd_min, shift_tol, shift_iter, max_iter``
+        (see :data:`LOCALIZATION_PARAMS`).
+    radius_map : ndarray, optional
+        Per-pixel lens radius (Eq. 3.2's arg-max); without it each component's own size is used.
+
+    Returns
+    -------
+    list of Candidate
+        At most ``n_top``, best score first; score is ``cm`` at the candidate's centre.
+    """
+    wcm = np.asarray(cm, dtype=np.float32).copy()
+    found_c = np.zeros((0, 2))
+    found_r = np.zeros(0, np.int64)
+    for _ in range(params["max_iter"]):
+        if not wcm.max() > 0:
+            break
+        wcm = normalise(wcm)
+        raw = peak_mask(wcm, params["h_peak"])
+        blobs = components(denoise(raw))
+        keep = shape_filter(blobs, params["asp_min"], params["pd_min"])
+        starts = blobs.centroids[keep][:, ::-1]
+        sizes = np.maximum(1, np.rint(np.sqrt(blobs.areas[keep] / np.pi))).astype(np.int64)
+        centres, radius = drmshift(wcm, starts, radius_map, sizes, params["shift_tol"],
+                                   params["shift_iter"])
+        chosen = non_overlapping(centres, radius, found_c, found_r)
+        if too_many(len(chosen), len(found_r), params["n_pi"]):
+            break
+        found_c = np.concatenate([found_c, centres[chosen]])
+        found_r = np.concatenate([found_r, radius[chosen]])
+        if len(found_r) >= params["n_top"]:
+            break
+        clear_found(wcm, raw, centres[chosen], radius[chosen])
+    return best_candidates(cm, found_c, found_r, params["n_top"])
+
+
+def best_candidates(cm: np.ndarray, centres: np.ndarray, radius: np.ndarray,
+                    n_top: int) -> list[Candidate]:
+    """Candidates scored by ``cm`` at their rounded centre, the ``n_top`` best first."""
+    cells = nearest_cells(centres, cm.shape)
+    scores = cm[cells[:, 0], cells[:, 1]]
+    order = np.argsort(-scores, kind="stable")[:n_top]
+    return [Candidate.from_circle(centres[i, 1] + 0.5, centres[i, 0] + 0.5, radius[i], scores[i])
+            for i in order]
