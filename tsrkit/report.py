@@ -11,6 +11,7 @@ from importlib import metadata
 from pathlib import Path
 from typing import Any
 
+from rich import box
 from rich.console import Console
 from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TextColumn,
                            TimeRemainingColumn)
@@ -20,10 +21,12 @@ from tsrkit.atomic import atomic_open, write_json
 from tsrkit.eval.perframe import recall_sort_key
 from tsrkit.types import Dataset
 
-HEADLINE = (("per_frame", "recall_mean", "recall"), ("per_frame", "precision_mean", "precision"),
-            ("per_frame", "hit_frame_fraction", "hit frames"), ("iou50", "ap", "AP50"),
-            ("iou50", "ap_50_95", "AP50:95"), ("state", "accuracy", "state acc."),
-            ("timing", "ms_per_frame_median", "ms/frame"))
+#: (section, key, column label, format) of the headline figures.
+HEADLINE = (("per_frame", "recall_mean", "recall", ".3f"),
+            ("per_frame", "precision_mean", "prec.", ".3f"),
+            ("per_frame", "hit_frame_fraction", "hit", ".3f"), ("iou50", "ap", "AP50", ".3f"),
+            ("iou50", "ap_50_95", "AP", ".3f"), ("state", "accuracy", "state", ".3f"),
+            ("timing", "ms_per_frame_median", "ms", ".1f"))
 
 
 class ProgressBar:
@@ -90,16 +93,17 @@ def write_outputs(out: Path, report: dict, evaluation) -> None:
         fh.write(summary_markdown(report))
 
 
-def fmt(value: Any) -> str:
-    """A number for a table: 3 decimals, or a dash for a missing value."""
+def fmt(value: Any, spec: str = ".3f") -> str:
+    """A number for a table (``spec`` for floats), or a dash for a missing value."""
     if value is None:
         return "-"
-    return f"{value:.3f}" if isinstance(value, float) else str(value)
+    return format(value, spec) if isinstance(value, float) else str(value)
 
 
 def headline(report: dict) -> dict[str, str]:
     """The headline figures of a report, formatted."""
-    return {label: fmt((report.get(section) or {}).get(key)) for section, key, label in HEADLINE}
+    return {label: fmt((report.get(section) or {}).get(key), spec)
+            for section, key, label, spec in HEADLINE}
 
 
 def title(report: dict) -> str:
@@ -129,8 +133,8 @@ def summary_markdown(report: dict) -> str:
 
 
 def _interval(report: dict, label: str) -> str:
-    key = {"recall": "recall_mean", "precision": "precision_mean",
-           "hit frames": "hit_frame_fraction"}.get(label)
+    key = {"recall": "recall_mean", "prec.": "precision_mean",
+           "hit": "hit_frame_fraction"}.get(label)
     interval = report.get("intervals", {}).get(key) if key else None
     return f"{interval[0]:.3f} - {interval[1]:.3f}" if interval else ""
 
@@ -161,11 +165,13 @@ def markdown_table(header: list[str], rows: list[list[str]]) -> str:
 def report_table(reports: list[dict]) -> Table:
     """A rich table of the headline figures, one row per run."""
     table = Table(title=f"tsrkit benchmark: {reports[0]['dataset']['name']} "
-                        f"({reports[0]['frames']} frames)")
-    table.add_column("method")
-    for _, _, label in HEADLINE:
-        table.add_column(label, justify="right")
-    table.add_column("skipped", justify="right")
+                        f"({reports[0]['frames']} frames)", box=box.SIMPLE_HEAD, pad_edge=False,
+                  caption="recall, precision, hit: Zheng 5.2.1 per-frame means; AP50 / AP "
+                          "(0.5:0.95): pycocotools; state: accuracy; ms: median per frame")
+    table.add_column("method", overflow="fold")
+    for _, _, label, _ in HEADLINE:
+        table.add_column(label, justify="right", min_width=5, no_wrap=True)
+    table.add_column("skip", justify="right")
     for report in reports:
         table.add_row(title(report), *headline(report).values(), str(len(report["skipped"])))
     return table
@@ -180,7 +186,7 @@ def compare_markdown(comparison: dict) -> str:
     """compare.md: the side-by-side headline table and the paired tests."""
     reports = comparison["reports"]
     lines = [f"# Comparison on {comparison['dataset']}", "",
-             markdown_table(["method"] + [label for _, _, label in HEADLINE],
+             markdown_table(["method"] + [label for _, _, label, _ in HEADLINE],
                             [[title(r)] + list(headline(r).values()) for r in reports]), "",
              "## Paired tests on the same frames (Wilcoxon signed-rank, per-frame recall)", ""]
     lines.append(markdown_table(

@@ -1,0 +1,55 @@
+"""``tsrkit benchmark`` / ``compare`` on the command line, with in-process fake plugins."""
+import json
+
+import benchmark_fakes
+import pytest
+from benchmark_fakes import hand_dataset
+from click.testing import CliRunner
+
+from tsrkit.cli.main import cli
+
+
+@pytest.fixture
+def fakes(registry, monkeypatch):
+    """The fake plugins registered, and ``open_dataset`` serving the hand-built frames."""
+    registry.add(benchmark_fakes, "benchmark-fakes")
+    monkeypatch.setattr("tsrkit.datasets.open_dataset",
+                        lambda ref, format=None, images=None: hand_dataset(6, name=ref))
+    return registry
+
+
+def test_benchmark_prints_table_and_writes_report(fakes, tmp_path):
+    result = CliRunner().invoke(cli, ["benchmark", "--dataset", "hand", "--detector", "oracle",
+                                      "--classifier", "always-red", "--out", str(tmp_path),
+                                      "--workers", "1", "--quiet"])
+    assert result.exit_code == 0, result.output
+    assert "always-red" in result.stdout and "0.750" in result.stdout
+    report = json.loads((tmp_path / "report.json").read_text())
+    assert report["dataset"]["name"] == "hand" and report["classifier"]["name"] == "always-red"
+    assert report["per_frame"]["recall_mean"] == pytest.approx(0.75)
+
+
+def test_benchmark_param_reaches_the_plugin(fakes, tmp_path):
+    result = CliRunner().invoke(cli, ["benchmark", "-d", "oracle", "-p", "crash_on=frame001",
+                                      "-o", str(tmp_path), "-w", "1", "-q"])
+    assert result.exit_code == 0, result.output
+    report = json.loads((tmp_path / "report.json").read_text())
+    assert [s["source"] for s in report["skipped"]] == ["frame001"]
+    assert report["params"]["detector"]["crash_on"] == "frame001"
+
+
+def test_compare_runs_each_detector(fakes, tmp_path):
+    result = CliRunner().invoke(cli, ["compare", "--detectors", "oracle,shifted",
+                                      "-o", str(tmp_path), "-w", "1", "-q"])
+    assert result.exit_code == 0, result.output
+    assert "oracle vs shifted" in result.stdout
+    comparison = json.loads((tmp_path / "compare.json").read_text())
+    assert comparison["detectors"] == ["oracle", "shifted"]
+    assert (tmp_path / "shifted" / "summary.md").is_file()
+
+
+def test_unknown_detector_is_one_line_error(fakes, tmp_path):
+    result = CliRunner().invoke(cli, ["benchmark", "-d", "nope", "-o", str(tmp_path)])
+    assert result.exit_code == 2
+    assert "no detector called 'nope'" in result.output
+    assert "Traceback" not in result.output
