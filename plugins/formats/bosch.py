@@ -23,7 +23,7 @@ from tsrkit.hookspecs import hookimpl
 from tsrkit.params import Param
 from tsrkit.plugin import DatasetFormat
 from tsrkit.types import Dataset, Sample
-from tsrkit_plugins.formats.common import annotation, field, numbers, read_json
+from tsrkit_plugins.formats.common import absolute, annotation, field, numbers, read_json
 
 #: The 14 BSTLD labels and the state each means (arrows keep their colour).
 LABELS = {
@@ -72,7 +72,8 @@ class Bosch(DatasetFormat):
     summary = "Bosch Small Traffic Lights YAML/JSON (14 labels -> states, bad boxes repaired)"
     section = "Behrendt, Novak & Botros, ICRA 2017 (BSTLD label files)"
     params = (
-        Param("width", "int", 1280, min=1, help="Image width for clipping boxes", section="BSTLD"),
+        Param("width", "int", 1280, min=1, help="Image width for clipping boxes",
+              section="BSTLD"),
         Param("height", "int", 720, min=1, help="Image height for clipping boxes",
               section="BSTLD"),
     )
@@ -94,7 +95,8 @@ class Bosch(DatasetFormat):
         counts = {"repaired": 0, "dropped": 0}
         samples = tuple(self._sample(file, entry, f"entry {i}", images, counts)
                         for i, entry in enumerate(data))
-        return Dataset(file.stem, samples, self.name, str(file.parent), {**counts, "box": "housing"})
+        return Dataset(file.stem, samples, self.name, str(file.parent),
+                       {**counts, "box": "housing"})
 
     def _sample(self, file: Path, entry, where: str, images: Path | None, counts) -> Sample:
         width, height = self.params["width"], self.params["height"]
@@ -128,7 +130,7 @@ def _image(file: Path, written: str, images: Path | None) -> str:
         chosen = path if path.exists() or images is None else images / path.name
     else:
         chosen = (images if images is not None else file.parent) / path
-    return str(chosen.resolve())
+    return absolute(chosen)
 
 
 @hookimpl

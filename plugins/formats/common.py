@@ -19,7 +19,12 @@ def resolve_image(base: Path, name: str, images: Path | None = None) -> str:
     names are kept as they are).
     """
     root = images if images is not None else base
-    return str((Path(root) / name).resolve())
+    return absolute(Path(root) / name)
+
+
+def absolute(path: str | os.PathLike) -> str:
+    """``path`` made absolute and normalised, without following symbolic links."""
+    return os.path.abspath(path)
 
 
 def relative_source(source: str, folder: Path) -> str:

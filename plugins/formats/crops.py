@@ -17,7 +17,7 @@ from tsrkit.hookspecs import hookimpl
 from tsrkit.inputs import IMAGE_EXTENSIONS
 from tsrkit.plugin import DatasetFormat
 from tsrkit.types import Dataset, Sample
-from tsrkit_plugins.formats.common import annotation, resolve_image
+from tsrkit_plugins.formats.common import absolute, annotation, resolve_image
 
 LABELS = "labels.csv"
 SPLITS = {"train": "train", "valid": "valid", "val": "valid", "test": "test"}
@@ -114,7 +114,7 @@ def _from_folders(root: Path) -> list[Sample]:
     for image in _image_files(root):
         parts = image.relative_to(root).parts
         split = SPLITS.get(parts[0]) if len(parts) == 3 else None
-        samples.append(crop_sample(str(image.resolve()), parts[-2], *image_size(image), split))
+        samples.append(crop_sample(absolute(image), parts[-2], *image_size(image), split))
     return samples
 
 

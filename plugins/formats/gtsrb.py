@@ -3,9 +3,9 @@
 Reads the original semicolon files (``Filename;Width;Height;Roi.X1;Roi.Y1;Roi.X2;Roi.Y2;
 ClassId``, e.g. ``GT-final_test.csv`` or the per-class ``GT-000NN.csv``; ROI in the original
 image's pixels, images beside the CSV) and the comma ``labels.csv`` of
-``shared/datasets/gtsrb_test_35px_subset`` (``file,class_id,class_name_de,...,roi_*_35px``; the
-ROI used is the one in the stored 35x35 images, whose size it records). A folder is read through its ``labels.csv``
-when it has one, else through every ``GT-*.csv`` below it.
+``shared/datasets/gtsrb_test_35px_subset`` (``file,class_id,class_name_de,...,roi_*_35px``;
+the ROI used is the one in the stored 35x35 images, whose size it records). A folder is read
+through its ``labels.csv`` when it has one, else through every ``GT-*.csv`` below it.
 
 Signs are not signal states: ``Annotation.state`` holds the class NAME (from
 ``GTSRB_Class_Names.csv`` beside the file when present, else ``class_name_de``, else the id as

@@ -78,7 +78,8 @@ class Lara(DatasetFormat):
             try:
                 timestamp, frame, object_id = float(tokens[0]), int(tokens[2]), int(tokens[7])
             except ValueError:
-                raise DatasetError(file, "timestamp, frame and id must be numbers", where) from None
+                raise DatasetError(file, "timestamp, frame and id must be numbers",
+                                   where) from None
             bbox = checked_box(tokens[3:7], file, where)
             record = frames.setdefault(frame, {"timestamp": timestamp, "annotations": []})
             record["annotations"].append(annotation(bbox, tokens[9], SUBTYPES[tokens[9]],

@@ -19,7 +19,7 @@ from tsrkit.hookspecs import hookimpl
 from tsrkit.params import Param
 from tsrkit.plugin import DatasetFormat
 from tsrkit.types import Dataset, Sample
-from tsrkit_plugins.formats.common import annotation, checked_box
+from tsrkit_plugins.formats.common import absolute, annotation, checked_box
 
 COLUMNS = ("Filename", "Annotation tag", "Upper left corner X", "Upper left corner Y",
            "Lower right corner X", "Lower right corner Y")
@@ -82,7 +82,7 @@ def _rows(file: Path, images: Path | None):
             extra = {k: row[c] for k, c in (("origin_file", "Origin file"),
                                             ("origin_frame", "Origin frame number"),
                                             ("track", "Origin track")) if row.get(c)}
-            yield str(image.resolve()), annotation(bbox, row["Annotation tag"], **extra)
+            yield absolute(image), annotation(bbox, row["Annotation tag"], **extra)
 
 
 @hookimpl

@@ -18,8 +18,8 @@ from tsrkit.datasets import DatasetError, to_state
 from tsrkit.hookspecs import hookimpl
 from tsrkit.plugin import DatasetFormat
 from tsrkit.types import Dataset, Sample
-from tsrkit_plugins.formats.common import (annotation, checked_box, explicit_state, raw_label,
-                                           relative_source, unique_path)
+from tsrkit_plugins.formats.common import (absolute, annotation, checked_box, explicit_state,
+                                           raw_label, relative_source, unique_path)
 
 ANNOTATIONS = "Annotations"
 SETS = Path("ImageSets") / "Main"
@@ -118,12 +118,12 @@ def _text(element: ET.Element, tag: str, file: Path, where: str) -> str:
 def _image(file: Path, root: ET.Element, images: Path | None) -> str:
     filename = _text(root, "filename", file, "<annotation>")
     if images is not None:
-        return str((images / filename).resolve())
+        return absolute(images / filename)
     written = (root.findtext("path") or "").strip()
     candidates = ([file.parent / written] if written else []) + [
         file.parent / filename, file.parent.parent / "JPEGImages" / filename]
     chosen = next((c for c in candidates if c.is_file()), file.parent / filename)
-    return str(chosen.resolve())
+    return absolute(chosen)
 
 
 def _sample(file: Path, images: Path | None, split: str | None) -> Sample:

@@ -23,8 +23,8 @@ from tsrkit.hookspecs import hookimpl
 from tsrkit.inputs import IMAGE_EXTENSIONS
 from tsrkit.plugin import DatasetFormat
 from tsrkit.types import Dataset, Sample
-from tsrkit_plugins.formats.common import (annotation, class_names, numbers, raw_label,
-                                           unique_path)
+from tsrkit_plugins.formats.common import (absolute, annotation, class_names, numbers,
+                                           raw_label, unique_path)
 
 DATA_YAML = "data.yaml"
 SPLIT_KEYS = {"train": "train", "val": "valid", "test": "test"}
@@ -143,7 +143,7 @@ def _split_images(base: Path, entry: str, images: Path | None) -> list[Path] | N
         return sorted(p for p in target.iterdir() if p.suffix.lower() in IMAGE_EXTENSIONS)
     if target.is_file():
         root = images if images is not None else target.parent
-        return [(root / line.strip()).resolve() for line in
+        return [Path(absolute(root / line.strip())) for line in
                 target.read_text(encoding="utf-8").splitlines() if line.strip()]
     return None
 
@@ -153,7 +153,7 @@ def _sample(image: Path, split: str, classes: dict[int, str], data_file: Path) -
     lines = label_file.read_text(encoding="utf-8").splitlines() if label_file.is_file() else []
     rows = [(n, line.split()) for n, line in enumerate(lines, 1) if line.strip()]
     if not rows:
-        return Sample(str(image.resolve()), (), split=split)
+        return Sample(absolute(image), (), split=split)
     width, height = image_size(image)
     annotations = []
     for number, tokens in rows:
@@ -169,7 +169,7 @@ def _sample(image: Path, split: str, classes: dict[int, str], data_file: Path) -
         shape = "box" if count == 4 else "polygon"
         annotations.append(annotation(yolo_box(values, width, height), classes[int(tokens[0])],
                                       yolo_shape=shape))
-    return Sample(str(image.resolve()), tuple(annotations), width, height, split)
+    return Sample(absolute(image), tuple(annotations), width, height, split)
 
 
 def _label_line(class_id: int, bbox, width: int, height: int) -> str:
