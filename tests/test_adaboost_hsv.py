@@ -36,6 +36,12 @@ def samples(seed, n=6, colour=RED):
     return out
 
 
+def background_samples(seed, n=6):
+    """Scenes without a target box (the negative images of Lee 3.2)."""
+    rng = np.random.default_rng(seed)
+    return [Sample(f"empty-{seed}", (), image=scene(rng, (0, 0, 0, 0), RED)) for _ in range(n)]
+
+
 def make(**params):
     values = {p.name: p.default for p in ab.AdaBoostHSV.params}
     values.update(params)
@@ -45,14 +51,16 @@ def make(**params):
 @pytest.fixture(scope="module")
 def trained():
     det = make(n_estimators=20, min_size=5, max_boxes=3)
-    model = det.fit(samples(1))
+    model = det.fit(samples(1) + background_samples(11))
     det.use_model(model)
     return det, model
 
 
 def test_learns_patch_to_near_perfect_pixel_accuracy(trained):
     det, model = trained
-    positive, negative = ab.pixel_histograms(samples(2), "red", 50)
+    counts = ab.pixel_histograms(samples(2), "red", 50)
+    positive, negative = counts.positive, counts.negative
+    assert counts.images == counts.target_images == 6 and model.info["prior"] == 0.5
     stumps = {k: model.arrays[k] for k in ab.STUMP_KEYS}
     f = ab.boosted_margin(ab.plane_features(), stumps)
     true_pos, true_neg = positive[f > 0].sum(), negative[f <= 0].sum()

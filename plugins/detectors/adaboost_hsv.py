@@ -7,6 +7,7 @@ Lee 2017, section 3.2 (Eq. 3.1 and the two unnumbered equations after it).
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
 
 import cv2
 import numpy as np
@@ -56,20 +57,36 @@ def plane_features() -> np.ndarray:
     return color_features(hue, sat)
 
 
-def pixel_histograms(samples: Iterable[Sample], target: str,
-                     min_value: int) -> tuple[np.ndarray, np.ndarray]:
+@dataclass(frozen=True)
+class PixelCounts:
+    """Target and background pixel counts over the (hue, saturation) plane, and image counts."""
+
+    positive: np.ndarray
+    negative: np.ndarray
+    images: int
+    target_images: int
+
+    @property
+    def image_prior(self) -> float:
+        """P(sign) of Eq. 3.1 read as the share of training images that hold a target box.
+
+        Clipped to [0.01, 0.99]: a training set of only target images (or none) would
+        otherwise make every pixel certain.
+        """
+        return float(np.clip(self.target_images / max(self.images, 1), 0.01, 0.99))
+
+
+def pixel_histograms(samples: Iterable[Sample], target: str, min_value: int) -> PixelCounts:
     """Count target and background pixels over the (hue, saturation) plane.
 
     Target pixels lie inside a box whose state is ``target``; background pixels lie outside
     every box; pixels inside boxes of other states are not used. Pixels darker than
-    ``min_value`` (V) are not used either: their hue is undefined.
-
-    Returns
-    -------
-    positive, negative : ndarray of shape (65536,), int64
+    ``min_value`` (V) are not used either: their hue is undefined. The histograms have 65536
+    cells, indexed by :func:`hs_index`.
     """
     positive = np.zeros(LEVELS * LEVELS, np.int64)
     negative = np.zeros_like(positive)
+    images = target_images = 0
     for sample in samples:
         hue, sat, val = hsv_planes(sample.load().image)
         inside = np.zeros(hue.shape, bool)
@@ -83,7 +100,9 @@ def pixel_histograms(samples: Iterable[Sample], target: str,
         index = hs_index(hue, sat)
         positive += np.bincount(index[inside & usable], minlength=LEVELS * LEVELS)
         negative += np.bincount(index[~any_box & usable], minlength=LEVELS * LEVELS)
-    return positive, negative
+        images += 1
+        target_images += any(ann.state == target for ann in sample.annotations)
+    return PixelCounts(positive, negative, images, target_images)
 
 
 def _box_slice(bbox: Sequence[float], shape: tuple[int, int]) -> tuple[slice, slice]:
@@ -164,8 +183,12 @@ def posterior(likelihood: np.ndarray, prior: float) -> np.ndarray:
     """Lee Eq. 3.1, ``P(sign|x) = eta P(x|sign) P(sign)``, with eta normalising over two classes.
 
     The booster is trained on balanced classes, so g(f) estimates the target probability under
-    equal priors; this reading treats g and 1 - g as the two likelihoods and applies the prior
-    of the training labels. ``prior = 0.5`` leaves g unchanged.
+    equal priors; this reading treats g and 1 - g as the two likelihoods and applies the prior.
+    Lee takes P(sign) "from the ground truth of our training data" right before counting
+    positive and negative training images, so the prior is read as the share of training
+    images holding the target (:attr:`PixelCounts.image_prior`); the share of target pixels
+    (well under 1 % for traffic lights) would suppress every pixel. ``prior = 0.5`` leaves g
+    unchanged.
     """
     target = likelihood * prior
     return target / (target + (1.0 - likelihood) * (1.0 - prior))
@@ -244,7 +267,7 @@ class AdaBoostHSV(Detector):
         Param("min_value", "int", 50, min=0, max=255,
               help="pixels darker than this V are background (hue undefined); training too"),
         Param("prior", "float", None, min=0.001, max=0.999,
-              help="P(sign) of Eq. 3.1; default: the training labels' share of target pixels",
+              help="P(sign) of Eq. 3.1; default: the share of training images with a target",
               section="Eq. 3.1"),
         Param("threshold", "float", 0.5, min=0, max=1, help="probability threshold"),
         Param("min_size", "int", 30, min=1,
@@ -266,12 +289,13 @@ class AdaBoostHSV(Detector):
     def fit(self, samples: Iterable[Sample]) -> Model:
         """Learn the target colour from annotated boxes; see :func:`pixel_histograms`."""
         p = self.params
-        positive, negative = pixel_histograms(samples, p["target"], p["min_value"])
-        stumps = fit_stumps(positive, negative, p["n_estimators"], p["seed"])
-        prior = float(positive.sum() / (positive.sum() + negative.sum()))
-        return Model(arrays=stumps, info={"target": p["target"], "prior": prior,
-                                          "target_pixels": int(positive.sum()),
-                                          "background_pixels": int(negative.sum())})
+        counts = pixel_histograms(samples, p["target"], p["min_value"])
+        stumps = fit_stumps(counts.positive, counts.negative, p["n_estimators"], p["seed"])
+        return Model(arrays=stumps, info={
+            "target": p["target"], "prior": counts.image_prior,
+            "target_pixels": int(counts.positive.sum()),
+            "background_pixels": int(counts.negative.sum()),
+            "images": counts.images, "target_images": counts.target_images})
 
     def use_model(self, model: Model) -> None:
         """Build the lookup table from ``model`` (a fitted or loaded model)."""
