@@ -119,6 +119,14 @@ def load_registry(path: str | os.PathLike | None = None) -> dict[str, DatasetEnt
     return {str(name): _entry(path, str(name), fields) for name, fields in datasets.items()}
 
 
+def _yaml_off(mapping: Any) -> Any:
+    """YAML 1.1 loads an unquoted ``off`` as False; in a ``states`` mapping it means "off"."""
+    if not isinstance(mapping, Mapping):
+        return mapping
+    return {("off" if k is False else k): ("off" if v is False else v)
+            for k, v in mapping.items()}
+
+
 def _entry(path: Path, name: str, fields: Any) -> DatasetEntry:
     where = f"datasets.{name}"
     if not isinstance(fields, Mapping):
@@ -130,7 +138,7 @@ def _entry(path: Path, name: str, fields: Any) -> DatasetEntry:
         raise DatasetError(path, f"box must be one of {', '.join(BOXES)}, "
                                  f"got {fields['box']!r}", where)
     try:
-        states = check_mapping(fields.get("states") or {}, where)
+        states = check_mapping(_yaml_off(fields.get("states") or {}), where)
     except ValueError as exc:
         raise DatasetError(path, str(exc)) from None
     known = set(REQUIRED) | {"path", "manifest", "splits", "states", "description"}
