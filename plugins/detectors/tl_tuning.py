@@ -25,16 +25,25 @@ BROAD_RANGES = np.array([[[50, 40, 40], [115, 255, 255]],
 PASS_STATES = {"green": ("green",), "yellowred": ("red", "yellow")}
 
 
-def contour_pixels(hsv: np.ndarray, contour: np.ndarray) -> np.ndarray:
-    """HSV values (N, 3) of the pixels inside a contour."""
+def contour_pixels(hsv: np.ndarray, mask: np.ndarray, contour: np.ndarray) -> np.ndarray:
+    """HSV values (N, 3) of the pixels inside a contour that passed the range filter ``mask``."""
     x, y, w, h = cv2.boundingRect(contour)
     inside = np.zeros((h, w), np.uint8)
     cv2.drawContours(inside, [contour - (x, y)], -1, 255, thickness=cv2.FILLED)
-    return hsv[y:y + h, x:x + w][inside > 0]
+    return hsv[y:y + h, x:x + w][(inside > 0) & (mask[y:y + h, x:x + w] > 0)]
+
+
+def lens_contour(contour: np.ndarray, scale: np.ndarray, boxes) -> bool:
+    """A contour centred in an annotated box and not larger than the box (full-res pixels)."""
+    x, y, w, h = cv2.boundingRect(contour)
+    centre = (np.array([x + w / 2, y + h / 2]) * scale)[None, :]
+    hits = centre_hits(centre, boxes)[0]
+    areas = np.array([(b[2] - b[0]) * (b[3] - b[1]) for b in boxes])
+    return bool(np.any(hits & (w * h * scale[0] * scale[1] <= areas)))
 
 
 def annotated_lens_pixels(samples, factor: int) -> dict[str, np.ndarray]:
-    """Pixels of broad-range contours centred in a box of their colour, per pass (Figure 16)."""
+    """Pixels of broad-range contours that fit a box of their colour, per pass (Figure 16)."""
     found = {colour: [] for colour in PASSES}
     for sample in samples:
         frame = sample.load()
@@ -44,11 +53,10 @@ def annotated_lens_pixels(samples, factor: int) -> dict[str, np.ndarray]:
             boxes = [a.bbox for a in sample.annotations if a.state in PASS_STATES[colour]]
             if not boxes:
                 continue
-            for contour in extract_contours(range_mask(hsv, BROAD_RANGES, rows)):
-                x, y, w, h = cv2.boundingRect(contour)
-                centre = (np.array([x + w / 2, y + h / 2]) * scale)[None, :]
-                if centre_hits(centre, boxes).any():
-                    found[colour].append(contour_pixels(hsv, contour))
+            mask = range_mask(hsv, BROAD_RANGES, rows)
+            for contour in extract_contours(mask):
+                if lens_contour(contour, scale, boxes):
+                    found[colour].append(contour_pixels(hsv, mask, contour))
     return {colour: np.concatenate(parts) if parts else np.zeros((0, 3), np.uint8)
             for colour, parts in found.items()}
 
