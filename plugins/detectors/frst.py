@@ -15,6 +15,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import reduce
 
 import cv2
 import numpy as np
@@ -27,58 +28,66 @@ MODES = ("both", "bright", "dark")
 class Voters:
     """The pixels whose gradient takes part in the vote (``||g|| > beta * max ||g||``).
 
-    ``rows``/``cols`` are their coordinates, ``ux``/``uy`` the unit gradient, ``magnitude`` the
-    gradient norm ``||g(p)||``; ``shape`` is the image shape.
+    Votes are cast on a working grid that pads the image by ``pad`` pixels on every side, so
+    that a vote leaving the image needs no bounds check: it lands in the margin, which is cut
+    away afterwards. ``index`` is each voter's flat index on that grid, ``ux``/``uy`` its unit
+    gradient, ``magnitude`` the norm ``||g(p)||``; ``shape`` is the image shape.
     """
 
-    rows: np.ndarray
-    cols: np.ndarray
+    index: np.ndarray
     ux: np.ndarray
     uy: np.ndarray
     magnitude: np.ndarray
     shape: tuple[int, int]
+    pad: int
+
+    @property
+    def grid(self) -> tuple[int, int]:
+        """Shape of the padded working grid."""
+        return self.shape[0] + 2 * self.pad, self.shape[1] + 2 * self.pad
+
+    def crop(self, flat: np.ndarray) -> np.ndarray:
+        """The image part of a flat array over the working grid, as a 2-D view."""
+        height, width = self.shape
+        return flat.reshape(self.grid)[self.pad:self.pad + height, self.pad:self.pad + width]
 
 
 def sobel_gradient(image: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Gradient ``g(p) = (gx, gy)`` by the 3x3 Sobel filter (Loy & Zelinsky, section 2).
 
-    Borders are reflected without repeating the edge pixel (OpenCV's BORDER_REFLECT_101).
+    Computed in float64; borders are reflected without repeating the edge pixel (OpenCV's
+    BORDER_REFLECT_101).
     """
-    gx = cv2.Sobel(image, cv2.CV_32F, 1, 0, ksize=3, borderType=cv2.BORDER_REFLECT_101)
-    gy = cv2.Sobel(image, cv2.CV_32F, 0, 1, ksize=3, borderType=cv2.BORDER_REFLECT_101)
+    gx = cv2.Sobel(image, cv2.CV_64F, 1, 0, ksize=3, borderType=cv2.BORDER_REFLECT_101)
+    gy = cv2.Sobel(image, cv2.CV_64F, 0, 1, ksize=3, borderType=cv2.BORDER_REFLECT_101)
     return gx, gy
 
 
-def select_voters(gx: np.ndarray, gy: np.ndarray, beta: float) -> Voters:
+def select_voters(gx: np.ndarray, gy: np.ndarray, beta: float, pad: int) -> Voters:
     """Keep the pixels whose gradient norm exceeds ``beta`` times the largest one.
 
     This is Loy & Zelinsky's gradient threshold beta ("ignoring small gradients"), read as a
     fraction of the image's largest gradient norm; zero gradients never vote, whatever beta.
+    ``pad`` must be at least the largest radius.
     """
     magnitude = cv2.magnitude(gx, gy)
-    top = float(magnitude.max()) if magnitude.size else 0.0
-    rows, cols = np.nonzero(magnitude > max(beta * top, 0.0))
+    rows, cols = np.nonzero(magnitude > beta * float(magnitude.max()))
     mag = magnitude[rows, cols]
-    return Voters(rows, cols, gx[rows, cols] / mag, gy[rows, cols] / mag, mag, gx.shape)
+    index = (rows + pad) * (gx.shape[1] + 2 * pad) + cols + pad
+    return Voters(index, gx[rows, cols] / mag, gy[rows, cols] / mag, mag, gx.shape, pad)
 
 
-def affected_pixels(voters: Voters, n: int, sign: int) -> tuple[np.ndarray, np.ndarray]:
-    """Flat indices of the affected pixels ``p +- round(g(p)/||g(p)|| * n)`` inside the image.
+def affected_pixels(voters: Voters, n: int, sign: int) -> np.ndarray:
+    """Flat grid indices of the affected pixels ``p +- round(g(p)/||g(p)|| * n)``.
 
     ``sign=+1`` gives the positively-affected pixels p+ve, ``-1`` the negatively-affected p-ve.
-    Rounding is half away from zero (``floor(|x| + 0.5)`` with the sign of ``x``). Returns the flat indices and the boolean mask of voters whose
-    affected pixel falls inside the image (votes leaving the image are dropped).
+    ``round`` is to the nearest integer with ties to even (``np.rint``).
     """
-    height, width = voters.shape
-    rows = voters.rows + sign * round_half_away(voters.uy * n)
-    cols = voters.cols + sign * round_half_away(voters.ux * n)
-    inside = (rows >= 0) & (rows < height) & (cols >= 0) & (cols < width)
-    return rows[inside] * width + cols[inside], inside
-
-
-def round_half_away(values: np.ndarray) -> np.ndarray:
-    """Round to the nearest integer, halves away from zero, as integers."""
-    return (np.sign(values) * np.floor(np.abs(values) + 0.5)).astype(np.intp)
+    step = np.rint(voters.uy * n)
+    step *= voters.grid[1]
+    step += np.rint(voters.ux * n)
+    offset = step.astype(np.intp)
+    return voters.index + offset if sign > 0 else voters.index - offset
 
 
 def orientation_projection(index: np.ndarray, sign: int, size: int) -> np.ndarray:
@@ -87,13 +96,15 @@ def orientation_projection(index: np.ndarray, sign: int, size: int) -> np.ndarra
     Votes are accumulated with ``np.bincount`` so that several voters hitting the same pixel all
     count (``O[index] += 1`` would keep only one of them).
     """
-    return sign * np.bincount(index, minlength=size)
+    counts = np.bincount(index, minlength=size)
+    return counts if sign > 0 else np.negative(counts, out=counts)
 
 
 def magnitude_projection(index: np.ndarray, weights: np.ndarray, sign: int,
                          size: int) -> np.ndarray:
     """M_n: ``+||g(p)||`` at each positively- or ``-||g(p)||`` at each negatively-affected pixel."""
-    return sign * np.bincount(index, weights=weights, minlength=size)
+    sums = np.bincount(index, weights=weights, minlength=size)
+    return sums if sign > 0 else np.negative(sums, out=sums)
 
 
 def kappa(n: int) -> float:
@@ -110,13 +121,17 @@ def radial_strength(magnitude: np.ndarray, orientation: np.ndarray, k: float,
                     alpha: float) -> np.ndarray:
     """F_n = (M_n / k_n) * (|O~_n| / k_n) ** alpha.
 
-    O_n holds integer vote counts, so ``(|O~_n| / k_n) ** alpha`` takes at most ``ceil(k_n) + 1``
-    values: they are computed once and looked up, which gives the same numbers as the power.
+    O_n holds integer vote counts, so ``(|O~_n| / k_n) ** alpha / k_n`` takes at most
+    ``ceil(k_n) + 1`` values: they are computed once and looked up, which gives the same numbers
+    as the power.
     """
     levels = np.arange(math.ceil(k) + 1)
-    table = (np.minimum(levels, k) / k) ** alpha
-    counts = np.minimum(np.abs(orientation), levels[-1]).astype(np.intp)
-    return magnitude / k * table[counts]
+    table = (np.minimum(levels, k) / k) ** alpha / k
+    counts = np.abs(orientation)
+    np.minimum(counts, levels[-1], out=counts)
+    strength = np.take(table, counts)
+    strength *= magnitude
+    return strength
 
 
 def orientation_strength(orientation: np.ndarray, k: float, alpha: float) -> np.ndarray:
@@ -194,7 +209,7 @@ def frst(image: np.ndarray, radii: Sequence[int] = tuple(range(1, 11)), alpha: f
     """
     image = np.asarray(image, dtype=np.float32)
     check_frst_args(image, radii, alpha, beta, mode)
-    voters = select_voters(*sobel_gradient(image), beta)
+    voters = select_voters(*sobel_gradient(image), beta, max(radii))
     signs = {"both": (1, -1), "bright": (1,), "dark": (-1,)}[mode]
     total = np.zeros(image.shape, np.float32)
     for n in radii:
@@ -202,17 +217,16 @@ def frst(image: np.ndarray, radii: Sequence[int] = tuple(range(1, 11)), alpha: f
         k = kappa(int(n))
         strength = (orientation_strength(orientation, k, alpha) if orientation_only
                     else radial_strength(magnitude, orientation, k, alpha))
-        total += spread(strength.reshape(image.shape), int(n))
+        total += spread(voters.crop(strength), int(n))
     return total
 
 
 def projections(voters: Voters, n: int, signs: Sequence[int]) -> tuple[np.ndarray, np.ndarray]:
-    """O_n and M_n (flat) for radius ``n``, voting at the affected pixels of the given signs."""
-    size = voters.shape[0] * voters.shape[1]
-    orientation = np.zeros(size, np.int64)
-    magnitude = np.zeros(size, np.float64)
-    for sign in signs:
-        index, inside = affected_pixels(voters, n, sign)
-        orientation += orientation_projection(index, sign, size)
-        magnitude += magnitude_projection(index, voters.magnitude[inside], sign, size)
+    """O_n and M_n, flat over the working grid, for radius ``n`` and the affected pixels of ``signs``."""
+    size = voters.grid[0] * voters.grid[1]
+    votes = [(affected_pixels(voters, n, sign), sign) for sign in signs]
+    orientation = reduce(np.add, (orientation_projection(index, sign, size)
+                                  for index, sign in votes))
+    magnitude = reduce(np.add, (magnitude_projection(index, voters.magnitude, sign, size)
+                                for index, sign in votes))
     return orientation, magnitude

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import cv2
 import numpy as np
-from scipy import ndimage
 
 from tsrkit.hookspecs import hookimpl
 from tsrkit.params import Param
@@ -51,23 +50,27 @@ def spot_candidates(symmetry: np.ndarray, fraction: float, top: int,
                     state: str) -> list[Candidate]:
     """The ``top`` strongest 8-connected spots of ``symmetry >= fraction * max`` (Zheng 5.2.2).
 
-    Each spot becomes a candidate at its centroid (in continuous coordinates: pixel ``(i, j)``
+    Components are labelled inside the bounding box of the above-threshold pixels only (the
+    rest of the map is background). Each spot becomes a candidate at its centroid (in continuous coordinates: pixel ``(i, j)``
     covers ``[j, j+1) x [i, i+1)``, so its centre is ``(j + 0.5, i + 0.5)``), with half the longer side of its bounding
     box as radius and its peak symmetry value as score.
     """
     peak = float(symmetry.max())
     if peak <= 0:
         return []
-    mask = (symmetry >= fraction * peak).astype(np.uint8)
+    rows, cols = np.nonzero(symmetry >= fraction * peak)
+    top_row, left = rows.min(), cols.min()
+    window = symmetry[top_row:rows.max() + 1, left:cols.max() + 1]
+    mask = (window >= fraction * peak).astype(np.uint8)
     count, labels, stats, centroids = cv2.connectedComponentsWithStats(mask, connectivity=8)
-    if count <= 1:
-        return []
-    scores = ndimage.maximum(symmetry, labels, np.arange(1, count))
+    on = labels > 0
+    scores = np.zeros(count - 1)
+    np.maximum.at(scores, labels[on] - 1, window[on])
     best = np.argsort(-scores, kind="stable")[:top]
-    return [Candidate.from_circle(
-        centroids[i + 1][0] + 0.5, centroids[i + 1][1] + 0.5,
-        max(stats[i + 1, cv2.CC_STAT_WIDTH], stats[i + 1, cv2.CC_STAT_HEIGHT]) / 2,
-        scores[i], state) for i in best]
+    sides = np.maximum(stats[1:, cv2.CC_STAT_WIDTH], stats[1:, cv2.CC_STAT_HEIGHT])
+    return [Candidate.from_circle(centroids[i + 1][0] + left + 0.5,
+                                  centroids[i + 1][1] + top_row + 0.5,
+                                  sides[i] / 2, scores[i], state) for i in best]
 
 
 class LabFrst(Detector):

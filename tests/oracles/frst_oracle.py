@@ -25,11 +25,6 @@ def sobel_at(padded: np.ndarray, r: int, c: int) -> tuple[float, float]:
     return gx, gy
 
 
-def half_away(x: float) -> int:
-    """Round half away from zero."""
-    return int(math.copysign(math.floor(abs(x) + 0.5), x))
-
-
 def gaussian_2d(n: int) -> np.ndarray:
     """A_n: 2-D Gaussian, sigma 0.25 n, half-width ceil(3 sigma), summing to one."""
     sigma = 0.25 * n
@@ -63,7 +58,7 @@ def frst_oracle(image, radii=tuple(range(1, 11)), alpha=2.0, beta=0.0, mode="bot
             norm = norms[r, c]
             if norm <= limit or norm == 0:
                 continue
-            dr, dc = half_away(gy / norm * n), half_away(gx / norm * n)
+            dr, dc = round(gy / norm * n), round(gx / norm * n)
             for sign in signs:
                 rr, cc = r + sign * dr, c + sign * dc
                 if 0 <= rr < height and 0 <= cc < width:

@@ -1,0 +1,105 @@
+"""Time the lab-frst detector on real road scenes at 480x356 and 1280x720, one thread.
+
+Frames are the Korean Roboflow scenes resized to each size. Also times the fast FRST against the
+loop oracle of tests/oracles on the same feature maps (one frame) and checks they agree.
+Run: /work/venv/bin/python benchmarks/bench_lab_frst.py [--frames N] [--repeats R]
+"""
+from __future__ import annotations
+
+import os
+
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ[_var] = "1"
+
+import argparse  # noqa: E402
+import json  # noqa: E402
+import statistics  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import cv2  # noqa: E402
+import numpy as np  # noqa: E402
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO / "tests"))
+
+from oracles.frst_oracle import frst_oracle  # noqa: E402
+
+import tsrkit  # noqa: E402
+from tsrkit.types import Frame  # noqa: E402
+from tsrkit_plugins.detectors.frst import frst  # noqa: E402
+from tsrkit_plugins.detectors.lab_frst import lab_feature_map  # noqa: E402
+
+SIZES = ((480, 356), (1280, 720))
+
+
+def scenes(count: int) -> list[np.ndarray]:
+    """The first ``count`` images of roboflow_traffic_light_kr, as BGR uint8."""
+    root = Path(os.environ.get("TSRKIT_DATA_DIR", REPO.parent / "shared" / "datasets"))
+    entries = json.loads((root / "roboflow_traffic_light_kr" / "annotations.json").read_text())
+    return [cv2.imread(str(root / "roboflow_traffic_light_kr" / e["file"]))
+            for e in entries[:count]]
+
+
+def median_ms(detector: tsrkit.Detector, frames: list[Frame], repeats: int) -> float:
+    """Median wall time of one ``detect`` call over every frame and repetition."""
+    times = []
+    for frame in frames:
+        detector.detect(frame)
+        for _ in range(repeats):
+            start = time.perf_counter()
+            detector.detect(frame)
+            times.append((time.perf_counter() - start) * 1000)
+    return statistics.median(times)
+
+
+def oracle_comparison(image: np.ndarray) -> dict[str, float]:
+    """Fast vs loop FRST on the two parts of one 480x356 feature map: time and agreement."""
+    feature = lab_feature_map(image)
+    parts = ((np.maximum(feature, 0), "bright"), (np.minimum(feature, 0), "dark"))
+    start = time.perf_counter()
+    slow = [frst_oracle(part, alpha=3.0, mode=mode) for part, mode in parts]
+    oracle_s = time.perf_counter() - start
+    fast_times = []
+    for _ in range(20):
+        start = time.perf_counter()
+        fast = [frst(part, alpha=3.0, mode=mode) for part, mode in parts]
+        fast_times.append(time.perf_counter() - start)
+    fast_s = statistics.median(fast_times)
+    diff = max(float(np.abs(f - s).max()) for f, s in zip(fast, slow))
+    peak = max(float(np.abs(s).max()) for s in slow)
+    return {"oracle_ms": oracle_s * 1000, "fast_ms": fast_s * 1000,
+            "speedup": oracle_s / fast_s, "max_abs_diff": diff, "max_abs_value": peak}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--frames", type=int, default=10)
+    parser.add_argument("--repeats", type=int, default=10)
+    parser.add_argument("--beta", type=float, default=None, help="override the beta default")
+    args = parser.parse_args()
+    cv2.setNumThreads(1)
+    images = scenes(args.frames)
+    detector = tsrkit.detector("lab-frst", **({} if args.beta is None else {"beta": args.beta}))
+    print(f"lab-frst params: {detector.params}")
+    results = {}
+    for width, height in SIZES:
+        frames = [Frame(cv2.resize(im, (width, height), interpolation=cv2.INTER_AREA), "bench")
+                  for im in images]
+        results[width, height] = median_ms(detector, frames, args.repeats)
+        print(f"{width}x{height}: median {results[width, height]:.1f} ms/frame "
+              f"({len(frames)} frames x {args.repeats} repeats)")
+    small, large = results[SIZES[0]], results[SIZES[1]]
+    print(f"1280x720 / 480x356 time ratio: {large / small:.2f} "
+          f"(pixel ratio {1280 * 720 / (480 * 356):.2f})")
+    small_frame = cv2.resize(images[0], SIZES[0], interpolation=cv2.INTER_AREA)
+    check = oracle_comparison(small_frame)
+    print(f"FRST of both feature-map parts, 480x356, alpha 3, radii 1..10, beta 0: "
+          f"oracle {check['oracle_ms']:.0f} ms, fast {check['fast_ms']:.1f} ms, "
+          f"speed-up {check['speedup']:.0f}x, max abs diff {check['max_abs_diff']:.2e} "
+          f"(max |S| {check['max_abs_value']:.3g})")
+
+
+if __name__ == "__main__":
+    main()

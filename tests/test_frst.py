@@ -1,0 +1,112 @@
+"""The fast radial symmetry transform against its loop oracle and on discs of known radius."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from oracles.frst_oracle import frst_oracle
+from tsrkit_plugins.detectors.frst import (affected_pixels, frst, kappa,
+                                           orientation_projection, radial_strength,
+                                           select_voters, sobel_gradient)
+
+
+def disc(radius: float, size: int = 41, bright: bool = True) -> np.ndarray:
+    """An anti-aliased disc of ``radius`` centred in a ``size`` x ``size`` image."""
+    yy, xx = np.mgrid[:size, :size]
+    centre = size // 2
+    image = np.clip(radius + 0.5 - np.hypot(yy - centre, xx - centre), 0, 1)
+    return (image if bright else 1 - image).astype(np.float32)
+
+
+@pytest.mark.parametrize("mode", ["both", "bright", "dark"])
+@pytest.mark.parametrize("orientation_only", [False, True])
+@pytest.mark.parametrize("beta", [0.0, 0.25])
+def test_fast_matches_oracle_on_random_images(mode, orientation_only, beta):
+    rng = np.random.default_rng([len(mode), int(orientation_only), int(beta * 100)])
+    image = rng.random((29, 37)).astype(np.float32)
+    args = dict(radii=range(1, 11), alpha=3.0, beta=beta, mode=mode,
+                orientation_only=orientation_only)
+    fast = frst(image, **args)
+    slow = frst_oracle(image, **args)
+    assert np.abs(slow).max() > 0.05
+    assert np.abs(fast - slow).max() <= 1e-4
+
+
+def test_fast_matches_oracle_on_a_blocky_uint8_image():
+    rng = np.random.default_rng(7)
+    image = np.kron(rng.integers(0, 256, (6, 8)), np.ones((5, 5))).astype(np.uint8)
+    fast = frst(image, radii=(1, 2, 4, 6), alpha=2.0)
+    slow = frst_oracle(image, radii=(1, 2, 4, 6), alpha=2.0)
+    assert np.abs(fast - slow).max() <= 1e-4 * max(1.0, np.abs(slow).max())
+
+
+@pytest.mark.parametrize("radius", [2, 3, 5, 7])
+def test_bright_disc_peaks_at_its_centre_for_its_radius(radius):
+    image = disc(radius)
+    own = frst(image, radii=[radius], alpha=3.0)
+    assert np.unravel_index(np.argmax(own), own.shape) == (20, 20)
+    at_centre = [frst(image, radii=[n], alpha=3.0)[20, 20] for n in range(1, 11)]
+    assert int(np.argmax(at_centre)) + 1 == radius
+
+
+def test_bright_disc_gives_a_positive_peak_and_dark_disc_a_negative_one():
+    bright = frst(disc(4), alpha=3.0)
+    dark = frst(disc(4, bright=False), alpha=3.0)
+    assert np.unravel_index(np.argmax(bright), bright.shape) == (20, 20)
+    assert bright.max() > 10 * abs(bright.min())
+    assert np.unravel_index(np.argmin(dark), dark.shape) == (20, 20)
+    assert -dark.min() > 10 * dark.max()
+
+
+def test_bright_and_dark_modes_keep_one_polarity():
+    image = disc(4, bright=False)
+    assert frst(image, mode="bright", alpha=3.0).min() >= 0
+    dark = frst(image, mode="dark", alpha=3.0)
+    assert dark.max() <= 0
+    assert np.unravel_index(np.argmin(dark), dark.shape) == (20, 20)
+
+
+def test_bincount_keeps_the_votes_a_fancy_index_increment_drops():
+    image = disc(5)
+    voters = select_voters(*sobel_gradient(image), beta=0.0, pad=5)
+    index = affected_pixels(voters, 5, +1)
+    size = voters.grid[0] * voters.grid[1]
+    counted = orientation_projection(index, +1, size)
+    naive = np.zeros(size, np.int64)
+    naive[index] += 1
+    centre = voters.crop(counted)[20, 20]
+    assert centre > 8
+    assert voters.crop(naive)[20, 20] == 1
+    assert counted.sum() == len(index)
+
+
+def test_orientation_only_ignores_contrast_but_magnitude_version_scales_with_it():
+    image = disc(4) * 0.5
+    assert np.allclose(frst(image, orientation_only=True), frst(3 * image, orientation_only=True))
+    assert np.allclose(3 * frst(image), frst(3 * image), rtol=1e-5, atol=1e-6)
+
+
+def test_orientation_is_clipped_at_kappa():
+    magnitude = np.array([2.0, 2.0, 2.0])
+    orientation = np.array([9, 10, 40])
+    strength = radial_strength(magnitude, orientation, kappa(5), alpha=2.0)
+    assert strength[0] == pytest.approx(2.0 / 9.9 * (9 / 9.9) ** 2)
+    assert strength[1] == strength[2] == pytest.approx(2.0 / 9.9)
+    assert (kappa(1), kappa(2), kappa(10)) == (8.0, 9.9, 9.9)
+
+
+def test_flat_image_has_no_symmetry():
+    assert not frst(np.full((20, 20), 0.3, np.float32)).any()
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    (dict(image=np.zeros((5, 5, 3))), "2-D"),
+    (dict(radii=[0, 1]), "radii"),
+    (dict(alpha=0), "alpha"),
+    (dict(beta=1.0), "beta"),
+    (dict(mode="grey"), "mode"),
+])
+def test_bad_arguments_name_the_problem(kwargs, match):
+    args = dict(image=np.zeros((9, 9), np.float32)) | kwargs
+    with pytest.raises(ValueError, match=match):
+        frst(**args)

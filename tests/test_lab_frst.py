@@ -1,0 +1,78 @@
+"""The LAB-FRST detector on synthetic frames with lit discs, and its feature map."""
+from __future__ import annotations
+
+import cv2
+import numpy as np
+import pytest
+
+import tsrkit
+from tsrkit.types import Frame
+from tsrkit_plugins.detectors.lab_frst import lab_feature_map, spot_candidates
+
+RED = (40, 40, 235)
+GREEN = (170, 230, 40)
+
+
+def street(lamps=(), size=(120, 160)) -> Frame:
+    """A grey frame with a darker housing band and lit discs ``(x, y, radius, bgr)``."""
+    image = np.full((*size, 3), 95, np.uint8)
+    cv2.rectangle(image, (10, 20), (150, 60), (35, 35, 35), -1)
+    for x, y, radius, colour in lamps:
+        cv2.circle(image, (x, y), radius, colour, -1, lineType=cv2.LINE_AA)
+    return Frame(image, "synthetic")
+
+
+def nearest(candidates, x, y):
+    return min(candidates, key=lambda c: np.hypot(c.x - x, c.y - y))
+
+
+def test_finds_a_red_lit_disc_and_labels_it_red():
+    found = tsrkit.detector("lab-frst").detect(street([(40, 40, 5, RED)]))
+    red = [c for c in found if c.state == "red"]
+    assert red
+    best = max(red, key=lambda c: c.score)
+    assert np.hypot(best.x - 40.5, best.y - 40.5) <= 1.5
+    assert best.radius >= 0.5
+
+
+def test_red_and_green_discs_get_their_own_state():
+    frame = street([(40, 40, 5, RED), (110, 40, 5, GREEN)])
+    found = tsrkit.detector("lab-frst").detect(frame)
+    assert nearest(found, 40.5, 40.5).state == "red"
+    assert nearest(found, 110.5, 40.5).state == "green"
+    assert np.hypot(nearest(found, 110.5, 40.5).x - 110.5,
+                    nearest(found, 110.5, 40.5).y - 40.5) <= 1.5
+    assert [c.score for c in found] == sorted((c.score for c in found), reverse=True)
+
+
+def test_keeps_at_most_top_spots_per_state():
+    lamps = [(20 + 20 * i, 40, 4, RED) for i in range(7)]
+    found = tsrkit.detector("lab-frst", top=3).detect(street(lamps))
+    assert sum(c.state == "red" for c in found) == 3
+
+
+def test_grey_frame_gives_no_candidates():
+    assert tsrkit.detector("lab-frst").detect(street()) == []
+
+
+def test_feature_map_sign_and_scale():
+    patches = np.array([[RED, GREEN, (128, 128, 128), (255, 255, 255)]], np.uint8)
+    red, green, grey, white = lab_feature_map(patches)[0]
+    lab = cv2.cvtColor(patches, cv2.COLOR_BGR2Lab).astype(float)[0, 0]
+    assert red == pytest.approx(lab[0] / 255 * (lab[1] + lab[2] - 256) / 128, abs=1e-6)
+    assert red > 0.4 and green < -0.2
+    assert abs(grey) < 0.02 and abs(white) < 0.02
+
+
+def test_spot_candidates_rank_by_peak_and_binarise_at_the_fraction():
+    symmetry = np.zeros((30, 30), np.float32)
+    symmetry[5, 5], symmetry[20, 8:11] = 1.0, 0.6
+    symmetry[25, 25] = 0.4
+    spots = spot_candidates(symmetry, 0.5, 5, "red")
+    assert [(c.x, c.y, c.score) for c in spots] == [(5.5, 5.5, 1.0), (9.5, 20.5, pytest.approx(0.6))]
+    assert spots[1].radius == 1.5
+
+
+def test_rejects_non_bgr_images():
+    with pytest.raises(ValueError, match="BGR uint8"):
+        lab_feature_map(np.zeros((10, 10), np.uint8))
