@@ -215,7 +215,7 @@ def _sun(canvas: Canvas, rng: np.random.Generator, lit: Lighting) -> None:
     if not canvas.free((x - 6 * s, y - 6 * s, x + 6 * s, y + 6 * s)):
         return
     color = (0.85, 0.95, 1.0) if lit.ambient > 0.9 else (0.5, 0.8, 1.0)
-    add_glow(canvas.light, x, y, color, s, 1.5, 2.0 * s, 0.6)
+    add_glow(canvas.base, x, y, color, s, 1.5, 2.0 * s, 0.6)  # behind what is drawn later
 
 
 def draw_buildings(canvas: Canvas, rng: np.random.Generator, lit: Lighting) -> None:
@@ -306,8 +306,7 @@ def draw_trees(canvas: Canvas, rng: np.random.Generator, lit: Lighting) -> None:
 def draw_cars(canvas: Canvas, rng: np.random.Generator, lit: Lighting, vx: float) -> None:
     """Cars ahead (red tail or brake light pairs) and, at dusk and night, oncoming headlights."""
     h, hz = canvas.height, canvas.horizon
-    for _ in range(rng.integers(0, 5)):
-        t = rng.uniform(0.08, 0.6)  # 1 / depth
+    for t in np.sort(rng.uniform(0.08, 0.6, rng.integers(0, 5))):  # 1 / depth, far first
         y = hz + (h - hz) * t
         cx = vx + rng.uniform(-0.8, 0.8) * canvas.width * t
         cw = canvas.width * 0.32 * t
@@ -384,6 +383,12 @@ def _lamp_head(canvas: Canvas, rng: np.random.Generator, lit: Lighting, x: float
         add_glow(canvas.light, x, road_y, color, 0, 0, size, 0.35, stretch=5.0)
 
 
+def retroreflection(lit: Lighting) -> float:
+    """Brightness of retro-reflective paint: as bright as the scene by day, brighter in the dark
+    (headlights light it back towards the camera)."""
+    return lit.ambient if lit.ambient > 0.5 else lit.ambient * 3.0
+
+
 def draw_sign(canvas: Canvas, rng: np.random.Generator, lit: Lighting) -> None:
     """A circular prohibition sign (white with a red ring) on a pole: a red distractor."""
     r = rng.uniform(4, 11) * canvas.scale
@@ -393,7 +398,7 @@ def draw_sign(canvas: Canvas, rng: np.random.Generator, lit: Lighting) -> None:
         return
     _line(canvas.base, (x, y), (x, canvas.horizon + 10 * canvas.scale),
           np.array((0.4, 0.4, 0.4)) * lit.ambient, max(r * 0.2, 1))
-    gain = lit.ambient if lit.ambient > 0.5 else lit.ambient * 3.0  # retro-reflective
+    gain = retroreflection(lit)
     _disk(canvas.base, x, y, r, np.array((0.1, 0.1, 0.85)) * gain)
     _disk(canvas.base, x, y, r * 0.72, np.array((0.92, 0.92, 0.92)) * gain)
 
@@ -507,7 +512,8 @@ def _draw_housing(canvas: Canvas, rng: np.random.Generator, lit: Lighting,
     if r > 3.5 * canvas.scale and rng.random() < 0.3:  # backplate with a light border
         x0, y0, x1, y1 = box
         grow = r * 0.9
-        _rect(canvas.base, (x0 - grow, y0 - grow, x1 + grow, y1 + grow), (0.1, 0.75, 0.85))
+        _rect(canvas.base, (x0 - grow, y0 - grow, x1 + grow, y1 + grow),
+              np.array((0.1, 0.75, 0.85)) * retroreflection(lit))
         _rect(canvas.base, (x0 - grow + 1, y0 - grow + 1, x1 + grow - 1, y1 + grow - 1),
               (dark, dark, dark))
     _rect(canvas.base, box, np.array((dark, dark, dark * 1.1)))
