@@ -53,3 +53,13 @@ def test_unknown_detector_is_one_line_error(fakes, tmp_path):
     assert result.exit_code == 2
     assert "no detector called 'nope'" in result.output
     assert "Traceback" not in result.output
+
+
+def test_bare_tsrkit_compares_the_defaults_into_tsrkit_out(fakes, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr("tsrkit.cli.benchmark.DEFAULT_COMPARE", ("oracle", "shifted"))
+    result = CliRunner().invoke(cli, [])
+    assert result.exit_code == 0, result.output
+    comparison = json.loads((tmp_path / "tsrkit-out" / "compare.json").read_text())
+    assert comparison["dataset"] == "sample"
+    assert [t["verdict"] for t in comparison["paired_tests"]] == ["oracle better"]

@@ -32,9 +32,9 @@ HEADLINE = (("per_frame", "recall_mean", "recall", ".3f"),
 class ProgressBar:
     """A rich progress bar with frames/s on stderr; does nothing when disabled."""
 
-    def __init__(self, total: int, enabled: bool):
+    def __init__(self, total: int, enabled: bool, label: str = "benchmark"):
         self.progress = Progress(
-            TextColumn("[bold]benchmark"), BarColumn(), MofNCompleteColumn(),
+            TextColumn(f"[bold]{label}"), BarColumn(), MofNCompleteColumn(),
             TextColumn("{task.fields[rate]} frames/s"), TimeRemainingColumn(),
             console=Console(stderr=True), disable=not enabled, transient=False)
         self.task = self.progress.add_task("frames", total=total, rate="-")

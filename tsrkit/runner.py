@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import multiprocessing
 import os
 import time
 from collections import deque
@@ -133,6 +134,14 @@ def _single_thread() -> None:
     cv2.setNumThreads(1)
 
 
+def _pool_context():
+    """Workers from a fork server: forking a process whose OpenCV thread pool has started can
+    crash the child, so children fork from a clean server that preloads the runner."""
+    context = multiprocessing.get_context("forkserver")
+    context.set_forkserver_preload(["tsrkit.runner"])
+    return context
+
+
 def _run_in_worker(index: int, sample: Sample) -> dict[str, Any]:
     return process_sample(index, sample, _WORKER_JOB)
 
@@ -161,7 +170,8 @@ def run_records(samples: Iterable[Sample], job: Job, workers: int = 1, engine: s
     elif workers == 1:
         yield from (process_sample(i, s, job) for i, s in enumerate(samples))
     else:
-        with ProcessPoolExecutor(workers, initializer=_init_worker, initargs=(job,)) as pool:
+        with ProcessPoolExecutor(workers, mp_context=_pool_context(), initializer=_init_worker,
+                                 initargs=(job,)) as pool:
             yield from ordered(lambda i, s: pool.submit(_run_in_worker, i, s),
                                lambda f: f.result(), samples, 4 * workers)
 
@@ -220,7 +230,8 @@ def evaluate(dataset: Dataset, detector: Detector | None, classifier: Classifier
     start = time.perf_counter()
     sink_context = (atomic_open(Path(out) / "detections.jsonl") if out is not None
                     else open(os.devnull, "w", encoding="utf-8"))
-    with sink_context as sink, ProgressBar(len(dataset), progress) as bar:
+    label = (detector or classifier).name
+    with sink_context as sink, ProgressBar(len(dataset), progress, label) as bar:
         for record in run_records(dataset.samples, job, workers, engine, scheduler):
             bar.advance()
             if "skipped" in record:

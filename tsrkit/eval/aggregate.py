@@ -67,6 +67,13 @@ class Evaluation:
         """The COCO ground truth of the evaluated frames."""
         return coco_dataset(self.images, self.annotations, self.name)
 
+    def state(self) -> dict[str, Any]:
+        """State metrics of the centre-matched pairs; empty when no state was predicted."""
+        if all(p == "unknown" for p in self.predicted):
+            return {**state_metrics([], []),
+                    "note": "the method predicts no state (every detection is 'unknown')"}
+        return state_metrics(self.truth, self.predicted, self.state_scores)
+
     def metrics(self) -> dict[str, Any]:
         """``frames``, ``per_frame``, ``iou50``, ``iou``, ``state``, ``categories``, ``intervals``."""
         scores = list(self.scores.values())
@@ -80,7 +87,7 @@ class Evaluation:
             "per_frame": summarise(scores),
             "iou50": iou50,
             "iou": summarise_overlap(self.overlap, self.iou_threshold),
-            "state": state_metrics(self.truth, self.predicted, self.state_scores),
+            "state": self.state(),
             "categories": category_table(scores),
             "intervals": headline_intervals(scores),
             "ms_per_frame_median": float(np.median(self.ms)) if self.ms else None,
