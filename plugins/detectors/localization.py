@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Any
 
 import cv2
@@ -81,9 +82,17 @@ class Components:
 
 
 def components(mask: np.ndarray) -> Components:
-    """Step 2.1: 8-connected components of a binary mask (background excluded)."""
-    _, _, stats, centroids = cv2.connectedComponentsWithStats(mask, connectivity=8)
-    return Components(stats[1:, :4], stats[1:, cv2.CC_STAT_AREA], centroids[1:])
+    """Step 2.1: 8-connected components of a binary mask (background excluded).
+
+    Labelling runs on the bounding rectangle of the set pixels only (the peaks are sparse).
+    """
+    x, y, w, h = cv2.boundingRect(mask)
+    if w == 0:
+        return Components(np.zeros((0, 4), np.int64), np.zeros(0, np.int64), np.zeros((0, 2)))
+    _, _, stats, centroids = cv2.connectedComponentsWithStats(
+        np.ascontiguousarray(mask[y:y + h, x:x + w]), connectivity=8)
+    boxes = stats[1:, :4] + np.array([x, y, 0, 0])
+    return Components(boxes, stats[1:, cv2.CC_STAT_AREA], centroids[1:] + np.array([x, y]))
 
 
 def shape_filter(found: Components, asp_min: float, pd_min: float) -> np.ndarray:
@@ -103,6 +112,7 @@ def nearest_cells(centres: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
     return cells
 
 
+@lru_cache(maxsize=8)
 def _window_offsets(reach: int) -> tuple[np.ndarray, np.ndarray]:
     dy, dx = np.mgrid[-reach:reach + 1, -reach:reach + 1]
     return dy.ravel(), dx.ravel()
@@ -143,7 +153,6 @@ def drmshift(cm: np.ndarray, starts: np.ndarray, radius_map: np.ndarray | None =
         reach = int(fixed.max(initial=0))
     else:
         reach = int(radius_map.max(initial=0))
-    padded = np.pad(cm.astype(np.float64), reach)
     dy, dx = _window_offsets(reach)
     active = np.ones(len(centres), bool)
     radius = np.zeros(len(centres), np.int64)
@@ -157,7 +166,8 @@ def drmshift(cm: np.ndarray, starts: np.ndarray, radius_map: np.ndarray | None =
         inside = dy * dy + dx * dx <= (r * r)[:, None]
         rows = cell[:, :1] + dy
         cols = cell[:, 1:] + dx
-        weight = padded[rows + reach, cols + reach] * inside
+        inside &= (rows >= 0) & (rows < cm.shape[0]) & (cols >= 0) & (cols < cm.shape[1])
+        weight = cm[rows.clip(0, cm.shape[0] - 1), cols.clip(0, cm.shape[1] - 1)] * inside
         m00 = weight.sum(axis=1)
         moved = m00 > 0
         new = np.stack([(weight * rows).sum(axis=1), (weight * cols).sum(axis=1)], axis=1)

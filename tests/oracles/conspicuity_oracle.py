@@ -37,15 +37,18 @@ def quadrant_masks(radius: int, margin: int, vertical: int, horizontal: int):
 
 
 def conspicuity_at_radius(light: np.ndarray, sat: np.ndarray, radius: int, weights,
-                          margin: int = 0, quadrant_rule: str = "min") -> np.ndarray:
+                          margin: int = 0, quadrant_rule: str = "max") -> np.ndarray:
     """Eq. 3.1 for one radius, each feature by direct correlation with its mask."""
     ld = window_mean(light, disk_mask(radius, radius))
     contrasts = []
     for vertical in (-1, 1):
         for horizontal in (-1, 1):
             inner, border = quadrant_masks(radius, margin, vertical, horizontal)
-            contrasts.append(np.maximum(0.0, window_mean(light, inner)
-                                        - window_mean(light, border)))
+            difference = window_mean(light, inner) - window_mean(light, border)
+            # Both means are multiples of 1/(255 n); anything this small is rounding noise,
+            # which the root of Eq. 3.1 would magnify.
+            difference[np.abs(difference) < 1e-9] = 0.0
+            contrasts.append(np.maximum(0.0, difference))
     lc = np.max(contrasts, axis=0) if quadrant_rule == "max" else np.min(contrasts, axis=0)
     sd = window_mean(sat, disk_mask(radius, 2 * radius))
     annulus = ~disk_mask(radius, 2 * radius) & disk_mask(2 * radius, 2 * radius)
@@ -56,7 +59,7 @@ def conspicuity_at_radius(light: np.ndarray, sat: np.ndarray, radius: int, weigh
 
 
 def conspicuity_reference(image: np.ndarray, radii=tuple(range(1, 11)), weights=(1, 1, 1),
-                          margin: int = 0, quadrant_rule: str = "min"):
+                          margin: int = 0, quadrant_rule: str = "max"):
     """Eq. 3.2: maximum over the radius set; returns (values, arg-max radius, per-radius stack)."""
     light = lightness(image).astype(np.float64) / 255.0
     sat = saturation(image).astype(np.float64) / 255.0

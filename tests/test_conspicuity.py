@@ -1,0 +1,139 @@
+"""Zheng's conspicuity map (3.2.1): fast maps against the direct-correlation oracle, and
+hand-computed micro images."""
+import json
+
+import cv2
+import numpy as np
+import pytest
+
+import tsrkit
+from tsrkit.types import Frame
+from tsrkit_plugins.detectors import conspicuity as cs
+from oracles.conspicuity_oracle import conspicuity_reference
+
+
+def random_image(seed, shape=(44, 57)):
+    rng = np.random.default_rng(seed)
+    return rng.integers(0, 256, (*shape, 3), dtype=np.uint8)
+
+
+def lit_disk(radius, shape=(60, 64), centre=(31, 29), colour=(40, 200, 60)):
+    image = np.full((*shape, 3), 30, np.uint8)
+    cv2.circle(image, (centre[1], centre[0]), radius, colour, -1)
+    return image
+
+
+def assert_matches_oracle(image, **settings):
+    fast = cs.conspicuity_map(image, **settings)
+    values, radius, stack = conspicuity_reference(image, **settings)
+    assert np.abs(fast.values - values).max() <= 1e-4
+    # The arg-max radius must agree wherever the oracle's best radius is not a near tie.
+    radii = sorted(set(settings.get("radii", range(1, 11))))
+    at_fast = np.take_along_axis(stack, np.searchsorted(radii, fast.radius)[None], 0)[0]
+    assert np.all((fast.radius == radius) | (np.abs(at_fast - values) <= 1e-4))
+
+
+@pytest.mark.parametrize("seed, settings", [
+    (0, {}),
+    (1, {"quadrant_rule": "min"}),
+    (2, {"margin": 2, "weights": (1.0, 2.0, 0.5)}),
+    (3, {"radii": (2, 3, 5), "weights": (2.0, 1.0, 4.0)}),
+])
+def test_fast_map_matches_oracle_on_random_images(seed, settings):
+    assert_matches_oracle(random_image(seed), **settings)
+
+
+def test_fast_map_matches_oracle_on_a_real_frame(shared_datasets):
+    root = shared_datasets / "roboflow_traffic_light_kr"
+    entry = next(e for e in json.loads((root / "annotations.json").read_text()) if e["boxes"])
+    box = entry["boxes"][0]
+    image = cv2.imread(str(root / entry["file"]))
+    cx, cy = int((box["x_min"] + box["x_max"]) / 2), int((box["y_min"] + box["y_max"]) / 2)
+    y0, x0 = max(0, cy - 30), max(0, cx - 35)
+    assert_matches_oracle(np.ascontiguousarray(image[y0:y0 + 60, x0:x0 + 70]))
+
+
+def test_window_sums_are_exact_integer_sums():
+    image = random_image(4)
+    light = cs.lightness(image)
+    sums = cs.PrefixSums(light, 20)
+    padded = cv2.copyMakeBorder(light, 20, 20, 20, 20, cv2.BORDER_REFLECT_101).astype(np.int64)
+    for r in (1, 4, 10):
+        quarters = [cs.quarter_disk_sum(sums, r, q) for q in cs.QUADRANTS]
+        direct = cs.disk_sum(sums, r)
+        assert np.array_equal(cs.disk_from_quarters(sums, r, quarters), direct)
+        assert int(direct[7, 9]) == int(np.sum(padded[27 - r:28 + r, 29 - r:30 + r]
+                                              * (np.hypot(*np.mgrid[-r:r + 1, -r:r + 1]) <= r)))
+        assert int(cs.quarter_box_sum(sums, r, (1, 1))[5, 6]) == int(
+            padded[25:26 + r, 26:27 + r].sum())
+
+
+@pytest.mark.parametrize("radius", [2, 4, 7])
+def test_single_lit_disk_peaks_at_its_centre_with_its_radius(radius):
+    cmap = cs.conspicuity_map(lit_disk(radius))
+    assert cmap.values[31, 29] == pytest.approx(cmap.values.max(), abs=1e-6)
+    assert cmap.radius[31, 29] == radius
+    # The printed Eq. 3.5 (max) makes a plateau over the lens; the prose's min a single peak.
+    strict = cs.conspicuity_map(lit_disk(radius), quadrant_rule="min")
+    assert np.unravel_index(np.argmax(strict.values), strict.values.shape) == (31, 29)
+    assert strict.radius[31, 29] == radius
+    assert np.sum(strict.values >= strict.values.max() - 1e-6) == 1
+
+
+def test_quadrant_contrast_is_zero_on_a_flat_image():
+    flat = np.full((30, 40, 3), (20, 120, 200), np.uint8)
+    sums = cs.PrefixSums(cs.lightness(flat), 12)
+    for r in (1, 3, 6):
+        for q in cs.QUADRANTS:
+            contrast = cs.quadrant_contrast(cs.quarter_disk_sum(sums, r, q),
+                                            cs.quarter_box_sum(sums, r, q),
+                                            cs.quarter_disk_size(r), (r + 1) ** 2)
+            assert not contrast.any()
+    assert cs.conspicuity_map(flat, radii=(1, 3, 6)).values.max() < 1e-2
+
+
+def test_geometric_mean_ratio_is_invariant_to_feature_scales():
+    rng = np.random.default_rng(5)
+    features = [rng.uniform(0.05, 1.0, 50).astype(np.float32) for _ in range(3)]
+    weights = (1.0, 2.0, 0.5)
+    base = cs.weighted_root(cs.weighted_product(features, weights), weights)
+    scaled = cs.weighted_root(cs.weighted_product(
+        [f * s for f, s in zip(features, (0.3, 7.0, 0.01))], weights), weights)
+    np.testing.assert_allclose(scaled / scaled[0], base / base[0], rtol=1e-5)
+    assert not np.allclose(scaled, base)
+
+
+def test_disk_and_annulus_sizes():
+    assert [cs.disk_size(r) for r in (1, 2, 3)] == [5, 13, 29]
+    assert cs.quarter_disk_size(1) == 3
+    image = np.zeros((20, 20, 3), np.uint8)
+    sums = cs.PrefixSums(cs.saturation(image), 8)
+    assert cs.annulus_saturation(cs.disk_sum(sums, 4), cs.disk_sum(sums, 2), 2).max() == 0
+
+
+@pytest.mark.parametrize("kwargs", [{"weights": (0, 0, 0)}, {"weights": (1, 1)},
+                                    {"radii": (0, 2)}, {"margin": -1}])
+def test_bad_settings_raise_value_error(kwargs):
+    with pytest.raises(ValueError):
+        cs.conspicuity_map(lit_disk(3), **kwargs)
+
+
+def test_non_bgr_input_raises_value_error():
+    with pytest.raises(ValueError, match="BGR uint8"):
+        cs.conspicuity_map(np.zeros((10, 10), np.uint8))
+
+
+def test_detector_finds_the_lit_disk_with_score_and_radius():
+    detector = tsrkit.detector("conspicuity")
+    candidates = detector.detect(Frame(lit_disk(4), "disk.png"))
+    best = candidates[0]
+    assert abs(best.x - 29.5) <= 0.5 and abs(best.y - 31.5) <= 0.5
+    assert best.radius == 4
+    assert best.score == pytest.approx(float(cs.conspicuity_map(lit_disk(4)).values.max()))
+    assert [c.score for c in candidates] == sorted((c.score for c in candidates), reverse=True)
+
+
+def test_region_of_interest_hides_the_lower_frame():
+    image = lit_disk(4, shape=(80, 64), centre=(60, 29))
+    assert not tsrkit.detector("conspicuity", roi_top=0.5).detect(Frame(image, "x"))
+    assert tsrkit.detector("conspicuity").detect(Frame(image, "x"))
