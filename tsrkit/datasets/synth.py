@@ -95,8 +95,15 @@ class SynthOptions:
 
 @dataclass(frozen=True)
 class Lighting:
-    """How one lighting condition exposes the scene (radiances relative to a sensor max of 1)."""
+    """How one lighting condition exposes the scene; radiances are relative to sensor full scale.
 
+    ``ambient`` scales every reflecting surface; ``lens_core`` and ``lens_halo`` are the ranges
+    of a lit lens's disk and halo radiance (above 1 the sensor clips: the white core of Zheng
+    4.2); ``washout`` is the largest white mixed into a lens colour by day; ``noise`` the sensor
+    noise (std); ``lamps_on``, ``windows_lit`` and ``wet_road`` are probabilities.
+    """
+
+    name: str
     ambient: float
     sky_top: tuple[float, float, float]
     sky_horizon: tuple[float, float, float]
@@ -110,12 +117,18 @@ class Lighting:
 
 
 LIGHTING = {
-    "day": Lighting(1.0, (0.82, 0.56, 0.30), (0.96, 0.90, 0.84), (0.95, 1.25), (0.10, 0.22),
-                    0.45, 0.010, 0.0, 0.0, 0.0),
-    "dusk": Lighting(0.42, (0.40, 0.22, 0.18), (0.40, 0.62, 0.95), (1.6, 3.0), (0.30, 0.55),
-                     0.0, 0.018, 0.7, 0.25, 0.3),
-    "night": Lighting(0.10, (0.07, 0.035, 0.02), (0.16, 0.13, 0.11), (5.0, 12.0), (0.65, 1.1),
-                      0.0, 0.028, 1.0, 0.35, 0.5),
+    "day": Lighting("day", ambient=1.0, sky_top=(0.82, 0.56, 0.30),
+                    sky_horizon=(0.96, 0.90, 0.84), lens_core=(0.95, 1.25),
+                    lens_halo=(0.10, 0.22), washout=0.45, noise=0.010, lamps_on=0.0,
+                    windows_lit=0.0, wet_road=0.0),
+    "dusk": Lighting("dusk", ambient=0.42, sky_top=(0.40, 0.22, 0.18),
+                     sky_horizon=(0.40, 0.62, 0.95), lens_core=(1.6, 3.0),
+                     lens_halo=(0.30, 0.55), washout=0.0, noise=0.018, lamps_on=0.7,
+                     windows_lit=0.25, wet_road=0.3),
+    "night": Lighting("night", ambient=0.10, sky_top=(0.07, 0.035, 0.02),
+                      sky_horizon=(0.16, 0.13, 0.11), lens_core=(5.0, 12.0),
+                      lens_halo=(0.65, 1.1), washout=0.0, noise=0.028, lamps_on=1.0,
+                      windows_lit=0.35, wet_road=0.5),
 }
 
 
@@ -194,16 +207,16 @@ def draw_sky(canvas: Canvas, rng: np.random.Generator, lit: Lighting) -> None:
     t = (np.arange(rows, dtype=np.float32) / max(rows - 1, 1)) ** 1.4
     top = np.asarray(lit.sky_top, np.float32) * rng.uniform(0.85, 1.1)
     bottom = np.asarray(lit.sky_horizon, np.float32) * rng.uniform(0.9, 1.05)
-    if lit is LIGHTING["day"] and rng.random() < 0.3:  # overcast
+    if lit.name == "day" and rng.random() < 0.3:  # overcast
         top = bottom = np.full(3, rng.uniform(0.72, 0.9), np.float32)
     canvas.base[:rows] = (top + (bottom - top) * t[:, None])[:, None, :]
-    for _ in range(rng.integers(0, 6) if lit.ambient > 0.5 else 0):
+    for _ in range(rng.integers(0, 6) if lit.name == "day" else 0):
         x, y = rng.uniform(0, canvas.width), rng.uniform(0, canvas.horizon * 0.7)
         s = rng.uniform(15, 50) * canvas.scale
         if canvas.free((x - 2 * s, y - s, x + 2 * s, y + s), 6 * canvas.scale):
             cv2.ellipse(canvas.base, (int(x), int(y)), (int(2 * s), int(s * 0.6)), 0, 0, 360,
                         (0.97, 0.97, 0.97), -1, cv2.LINE_AA)
-    if lit is LIGHTING["dusk"] or (lit is LIGHTING["day"] and rng.random() < 0.25):
+    if lit.name == "dusk" or (lit.name == "day" and rng.random() < 0.25):
         _sun(canvas, rng, lit)
 
 
@@ -214,7 +227,7 @@ def _sun(canvas: Canvas, rng: np.random.Generator, lit: Lighting) -> None:
     y = canvas.horizon - rng.uniform(0.1, 0.6) * canvas.horizon
     if not canvas.free((x - 6 * s, y - 6 * s, x + 6 * s, y + 6 * s)):
         return
-    color = (0.85, 0.95, 1.0) if lit.ambient > 0.9 else (0.5, 0.8, 1.0)
+    color = (0.85, 0.95, 1.0) if lit.name == "day" else (0.5, 0.8, 1.0)
     add_glow(canvas.base, x, y, color, s, 1.5, 2.0 * s, 0.6)  # behind what is drawn later
 
 
@@ -329,7 +342,7 @@ def draw_cars(canvas: Canvas, rng: np.random.Generator, lit: Lighting, vx: float
                          max(cw * 0.05, 0.8), 0.25, stretch=4.0)
         if lit.lamps_on and rng.random() < 0.5:
             _headlights(canvas, 2 * vx - cx, y * 0.98 + hz * 0.02, cw)
-    if lit.ambient > 0.9:
+    if lit.name == "day":
         _glints(canvas, rng)
 
 
@@ -578,12 +591,17 @@ def noise_field(shape: tuple[int, ...], offset: int) -> np.ndarray:
     return _noise_bank(size)[offset:offset + size].reshape(shape)
 
 
-def compress(image: np.ndarray, quality: int) -> np.ndarray:
-    """One JPEG round trip: the block and chroma artefacts of a low-quality video."""
+def encode_jpeg(image: np.ndarray, quality: int) -> np.ndarray:
+    """JPEG bytes of a BGR image (libjpeg through OpenCV: deterministic for equal input)."""
     ok, data = cv2.imencode(".jpg", image, [cv2.IMWRITE_JPEG_QUALITY, int(quality)])
     if not ok:
         raise TsrkitError("JPEG encoding failed")
-    return cv2.imdecode(data, cv2.IMREAD_COLOR)
+    return data
+
+
+def compress(image: np.ndarray, quality: int) -> np.ndarray:
+    """One JPEG round trip: the block and chroma artefacts of a low-quality video."""
+    return cv2.imdecode(encode_jpeg(image, quality), cv2.IMREAD_COLOR)
 
 
 # --------------------------------------------------------------------------- frames
@@ -657,17 +675,14 @@ def render_dataset(folder: Path, frames: int, seed: int, width: int, height: int
     samples = []
     for index in range(frames):
         image, annotations, condition = render_frame(index, seed, width, height, options)
-        ok, data = cv2.imencode(".jpg", image, [cv2.IMWRITE_JPEG_QUALITY, options.quality])
-        if not ok:
-            raise TsrkitError("JPEG encoding failed")
         path = images / f"{index:06d}.jpg"
-        path.write_bytes(data.tobytes())
+        path.write_bytes(encode_jpeg(image, options.quality).tobytes())
         samples.append(Sample(str(path), tuple(annotations), width, height,
                               frame_split(index, options),
                               {"lighting": condition, "seed": int(seed), "frame": index}))
     info = {"box_convention": "lens", "licence": "generated by tsrkit (MIT, as the code)",
             "generator_version": GENERATOR_VERSION, "seed": int(seed)}
-    return Dataset(f"synth-{seed}", tuple(samples), "synth", str(folder), info)
+    return Dataset(f"synth-{seed}", tuple(samples), "normalized", str(folder), info)
 
 
 def write_annotations(dataset: Dataset, folder: Path) -> None:
@@ -683,7 +698,8 @@ def _relocate(dataset: Dataset, old: Path, new: Path) -> Dataset:
     """The same dataset with image paths moved from folder ``old`` to folder ``new``."""
     samples = tuple(replace(s, source=str(new / Path(s.source).relative_to(old)))
                     for s in dataset.samples)
-    return replace(dataset, samples=samples, root=str(new))
+    info = {**dataset.info, "annotation_file": str(new / "annotations.json")}
+    return replace(dataset, samples=samples, root=str(new), info=info)
 
 
 def _open_permissions(folder: Path) -> None:
@@ -692,6 +708,11 @@ def _open_permissions(folder: Path) -> None:
     for path in folder.iterdir():
         if path.is_file():
             path.chmod(0o644)
+
+
+def _occupied(out: Path) -> TsrkitError:
+    return TsrkitError(f"{out} already exists and holds other data; choose another folder "
+                       "or pass overwrite=True (--overwrite)")
 
 
 def _publish(tmp: Path, out: Path, stamp: dict, overwrite: bool) -> None:
@@ -707,8 +728,7 @@ def _publish(tmp: Path, out: Path, stamp: dict, overwrite: bool) -> None:
         return
     if not overwrite:
         shutil.rmtree(tmp, ignore_errors=True)
-        raise TsrkitError(f"{out} already exists and holds other data; choose another folder "
-                          f"or pass overwrite=True (--overwrite)")
+        raise _occupied(out)
     trash = Path(tempfile.mkdtemp(prefix=f".{out.name}.old.", dir=out.parent))
     os.rename(out, trash / out.name)
     os.rename(tmp, out)
@@ -760,8 +780,7 @@ def generate(out, frames: int, seed: int, width: int = 480, height: int = 356,
     out = Path(out).expanduser().absolute()
     stamp = _stamp(frames, seed, width, height, opts)
     if out.is_dir() and any(out.iterdir()) and _read_stamp(out) != stamp and not overwrite:
-        raise TsrkitError(f"{out} already exists and is not empty; choose another folder "
-                          f"or pass overwrite=True (--overwrite)")
+        raise _occupied(out)
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".tmp", dir=out.parent))
     try:
