@@ -86,9 +86,10 @@ def drmshift_reference(cm: np.ndarray, rm: np.ndarray, start, h_c: float = 0.5,
             for jj in range(cj - r, cj + r + 1):
                 inside = 0 <= ii < height and 0 <= jj < width
                 if inside and (ii - ci) ** 2 + (jj - cj) ** 2 <= r * r:
-                    m00 += cm[ii, jj]
-                    m01 += ii * cm[ii, jj]
-                    m10 += jj * cm[ii, jj]
+                    weight = float(cm[ii, jj])
+                    m00 += weight
+                    m01 += ii * weight
+                    m10 += jj * weight
         if m00 > 0:
             i_tmp, j_tmp = i, j
             i, j = m01 / m00, m10 / m00
