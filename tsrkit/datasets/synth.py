@@ -51,7 +51,7 @@ from tsrkit.errors import TsrkitError
 from tsrkit.types import Annotation, Dataset, Sample
 
 #: Bumped whenever the rendered pixels or annotations change; names the sample cache folder.
-GENERATOR_VERSION = 1
+GENERATOR_VERSION = 2
 LIGHTINGS = ("day", "dusk", "night")
 #: Lens order in a housing: top to bottom, or left to right.
 LENS_ORDER = ("red", "yellow", "green")
