@@ -68,13 +68,16 @@ def select_voters(gx: np.ndarray, gy: np.ndarray, beta: float, pad: int) -> Vote
 
     This is Loy & Zelinsky's gradient threshold beta ("ignoring small gradients"), read as a
     fraction of the image's largest gradient norm; zero gradients never vote, whatever beta.
-    ``pad`` must be at least the largest radius.
+    ``pad`` must be at least the largest radius. The gradients are zero-padded to the working
+    grid first, so the selected flat indices are already grid indices.
     """
-    magnitude = cv2.magnitude(gx, gy)
-    rows, cols = np.nonzero(magnitude > beta * float(magnitude.max()))
-    mag = magnitude[rows, cols]
-    index = (rows + pad) * (gx.shape[1] + 2 * pad) + cols + pad
-    return Voters(index, gx[rows, cols] / mag, gy[rows, cols] / mag, mag, gx.shape, pad)
+    shape = gx.shape
+    gx = cv2.copyMakeBorder(gx, pad, pad, pad, pad, cv2.BORDER_CONSTANT).ravel()
+    gy = cv2.copyMakeBorder(gy, pad, pad, pad, pad, cv2.BORDER_CONSTANT).ravel()
+    magnitude = cv2.magnitude(gx, gy).ravel()
+    index = np.flatnonzero(magnitude > beta * float(magnitude.max()))
+    mag = magnitude[index]
+    return Voters(index, gx[index] / mag, gy[index] / mag, mag, shape, pad)
 
 
 def affected_pixels(voters: Voters, n: int, sign: int) -> np.ndarray:
