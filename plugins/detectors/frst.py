@@ -5,7 +5,7 @@ its gradient direction; the votes, clipped and sharpened, are smoothed and summe
 Reusable: any detector may call :func:`frst` on a 2-D float map.
 
 Source: G. Loy and A. Zelinsky, "Fast radial symmetry for detecting points of interest",
-IEEE PAMI 25(8), 2003, section 2 ("Definition of the transform") and its refinements
+IEEE PAMI 25(8), 2003: the definition of the transform and its refinements
 (gradient threshold beta, bright/dark-only symmetry, orientation-based symmetry). That paper is
 not among the project's seed documents, so the functions below name each quantity by its
 symbol (O_n, M_n, F_n, A_n, S_n) instead of an equation number.
@@ -53,7 +53,7 @@ class Voters:
 
 
 def sobel_gradient(image: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Gradient ``g(p) = (gx, gy)`` by the 3x3 Sobel filter (Loy & Zelinsky, section 2).
+    """Gradient ``g(p) = (gx, gy)`` by the 3x3 Sobel filter (Loy & Zelinsky 2003).
 
     Computed in float64; borders are reflected without repeating the edge pixel (OpenCV's
     BORDER_REFLECT_101).
@@ -66,7 +66,7 @@ def sobel_gradient(image: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def select_voters(gx: np.ndarray, gy: np.ndarray, beta: float, pad: int) -> Voters:
     """Keep the pixels whose gradient norm exceeds ``beta`` times the largest one.
 
-    This is Loy & Zelinsky's gradient threshold beta ("ignoring small gradients"), read as a
+    This is Loy & Zelinsky's gradient threshold beta for ignoring small gradients, read as a
     fraction of the image's largest gradient norm; zero gradients never vote, whatever beta.
     ``pad`` must be at least the largest radius. The gradients are zero-padded to the working
     grid first, so the selected flat indices are already grid indices.
@@ -111,7 +111,7 @@ def magnitude_projection(index: np.ndarray, weights: np.ndarray, sign: int,
 
 
 def kappa(n: int) -> float:
-    """The normalising factor k_n: 8 for n = 1, 9.9 otherwise (Loy & Zelinsky, section 2)."""
+    """The normalising factor k_n: 8 for n = 1, 9.9 otherwise (Loy & Zelinsky 2003)."""
     return 8.0 if n == 1 else 9.9
 
 
@@ -140,8 +140,8 @@ def radial_strength(magnitude: np.ndarray, orientation: np.ndarray, k: float,
 def orientation_strength(orientation: np.ndarray, k: float, alpha: float) -> np.ndarray:
     """Orientation-based F_n = sign(O~_n) (|O~_n| / k_n) ** alpha (no magnitude projection).
 
-    Loy & Zelinsky's variant that ignores gradient magnitude, so the result does not change
-    when the image contrast is scaled.
+    The orientation-based variant Loy & Zelinsky describe: gradient magnitude is ignored, so the
+    result does not change when the image contrast is scaled.
     """
     clipped = clipped_orientation(orientation, k)
     return np.sign(clipped) * (np.abs(clipped) / k) ** alpha

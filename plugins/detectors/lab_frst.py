@@ -74,11 +74,18 @@ def spot_candidates(symmetry: np.ndarray, fraction: float, top: int,
 
 
 class LabFrst(Detector):
-    """LAB-FRST baseline (Siogkas et al. via Zheng 2016, 5.2.2)."""
+    """LAB-FRST baseline (Siogkas et al. via Zheng 2016, 5.2.2).
+
+    Zheng 5.2.2 sets radii 1..10, alpha 3, binarisation at half the maximum and 8-connectivity;
+    it also says "the orientation flag is set to be true" for the inventor's code, which we cannot
+    see. We default to the full transform F_n = (M_n/k_n)(|O~_n|/k_n)^alpha and expose the
+    orientation-based variant as ``orientation_only``. Zheng gives no gradient threshold, so
+    ``beta`` defaults to 0 (every non-zero gradient votes).
+    """
 
     name = "lab-frst"
     summary = "CIELab L*(a+b) map, fast radial symmetry transform, top bright (red) and dark (green) spots"
-    section = "Zheng 2016, 5.2.2; Loy & Zelinsky 2003, section 2"
+    section = "Zheng 2016, 5.2.2; Loy & Zelinsky 2003"
     params = (
         Param("radii", "ints", tuple(range(1, 11)), min=1, max=64,
               help="FRST radii n in pixels", section="Zheng 5.2.2"),
