@@ -29,7 +29,9 @@ once after the maximum of Eq. 3.2 (the root is monotonic, so the arg-max is unch
 from __future__ import annotations
 
 from collections.abc import Sequence
+import math
 from dataclasses import dataclass
+from functools import lru_cache
 
 import cv2
 import numpy as np
@@ -55,37 +57,41 @@ def saturation(image: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(cv2.cvtColor(image, cv2.COLOR_BGR2HSV)[:, :, 1])
 
 
-def half_widths(radius: int) -> np.ndarray:
+@lru_cache(maxsize=None)
+def half_widths(radius: int) -> tuple[int, ...]:
     """Half-width of the digital disk on each row ``dy = 0..radius`` (Eq. 3.4: ``|d| <= r``)."""
-    dy = np.arange(radius + 1)
-    return np.floor(np.sqrt(radius * radius - dy * dy) + 1e-9).astype(int)
+    return tuple(math.isqrt(radius * radius - dy * dy) for dy in range(radius + 1))
 
 
 def disk_size(radius: int) -> int:
     """Number of pixels of the disk A1 (the denominator of Eq. 3.3)."""
     w = half_widths(radius)
-    return int(2 * w[0] + 1 + 2 * np.sum(2 * w[1:] + 1))
+    return 2 * w[0] + 1 + 2 * sum(2 * h + 1 for h in w[1:])
 
 
 def quarter_disk_size(radius: int) -> int:
     """Number of pixels of one quadrant of A1, axes included (Eq. 3.7 denominator)."""
-    return int(np.sum(half_widths(radius) + 1))
+    return sum(h + 1 for h in half_widths(radius))
+
+
+def mirror(channel: np.ndarray, pad: int) -> np.ndarray:
+    """The channel with ``pad`` mirrored pixels on every side (reflect-101)."""
+    return cv2.copyMakeBorder(channel, pad, pad, pad, pad, cv2.BORDER_REFLECT_101)
 
 
 class PrefixSums:
     """Exact integer window sums of one uint8 channel from its row prefix sums.
 
-    The channel is mirrored by ``pad`` pixels; ``prefix[y, c]`` is the sum of the padded row
+    The channel comes mirrored by ``pad`` pixels (:func:`mirror`); ``prefix[y, c]`` is the sum of the padded row
     ``y`` left of padded column ``c``. A horizontal run on row ``i + dy`` from column
     ``j - a`` to ``j + b`` is ``prefix(dy, b + 1) - prefix(dy, -a)``, so any window made of
     row runs is a signed sum of shifted views of this one array (it stays in cache), and a run
     of equal column offsets down consecutive rows is one look-up in the column prefix of it.
     """
 
-    def __init__(self, channel: np.ndarray, pad: int):
+    def __init__(self, padded: np.ndarray, pad: int):
         self.pad = pad
-        self.height, self.width = channel.shape
-        padded = cv2.copyMakeBorder(channel, pad, pad, pad, pad, cv2.BORDER_REFLECT_101)
+        self.height, self.width = padded.shape[0] - 2 * pad, padded.shape[1] - 2 * pad
         self.prefix = np.zeros((padded.shape[0] + 1, padded.shape[1] + 1), np.int32)
         np.cumsum(padded, axis=1, dtype=np.int32, out=self.prefix[1:, 1:])
         self.integral = np.cumsum(self.prefix, axis=0, dtype=np.int32)
@@ -99,15 +105,37 @@ class PrefixSums:
                    columns: Sequence[tuple[int, int, int, int]] = ()) -> np.ndarray:
         """Sum of ``sign * prefix(dy, dc)`` over ``runs`` = (dy, dc, sign) plus, over ``columns``
         = (top, bottom, dc, sign), ``sign`` times the prefix at column offset ``dc`` summed over
-        rows ``top..bottom``."""
-        total = np.zeros((self.height, self.width), np.int32)
-        for dy, dc, sign in runs:
-            (cv2.add if sign > 0 else cv2.subtract)(total, self.view(self.prefix, dy, dc), dst=total)
-        for top, bottom, dc, sign in columns:
-            first, second = (cv2.add, cv2.subtract) if sign > 0 else (cv2.subtract, cv2.add)
-            first(total, self.view(self.integral, bottom, dc), dst=total)
-            second(total, self.view(self.integral, top - 1, dc), dst=total)
+        rows ``top..bottom``. Runs sharing ``dc`` and ``sign`` on consecutive rows are merged
+        into one column look-up (two array operations instead of one per row)."""
+        singles, merged = merge_runs(runs)
+        terms = [(self.view(self.prefix, dy, dc), sign) for dy, dc, sign in singles]
+        for top, bottom, dc, sign in (*merged, *columns):
+            terms += [(self.view(self.integral, bottom, dc), sign),
+                      (self.view(self.integral, top - 1, dc), -sign)]
+        terms.sort(key=lambda term: -term[1])
+        total = terms[0][0].copy()
+        for table, sign in terms[1:]:
+            (cv2.add if sign > 0 else cv2.subtract)(total, table, dst=total)
         return total
+
+
+def merge_runs(runs: Sequence[tuple[int, int, int]]):
+    """Split ``(dy, dc, sign)`` terms into single rows and ``(top, bottom, dc, sign)`` columns
+    covering two or more consecutive rows with the same ``dc`` and ``sign``."""
+    singles, merged = [], []
+    ordered = sorted(runs, key=lambda t: (t[1], t[2], t[0]))
+    start = 0
+    for end in range(1, len(ordered) + 1):
+        if end < len(ordered) and ordered[end][1:] == ordered[end - 1][1:] \
+                and ordered[end][0] == ordered[end - 1][0] + 1:
+            continue
+        group = ordered[start:end]
+        if len(group) == 1:
+            singles.append(group[0])
+        else:
+            merged.append((group[0][0], group[-1][0], group[0][1], group[0][2]))
+        start = end
+    return singles, merged
 
 
 def disk_sum(sums: PrefixSums, radius: int) -> np.ndarray:
@@ -162,12 +190,12 @@ def disk_from_quarters(sums: PrefixSums, radius: int,
 def average(window_sum: np.ndarray, count: int) -> np.ndarray:
     """Mean of a [0, 1] feature over a window of ``count`` pixels from its uint8 sum (Eq. 3.3,
     3.7, 3.8, 3.10, 3.11: sum of flagged values over the number of flagged pixels)."""
-    return window_sum.astype(np.float32) * np.float32(1.0 / (255.0 * count))
+    return np.multiply(window_sum, np.float32(1.0 / (255.0 * count)), dtype=np.float32)
 
 
 def quadrant_contrast(disk_part: np.ndarray, box_part: np.ndarray, n_disk: int,
                       n_box: int) -> np.ndarray:
-    """Eq. 3.6-3.8 as an exact integer: ``n_disk * n_border * 255 * max(0, LD_k - LB_k)``.
+    """Eq. 3.7-3.8 as an exact integer: ``n_disk * n_border * 255 * (LD_k - LB_k)``.
 
     ``LD_k`` averages the ``n_disk`` pixels of A1 in the quadrant (Eq. 3.7), ``LB_k`` the
     ``n_border = n_box - n_disk`` pixels of A2 in it (Eq. 3.8); with the quadrant's A1 sum ``D``
@@ -175,20 +203,21 @@ def quadrant_contrast(disk_part: np.ndarray, box_part: np.ndarray, n_disk: int,
     Keeping the numerator integral keeps a zero contrast exactly zero (the root of Eq. 3.1 would
     magnify rounding noise near zero).
     """
-    numerator = cv2.addWeighted(disk_part, float(n_box), box_part, -float(n_disk), 0.0,
-                                dtype=cv2.CV_32S)
-    return cv2.max(numerator, 0)
+    return cv2.addWeighted(disk_part, float(n_box), box_part, -float(n_disk), 0.0,
+                           dtype=cv2.CV_32S)
 
 
 def lightness_contrast(per_quadrant: Sequence[np.ndarray], n_disk: int, n_box: int,
                        rule: str = "max") -> np.ndarray:
-    """Eq. 3.5: combine the four quadrant contrasts of :func:`quadrant_contrast` (``"max"`` as
-    printed, ``"min"`` for the prose's "all four quadrants") and scale to lightness units."""
+    """Eq. 3.5-3.6: combine the four quadrant differences of :func:`quadrant_contrast`
+    (``"max"`` as printed, ``"min"`` for the prose's "all four quadrants"), round negative
+    differences up to zero and scale to lightness units. Clipping once after the combination
+    equals clipping each quadrant first, since max and min commute with ``max(0, .)``."""
     combine = cv2.max if rule == "max" else cv2.min
     out = combine(per_quadrant[0], per_quadrant[1])
     for contrast in per_quadrant[2:]:
         combine(out, contrast, dst=out)
-    return average(out, n_disk * (n_box - n_disk))
+    return average(cv2.max(out, 0), n_disk * (n_box - n_disk))
 
 
 def annulus_saturation(outer_sum: np.ndarray, inner_sum: np.ndarray, radius: int) -> np.ndarray:
@@ -267,10 +296,27 @@ def conspicuity_map(image: np.ndarray, radii: Sequence[int] = tuple(range(1, 11)
         raise ValueError(f"expected a BGR uint8 image of shape (H, W, 3); got {image.dtype} "
                          f"{image.shape}")
     pad = max(2 * radii[-1], radii[-1] + margin)
-    light = PrefixSums(lightness(image), pad)
-    sat = PrefixSums(saturation(image), pad)
+    light, sat = mirror(lightness(image), pad), mirror(saturation(image), pad)
     best = np.zeros(image.shape[:2], np.float32)
     best_radius = np.full(image.shape[:2], radii[0], np.int32)
+    for top in range(0, image.shape[0], STRIP_ROWS):
+        rows = slice(top, min(top + STRIP_ROWS, image.shape[0]) + 2 * pad)
+        strip = slice(top, top + STRIP_ROWS)
+        best_products(PrefixSums(light[rows], pad), PrefixSums(sat[rows], pad), radii, weights,
+                      margin, quadrant_rule, best[strip], best_radius[strip])
+    return ConspicuityMap(weighted_root(best, weights), best_radius)
+
+
+#: Rows per strip: the working arrays of a strip stay in the CPU cache.
+STRIP_ROWS = 128
+
+
+def best_products(light: PrefixSums, sat: PrefixSums, radii: Sequence[int],
+                  weights: Sequence[float], margin: int, quadrant_rule: str, best: np.ndarray,
+                  best_radius: np.ndarray) -> None:
+    """Eq. 3.1 (under its root) for each radius and Eq. 3.2's running maximum, written into
+    ``best`` (zeros on entry) and ``best_radius``."""
+    sat_disks: dict[int, np.ndarray] = {}
     for r in radii:
         quarters = [quarter_disk_sum(light, r, q) for q in QUADRANTS]
         boxes = [quarter_box_sum(light, r + margin, q) for q in QUADRANTS]
@@ -278,16 +324,17 @@ def conspicuity_map(image: np.ndarray, radii: Sequence[int] = tuple(range(1, 11)
         contrast = lightness_contrast(
             [quadrant_contrast(d, b, n_quarter, n_box) for d, b in zip(quarters, boxes)],
             n_quarter, n_box, quadrant_rule)
-        light_disk = average(disk_from_quarters(light, r, quarters),
-                             disk_size(r))
-        inner = disk_sum(sat, r)
+        light_disk = average(disk_from_quarters(light, r, quarters), disk_size(r))
+        for radius in (r, 2 * r):
+            if radius not in sat_disks:
+                sat_disks[radius] = disk_sum(sat, radius)
+        inner = sat_disks.pop(r)
         sat_best = cv2.max(average(inner, disk_size(r)),
-                           annulus_saturation(disk_sum(sat, 2 * r), inner, r))
+                           annulus_saturation(sat_disks[2 * r], inner, r))
         product = weighted_product((light_disk, contrast, sat_best), weights)
-        better = product > best
-        np.copyto(best, product, where=better)
-        best_radius[better] = r
-    return ConspicuityMap(weighted_root(best, weights), best_radius)
+        better = np.greater(product, best)
+        np.maximum(best, product, out=best)
+        np.copyto(best_radius, np.int32(r), where=better)
 
 
 class Conspicuity(Detector):
