@@ -35,11 +35,13 @@ def test_hand_built_report_numbers(tmp_path):
     assert report["frames"] == 6 and report["skipped"] == []
     for name in ("report.json", "summary.md", "detections.jsonl", "detections.coco.json",
                  "ground_truth.coco.json", "plots/recall_fpr_bubbles.png",
-                 "plots/categories.png", "plots/pr_curve.png"):
+                 "plots/categories.png", "plots/pr_curve.png", "plots/confusion.png"):
         assert (tmp_path / name).is_file(), name
     lines = (tmp_path / "detections.jsonl").read_text().splitlines()
     assert len(lines) == 6 and json.loads(lines[1])["detections"][1]["x"] == 35
-    assert "| lighting - max radius |" in (tmp_path / "summary.md").read_text()
+    summary = (tmp_path / "summary.md").read_text()
+    assert "| lighting - max radius |" in summary
+    assert "| green | 3 | 0 | 0 | 0 | 0 |" in summary  # 3 green boxes called red
     assert json.loads((tmp_path / "report.json").read_text())["frames"] == 6
 
 
@@ -90,6 +92,7 @@ def test_classifier_alone_on_crops():
     assert report["state"]["accuracy"] == 0.5
     assert report["state"]["red_yellow_errors"]["yellow_as_red"] == 1
     assert report["detector"] is None and report["classifier"]["name"] == "always-red"
+    assert report["per_frame"]["note"].startswith("classifier alone")
 
 
 def test_cache_is_keyed_by_plugin_parameters(tmp_path):

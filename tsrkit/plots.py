@@ -83,10 +83,34 @@ def pr_curve(curve: dict | None, ap: float | None, path: Path) -> str:
     return _save(fig, path)
 
 
+def confusion_plot(state: dict, path: Path) -> str:
+    """The state confusion matrix (rows: ground truth, columns: predicted), counts annotated."""
+    labels, matrix = state["confusion"]["labels"], state["confusion"]["matrix"]
+    fig, ax = plt.subplots(figsize=(4.5, 4))
+    ax.imshow(matrix, cmap="Blues")
+    for i, row in enumerate(matrix):
+        for j, count in enumerate(row):
+            ax.text(j, i, str(count), ha="center", va="center", fontsize=8)
+    ax.set_xticks(range(len(labels)), labels, rotation=45, ha="right")
+    ax.set_yticks(range(len(labels)), labels)
+    ax.set_xlabel("predicted")
+    ax.set_ylabel("ground truth")
+    fig.tight_layout()
+    return _save(fig, path)
+
+
 def write_plots(folder: Path, report: dict, curve: dict | None) -> list[str]:
-    """Write the three plots into ``folder``; return their paths relative to the report."""
+    """Write the plots that apply into ``folder``; return their paths relative to the report.
+
+    Detection runs get the bubble plot, the category bars and the PR curve; runs with
+    predicted states get the confusion matrix.
+    """
     folder.mkdir(parents=True, exist_ok=True)
-    names = [bubble_plot(report["categories"], folder / "recall_fpr_bubbles.png"),
-             category_bars(report["categories"], folder / "categories.png"),
-             pr_curve(curve, report["iou50"]["ap"], folder / "pr_curve.png")]
+    names = []
+    if "ap" in report["iou50"]:
+        names += [bubble_plot(report["categories"], folder / "recall_fpr_bubbles.png"),
+                  category_bars(report["categories"], folder / "categories.png"),
+                  pr_curve(curve, report["iou50"]["ap"], folder / "pr_curve.png")]
+    if report["state"]["pairs"] and "note" not in report["state"]:
+        names.append(confusion_plot(report["state"], folder / "confusion.png"))
     return [f"{folder.name}/{name}" for name in names]

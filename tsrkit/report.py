@@ -121,11 +121,15 @@ def summary_markdown(report: dict) -> str:
              markdown_table(["figure", "value", "95 % interval"],
                             [[label, value, _interval(report, label)]
                              for label, value in headline(report).items()]), "",
+             pf.get("note") or
              f"Frames without ground truth: {pf['frames_without_gt']} "
              f"({pf['false_positives_without_gt']} false positives on "
-             f"{pf['frames_without_gt_with_detections']} of them).", "",
-             "## Frame counts by lighting and max target radius (Zheng Table 5-2 layout)", "",
-             category_markdown(report["categories"]), ""]
+             f"{pf['frames_without_gt_with_detections']} of them).", ""]
+    if report["categories"]:
+        lines += ["## Frame counts by lighting and max target radius (Zheng Table 5-2 layout)",
+                  "", category_markdown(report["categories"]), ""]
+    if report["state"]["pairs"] and "note" not in report["state"]:
+        lines += ["## States of matched detections", "", state_markdown(report["state"]), ""]
     if report["skipped"]:
         lines += ["## Skipped", ""] + [f"- `{s['source']}`: {s['reason']}"
                                        for s in report["skipped"]] + [""]
@@ -153,6 +157,22 @@ def category_markdown(rows: list[dict]) -> str:
                     + [str(r["precision_counts"].get(c, "")) for c in precision_cols]
                     + [str(r["frames"])])
     return markdown_table(header, body) if rows else "(no frame with ground truth)"
+
+
+def state_markdown(state: dict) -> str:
+    """Confusion matrix (rows truth, columns predicted), per-class figures and R-Y errors."""
+    labels, matrix = state["confusion"]["labels"], state["confusion"]["matrix"]
+    confusion = markdown_table(["truth \\ predicted"] + labels,
+                               [[label] + [str(v) for v in row]
+                                for label, row in zip(labels, matrix)])
+    classes = markdown_table(["state", "precision", "recall", "support"],
+                             [[name, fmt(c["precision"]), fmt(c["recall"]), str(c["support"])]
+                              for name, c in state["per_class"].items()])
+    ry = state["red_yellow_errors"]
+    ratio = state["discriminative_ratio"]["mean"]
+    return (f"{confusion}\n\n{classes}\n\nR-Y errors (Mascetti 5.1): {ry['total']} "
+            f"({ry['red_as_yellow']} red as yellow, {ry['yellow_as_red']} yellow as red); "
+            f"mean discriminative ratio (Zheng 5.3): {fmt(ratio)}.")
 
 
 def markdown_table(header: list[str], rows: list[list[str]]) -> str:

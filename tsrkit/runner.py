@@ -30,6 +30,11 @@ from tsrkit.registry import PluginNotFound, get_registry
 from tsrkit.types import Candidate, Dataset, Sample
 
 ENGINES = ("local", "dask")
+_NOT_DETECTION = {"note": "classifier alone on the ground-truth boxes: detection metrics do not "
+                          "apply"}
+#: What replaces the detection sections of a classifier-only (crop) report.
+CLASSIFICATION_ONLY = {"per_frame": _NOT_DETECTION, "iou50": _NOT_DETECTION,
+                       "iou": _NOT_DETECTION, "categories": [], "intervals": {}}
 
 
 class BenchmarkError(TsrkitError):
@@ -244,6 +249,8 @@ def evaluate(dataset: Dataset, detector: Detector | None, classifier: Classifier
     report = base_report(dataset, plugin_identity(detector), plugin_identity(classifier))
     metrics = evaluation.metrics()
     median = metrics.pop("ms_per_frame_median")
+    if detector is None:
+        metrics.update(CLASSIFICATION_ONLY)
     report.update(metrics)
     report["timing"] = {"ms_per_frame_median": median,
                         "frames_per_second": metrics["frames"] / wall if wall > 0 else None,
