@@ -66,7 +66,8 @@ def log_polar(gray: np.ndarray, n_rho: int, n_theta: int) -> np.ndarray:
                          cv2.INTER_LINEAR | cv2.WARP_POLAR_LOG)
 
 
-def sign_vector(image: np.ndarray, bbox: Sequence[float], settings: Mapping[str, Any]) -> np.ndarray:
+def sign_vector(image: np.ndarray, bbox: Sequence[float],
+                settings: Mapping[str, Any]) -> np.ndarray:
     """The feature vector of one box: ``n_rho * n_theta`` log-polar samples, or the raw crop."""
     gray = normalise_intensity(crop_gray(image, bbox, settings["crop_size"]))
     if settings["transform"] == "log-polar":

@@ -92,7 +92,10 @@ def window_pixels(planes: ColourPlanes, window: Window):
 
 
 def kernel_histogram(bins: np.ndarray, weights: np.ndarray, n_bins: int) -> np.ndarray:
-    """Lee Eq. 3.2: ``t_b = C sum_i K(||p_i||^2) H(p_i, b)``, normalised to sum 1 (zeros if empty)."""
+    """Lee Eq. 3.2: ``t_b = C sum_i K(||p_i||^2) H(p_i, b)``, C making it sum to 1.
+
+    An empty window (no weight) gives all zeros.
+    """
     hist = np.bincount(bins, weights=weights, minlength=n_bins)
     total = hist.sum()
     return hist / total if total > 0 else hist
