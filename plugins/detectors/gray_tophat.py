@@ -14,7 +14,8 @@ from tsrkit.hookspecs import hookimpl
 from tsrkit.params import Param
 from tsrkit.plugin import Detector
 from tsrkit.types import Candidate, Frame
-from tsrkit_plugins.detectors.localization import LOCALIZATION_PARAMS, localize, region_of_interest
+from tsrkit_plugins.detectors.localization import (LOCALIZATION_PARAMS, ROI_PARAM, localize,
+                                                     region_of_interest)
 
 
 def white_tophat(image: np.ndarray, se_size: int) -> np.ndarray:
@@ -36,8 +37,7 @@ class GrayTophat(Detector):
     params = (
         Param("se_size", "int", 21, min=3, max=201, section="5.2.2 (size not given; ours)",
               help="structuring-element diameter in pixels; wider than the largest lens"),
-        Param("roi_top", "float", 1.0, min=0.01, max=1.0, section="5.2.1",
-              help="search only the upper fraction of the frame (the thesis used 0.6)"),
+        ROI_PARAM,
     ) + LOCALIZATION_PARAMS
 
     def detect(self, frame: Frame) -> list[Candidate]:

@@ -45,6 +45,10 @@ LOCALIZATION_PARAMS = (
           help="limit on localization iterations"),
 )
 
+#: The optional region of interest both detectors expose.
+ROI_PARAM = Param("roi_top", "float", 1.0, min=0.01, max=1.0, section="5.2.1",
+                  help="search only the upper fraction of the frame (the thesis used 0.6)")
+
 #: Structuring element of Eq. 3.15: the disk of radius 1.
 DISK_1 = cv2.getStructuringElement(cv2.MORPH_CROSS, (3, 3))
 
