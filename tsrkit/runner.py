@@ -8,6 +8,7 @@ and parameters, so a killed run resumes where it stopped.
 from __future__ import annotations
 
 import hashlib
+import inspect
 import json
 import multiprocessing
 import os
@@ -52,7 +53,7 @@ class Job:
 
 
 def plugin_identity(plugin: Plugin | None) -> dict[str, Any] | None:
-    """Name, version and parameters of a plugin, as the report and the cache key record them."""
+    """Name, version, parameters and source hash of a plugin (report and cache key)."""
     if plugin is None:
         return None
     try:
@@ -60,7 +61,21 @@ def plugin_identity(plugin: Plugin | None) -> dict[str, Any] | None:
     except PluginNotFound:
         version = plugin.version or "0"
     params = json.loads(json.dumps(plugin.params, default=str, sort_keys=True))
-    return {"name": plugin.name, "version": version, "params": params}
+    return {"name": plugin.name, "version": version, "params": params,
+            "source_sha256": source_hash(type(plugin))}
+
+
+def source_hash(cls: type) -> str | None:
+    """SHA-256 of the file defining ``cls``, so editing a plugin without a version bump does
+    not reuse stale cached frames (helpers in other files are not covered)."""
+    try:
+        path = inspect.getsourcefile(cls)
+    except TypeError:
+        return None
+    if path is None or not os.path.isfile(path):
+        return None
+    with open(path, "rb") as fh:
+        return hashlib.sha256(fh.read()).hexdigest()
 
 
 def image_hash(sample: Sample) -> str:
