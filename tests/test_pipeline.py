@@ -69,3 +69,10 @@ def test_tracker_pauses_detection_and_resets_per_video():
     assert detector.calls == 1
     pipeline.process(frame("b.mp4", 0))
     assert detector.calls == 2  # a new video resets the tracker
+
+
+def test_classifier_sees_tracked_objects_and_keeps_their_identity():
+    pipeline = tsrkit.Pipeline(Fixed(), Greenify(), Sticky())
+    pipeline.process(frame("a.mp4", 0))
+    (tracked,) = pipeline.process(frame("a.mp4", 1)).detections
+    assert (tracked.state, tracked.origin, tracked.track_id) == ("green", "tracked", 1)

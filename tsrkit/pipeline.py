@@ -1,11 +1,11 @@
-"""Detector -> classifier -> tracker on one frame, timed.
+"""Detector -> tracker -> classifier on one frame, timed.
 
 ``FrameResult.ms`` is the compute time of the plugins on that frame (decoding and I/O excluded).
 """
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 from tsrkit.plugin import Classifier, Detector, Tracker
@@ -45,19 +45,23 @@ class Pipeline:
     _video: str | None = None
 
     def process(self, frame: Frame) -> FrameResult:
-        """Run the plugins on ``frame``; exceptions from a plugin propagate to the caller."""
+        """Detect, track, then classify ``frame``; exceptions from a plugin propagate.
+
+        The tracker sees the detector's candidates; the classifier then sees every reported
+        object, tracked ones included, and its states replace the detector's own.
+        """
         start = time.perf_counter()
         if self.tracker is not None and frame.source != self._video:
             self.tracker.reset()
             self._video = frame.source
         detect = self.tracker is None or self.tracker.needs_detection()
-        candidates = self.detector.detect(frame) if detect else []
-        if self.classifier is not None:
-            detections = self.classifier.classify(frame, candidates)
-        else:
-            detections = as_detections(candidates)
+        detections = as_detections(self.detector.detect(frame) if detect else [])
         if self.tracker is not None:
             detections = self.tracker.update(frame, detections)
+        if self.classifier is not None:
+            states = self.classifier.classify(frame, [d.candidate for d in detections])
+            detections = [replace(s, origin=d.origin, track_id=d.track_id)
+                          for s, d in zip(states, detections)]
         ms = (time.perf_counter() - start) * 1000.0
         return FrameResult(frame.source, frame.index, frame.width, frame.height, ms,
                            tuple(detections))
