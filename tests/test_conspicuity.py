@@ -38,6 +38,7 @@ def assert_matches_oracle(image, **settings):
     (1, {"quadrant_rule": "min"}),
     (2, {"margin": 2, "weights": (1.0, 2.0, 0.5)}),
     (3, {"radii": (2, 3, 5), "weights": (2.0, 1.0, 4.0)}),
+    (4, {"radii": (3, 12), "margin": 6}),
 ])
 def test_fast_map_matches_oracle_on_random_images(seed, settings):
     assert_matches_oracle(random_image(seed), **settings)

@@ -297,6 +297,8 @@ def conspicuity_map(image: np.ndarray, radii: Sequence[int] = tuple(range(1, 11)
         raise ValueError(f"expected a BGR uint8 image of shape (H, W, 3); got {image.dtype} "
                          f"{image.shape}")
     pad = max(2 * radii[-1], radii[-1] + margin)
+    if (STRIP_ROWS + 2 * pad + 1) * (image.shape[1] + 2 * pad + 1) * 255 >= 2 ** 31:
+        raise ValueError(f"image width {image.shape[1]} too large for 32-bit window sums")
     light, sat = mirror(lightness(image), pad), mirror(saturation(image), pad)
     best = np.zeros(image.shape[:2], np.float32)
     best_radius = np.full(image.shape[:2], radii[0], np.int32)
@@ -308,8 +310,9 @@ def conspicuity_map(image: np.ndarray, radii: Sequence[int] = tuple(range(1, 11)
     return ConspicuityMap(weighted_root(best, weights), best_radius)
 
 
-#: Rows per strip: the working arrays of a strip stay in the CPU cache.
-STRIP_ROWS = 128
+#: Rows per strip: the working arrays of a strip stay in the CPU cache, and a strip's column
+#: prefix sums stay below 2**31 (int32) for frames up to about 80,000 pixels wide.
+STRIP_ROWS = 64
 
 
 def best_products(light: PrefixSums, sat: PrefixSums, radii: Sequence[int],
