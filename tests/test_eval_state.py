@@ -21,9 +21,15 @@ def test_confusion_accuracy_and_red_yellow_errors():
     assert "off" not in m["per_class"]
 
 
-def test_unknown_state_and_length_mismatch_are_rejected():
-    with pytest.raises(ValueError, match="unknown states"):
-        state_metrics(["red"], ["purple"])
+def test_sign_classes_get_their_own_labels_and_no_red_yellow_figure():
+    m = state_metrics(["stop", "yield", "stop"], ["stop", "stop", "unknown"])
+    assert m["confusion"]["labels"] == ["stop", "unknown", "yield"]
+    assert m["confusion"]["matrix"] == [[1, 1, 0], [0, 0, 0], [1, 0, 0]]
+    assert m["accuracy"] == pytest.approx(1 / 3)
+    assert m["red_yellow_errors"] == {}
+
+
+def test_length_mismatch_is_rejected():
     with pytest.raises(ValueError, match="2 true states but 1"):
         state_metrics(["red", "red"], ["red"])
 

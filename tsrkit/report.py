@@ -169,10 +169,11 @@ def state_markdown(state: dict) -> str:
                              [[name, fmt(c["precision"]), fmt(c["recall"]), str(c["support"])]
                               for name, c in state["per_class"].items()])
     ry = state["red_yellow_errors"]
-    ratio = state["discriminative_ratio"]["mean"]
+    ratio = f"mean discriminative ratio (Zheng 5.3): {fmt(state['discriminative_ratio']['mean'])}."
+    if not ry:  # sign classes: no red/yellow pair
+        return f"{confusion}\n\n{classes}\n\n{ratio[0].upper()}{ratio[1:]}"
     return (f"{confusion}\n\n{classes}\n\nR-Y errors (Mascetti 5.1): {ry['total']} "
-            f"({ry['red_as_yellow']} red as yellow, {ry['yellow_as_red']} yellow as red); "
-            f"mean discriminative ratio (Zheng 5.3): {fmt(ratio)}.")
+            f"({ry['red_as_yellow']} red as yellow, {ry['yellow_as_red']} yellow as red); {ratio}")
 
 
 def markdown_table(header: list[str], rows: list[list[str]]) -> str:

@@ -38,16 +38,14 @@ def state_metrics(truth: Sequence[str], predicted: Sequence[str],
     Parameters
     ----------
     truth, predicted : sequences of str
-        States of matched pairs, each one of :data:`tsrkit.types.STATES`.
+        Labels of matched pairs: signal states (:data:`tsrkit.types.STATES`, kept in that
+        order) or any other class names, e.g. sign classes (sorted).
     scores : sequence of mappings, optional
         The predictions' ``state_scores`` for the discriminative-ratio figures.
     """
     if len(truth) != len(predicted):
         raise ValueError(f"{len(truth)} true states but {len(predicted)} predictions")
-    unknown = sorted((set(truth) | set(predicted)) - set(STATES))
-    if unknown:
-        raise ValueError(f"unknown states {unknown}; expected one of {STATES}")
-    labels = list(STATES)
+    labels = label_order(set(truth) | set(predicted))
     matrix = (confusion_matrix(truth, predicted, labels=labels) if len(truth)
               else np.zeros((len(labels), len(labels)), dtype=int))
     return {
@@ -58,6 +56,19 @@ def state_metrics(truth: Sequence[str], predicted: Sequence[str],
         "red_yellow_errors": red_yellow_errors(matrix, labels),
         "discriminative_ratio": ratio_figures(truth, predicted, scores or []),
     }
+
+
+def label_order(seen: set[str]) -> list[str]:
+    """The confusion-matrix labels: all signal states when only those occur, else sorted.
+
+    Examples
+    --------
+    >>> label_order({"green", "red"})
+    ['red', 'yellow', 'green', 'off', 'unknown']
+    >>> label_order({"stop", "yield", "unknown"})
+    ['stop', 'unknown', 'yield']
+    """
+    return list(STATES) if seen <= set(STATES) else sorted(seen)
 
 
 def per_class(matrix: np.ndarray, labels: Sequence[str]) -> dict[str, dict]:
@@ -74,7 +85,12 @@ def per_class(matrix: np.ndarray, labels: Sequence[str]) -> dict[str, dict]:
 
 
 def red_yellow_errors(matrix: np.ndarray, labels: Sequence[str]) -> dict[str, int]:
-    """Mascetti 5.1's R-Y errors: red predicted as yellow, yellow as red, and their sum."""
+    """Mascetti 5.1's R-Y errors: red predicted as yellow, yellow as red, and their sum.
+
+    Empty for label sets without both red and yellow (sign classes).
+    """
+    if "red" not in labels or "yellow" not in labels:
+        return {}
     r, y = labels.index("red"), labels.index("yellow")
     red_as_yellow, yellow_as_red = int(matrix[r, y]), int(matrix[y, r])
     return {"red_as_yellow": red_as_yellow, "yellow_as_red": yellow_as_red,
