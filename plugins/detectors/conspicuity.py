@@ -102,28 +102,29 @@ class PrefixSums:
         y, x = self.pad + 1 + dy, self.pad + dc
         return table[y:y + self.height, x:x + self.width]
 
-    def signed_sum(self, runs: Sequence[tuple[int, int, int]],
-                   columns: Sequence[tuple[int, int, int, int]] = ()) -> np.ndarray:
-        """Sum of ``sign * prefix(dy, dc)`` over ``runs`` = (dy, dc, sign) plus, over ``columns``
-        = (top, bottom, dc, sign), ``sign`` times the prefix at column offset ``dc`` summed over
-        rows ``top..bottom``. Runs sharing ``dc`` and ``sign`` on consecutive rows are merged
-        into one column look-up (two array operations instead of one per row)."""
-        singles, merged = merge_runs(runs)
-        terms = [(self.view(self.prefix, dy, dc), sign) for dy, dc, sign in singles]
-        for top, bottom, dc, sign in (*merged, *columns):
-            terms += [(self.view(self.integral, bottom, dc), sign),
-                      (self.view(self.integral, top - 1, dc), -sign)]
-        terms.sort(key=lambda term: -term[1])
-        total = terms[0][0].copy()
-        for table, sign in terms[1:]:
-            (cv2.add if sign > 0 else cv2.subtract)(total, table, dst=total)
+    def signed_sum(self, plan: Sequence[tuple[bool, int, int, int]]) -> np.ndarray:
+        """Execute a plan from :func:`compile_terms`: the signed sum of shifted table views."""
+        tables = (self.prefix, self.integral)
+        on_integral, dy, dc, _ = plan[0]
+        total = self.view(tables[on_integral], dy, dc).copy()
+        for on_integral, dy, dc, sign in plan[1:]:
+            (cv2.add if sign > 0 else cv2.subtract)(
+                total, self.view(tables[on_integral], dy, dc), dst=total)
         return total
 
 
-def merge_runs(runs: Sequence[tuple[int, int, int]]):
-    """Split ``(dy, dc, sign)`` terms into single rows and ``(top, bottom, dc, sign)`` columns
-    covering two or more consecutive rows with the same ``dc`` and ``sign``."""
-    singles, merged = [], []
+def compile_terms(runs: Sequence[tuple[int, int, int]],
+                  columns: Sequence[tuple[int, int, int, int]] = ()):
+    """Plan a window sum: ``sign * prefix(dy, dc)`` over ``runs`` = (dy, dc, sign) plus, over
+    ``columns`` = (top, bottom, dc, sign), ``sign`` times the prefix at column offset ``dc``
+    summed over rows ``top..bottom``.
+
+    Runs sharing ``dc`` and ``sign`` on consecutive rows are merged into one column look-up
+    (two array operations instead of one per row). Returns ``(on_integral, dy, dc, sign)``
+    terms, positive ones first.
+    """
+    merged = list(columns)
+    terms = []
     ordered = sorted(runs, key=lambda t: (t[1], t[2], t[0]))
     start = 0
     for end in range(1, len(ordered) + 1):
@@ -132,25 +133,29 @@ def merge_runs(runs: Sequence[tuple[int, int, int]]):
             continue
         group = ordered[start:end]
         if len(group) == 1:
-            singles.append(group[0])
+            terms.append((False, *group[0]))
         else:
             merged.append((group[0][0], group[-1][0], group[0][1], group[0][2]))
         start = end
-    return singles, merged
+    for top, bottom, dc, sign in merged:
+        terms += [(True, bottom, dc, sign), (True, top - 1, dc, -sign)]
+    return tuple(sorted(terms, key=lambda term: -term[3]))
 
 
-def disk_sum(sums: PrefixSums, radius: int) -> np.ndarray:
-    """Window sum over the disk ``|d| <= radius`` (numerator of Eq. 3.3 and Eq. 3.10)."""
+@lru_cache(maxsize=None)
+def disk_plan(radius: int):
+    """Plan of the disk ``|d| <= radius`` (numerator of Eq. 3.3 and Eq. 3.10)."""
     w = half_widths(radius)
     runs = []
     for dy in range(-radius, radius + 1):
         half = w[abs(dy)]
         runs += [(dy, half + 1, 1), (dy, -half, -1)]
-    return sums.signed_sum(runs)
+    return compile_terms(runs)
 
 
-def quarter_disk_sum(sums: PrefixSums, radius: int, quadrant: tuple[int, int]) -> np.ndarray:
-    """Window sum over quadrant ``k`` of A1, axes included (numerator of Eq. 3.7).
+@lru_cache(maxsize=None)
+def quarter_plan(radius: int, quadrant: tuple[int, int]):
+    """Plan of quadrant ``k`` of A1, axes included (numerator of Eq. 3.7).
 
     Every row run of the quarter starts (or ends) on the centre column, so that edge is one
     column look-up; the other edge follows the disk's staircase.
@@ -160,29 +165,52 @@ def quarter_disk_sum(sums: PrefixSums, radius: int, quadrant: tuple[int, int]) -
     rows = (-radius, 0) if vertical < 0 else (0, radius)
     if horizontal > 0:
         runs = [(vertical * dy, w[dy] + 1, 1) for dy in range(radius + 1)]
-        return sums.signed_sum(runs, [(rows[0], rows[1], 0, -1)])
+        return compile_terms(runs, [(rows[0], rows[1], 0, -1)])
     runs = [(vertical * dy, -w[dy], -1) for dy in range(radius + 1)]
-    return sums.signed_sum(runs, [(rows[0], rows[1], 1, 1)])
+    return compile_terms(runs, [(rows[0], rows[1], 1, 1)])
+
+
+@lru_cache(maxsize=None)
+def box_plan(half_side: int, quadrant: tuple[int, int]):
+    """Plan of quadrant ``k`` of the bounding box of side ``half_side + 1`` (A1 + A2)."""
+    vertical, horizontal = quadrant
+    top, bottom = (-half_side, 0) if vertical < 0 else (0, half_side)
+    left, right = (-half_side, 0) if horizontal < 0 else (0, half_side)
+    return compile_terms((), [(top, bottom, right + 1, 1), (top, bottom, left, -1)])
+
+
+@lru_cache(maxsize=None)
+def axes_plan(radius: int):
+    """Plan of minus the centre column ``|dy| <= radius`` and the two centre-row runs
+    ``0 <= +-dx <= radius`` (the parts the four quarters share)."""
+    return compile_terms([(0, radius + 1, -1), (0, 0, 1), (0, 1, -1), (0, -radius, 1)],
+                         [(-radius, radius, 1, -1), (-radius, radius, 0, 1)])
+
+
+def disk_sum(sums: PrefixSums, radius: int) -> np.ndarray:
+    """Window sum over the disk ``|d| <= radius`` (numerator of Eq. 3.3 and Eq. 3.10)."""
+    return sums.signed_sum(disk_plan(radius))
+
+
+def quarter_disk_sum(sums: PrefixSums, radius: int, quadrant: tuple[int, int]) -> np.ndarray:
+    """Window sum over quadrant ``k`` of A1, axes included (numerator of Eq. 3.7)."""
+    return sums.signed_sum(quarter_plan(radius, quadrant))
 
 
 def quarter_box_sum(sums: PrefixSums, half_side: int, quadrant: tuple[int, int]) -> np.ndarray:
     """Window sum over quadrant ``k`` of the bounding box of side ``half_side + 1`` (A1 + A2)."""
-    vertical, horizontal = quadrant
-    top, bottom = (-half_side, 0) if vertical < 0 else (0, half_side)
-    left, right = (-half_side, 0) if horizontal < 0 else (0, half_side)
-    return sums.signed_sum((), [(top, bottom, right + 1, 1), (top, bottom, left, -1)])
+    return sums.signed_sum(box_plan(half_side, quadrant))
 
 
 def disk_from_quarters(sums: PrefixSums, radius: int,
                        quarters: Sequence[np.ndarray]) -> np.ndarray:
     """The disk sum rebuilt from its four overlapping quarters (same value as :func:`disk_sum`).
 
-    The quarters share the centre row and column: ``disk = sum(quarters) - column - row``
-    where the column is ``|dy| <= radius, dx = 0`` and the row ``dy = 0, |dx| <= radius`` with
-    the centre counted twice.
+    The quarters share the centre row and column: ``disk = sum(quarters) - column - row_left
+    - row_right`` where the column is ``|dy| <= radius, dx = 0`` and each row run
+    ``dy = 0, 0 <= +-dx <= radius`` includes the centre.
     """
-    total = sums.signed_sum([(0, radius + 1, -1), (0, 0, 1), (0, 1, -1), (0, -radius, 1)],
-                            [(-radius, radius, 1, -1), (-radius, radius, 0, 1)])
+    total = sums.signed_sum(axes_plan(radius))
     for quarter in quarters:
         cv2.add(total, quarter, dst=total)
     return total
