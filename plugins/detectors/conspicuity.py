@@ -21,15 +21,18 @@ Reading choices (the thesis leaves them open or prints them ambiguously):
 * A2 is the bounding box of A1 widened by the margin ``m`` (half-side ``r + m``); quadrant ``k``
   is the quarter of that box on one side of the centre's row and column, both included.
 
-Speed: all window sums are exact integer sums of shifted views of one row-prefix array per
-channel (a disk of radius r costs 4r + 2 array additions, a quarter disk r + 3, a quarter box 4),
-the full lightness disk is assembled from its four quarters, and the root of Eq. 3.1 is taken
-once after the maximum of Eq. 3.2 (the root is monotonic, so the arg-max is unchanged).
+Speed: every window sum is an exact integer sum of shifted views of one row-prefix array per
+channel (rows of equal half-width merged into one look-up in its column prefix; the plan of
+each window is computed once per radius), the full lightness disk is assembled from its four
+quarters, saturation disks are shared between radii, the frame is processed in strips that stay
+in cache, and the root of Eq. 3.1 is taken once after the maximum of Eq. 3.2 (the root is
+monotonic, so the arg-max is unchanged). ``tests/oracles/conspicuity_oracle.py`` is the direct
+reference these are tested against.
 """
 from __future__ import annotations
 
-from collections.abc import Sequence
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -83,11 +86,11 @@ def mirror(channel: np.ndarray, pad: int) -> np.ndarray:
 class PrefixSums:
     """Exact integer window sums of one uint8 channel from its row prefix sums.
 
-    The channel comes mirrored by ``pad`` pixels (:func:`mirror`); ``prefix[y, c]`` is the sum of the padded row
-    ``y`` left of padded column ``c``. A horizontal run on row ``i + dy`` from column
-    ``j - a`` to ``j + b`` is ``prefix(dy, b + 1) - prefix(dy, -a)``, so any window made of
-    row runs is a signed sum of shifted views of this one array (it stays in cache), and a run
-    of equal column offsets down consecutive rows is one look-up in the column prefix of it.
+    The channel comes mirrored by ``pad`` pixels (:func:`mirror`); ``prefix[y, c]`` is the sum
+    of the padded row ``y`` left of padded column ``c``. A horizontal run on row ``i + dy`` from
+    column ``j - a`` to ``j + b`` is ``prefix(dy, b + 1) - prefix(dy, -a)``, so any window made
+    of row runs is a signed sum of shifted views of this one array, and a run of equal column
+    offsets down consecutive rows is one look-up in its column prefix (``integral``).
     """
 
     def __init__(self, padded: np.ndarray, pad: int):
