@@ -52,3 +52,39 @@ def test_load_filter_hides_it(installed):
     env = dict(installed, TSRKIT_LOAD_PLUGINS="format-*")
     done = tsrkit(env, "plugins", "--json")
     assert all(p["name"] != "brightest-blobs" for p in json.loads(done.stdout))
+
+
+def coco_ap50(folder: Path) -> float:
+    """AP at IoU 0.5 computed by pycocotools directly from the files a benchmark wrote."""
+    from pycocotools.coco import COCO
+    from pycocotools.cocoeval import COCOeval
+
+    truth = COCO(str(folder / "ground_truth.coco.json"))
+    found = json.loads((folder / "detections.coco.json").read_text())
+    evaluation = COCOeval(truth, truth.loadRes(found), "bbox")
+    evaluation.params.iouThrs = np.array([0.5])
+    evaluation.evaluate()
+    evaluation.accumulate()
+    evaluation.summarize()
+    return float(evaluation.stats[0])
+
+
+@pytest.mark.parametrize("dataset", ["roboflow_traffic_light_kr", "sample", "coco-file"])
+def test_installed_plugin_benchmarks_real_coco_and_sample(installed, tmp_path, dataset,
+                                                          shared_datasets):
+    if dataset == "coco-file":  # a COCO path: the bundled sample's coco.json
+        from tsrkit.datasets.synth import sample_path
+
+        dataset = str(sample_path().parent / "coco.json")
+    out = tmp_path / "bench"
+    done = tsrkit(installed, "benchmark", "--dataset", dataset, "--detector", "brightest-blobs",
+                  "--workers", "1", "--quiet", "--out", str(out))
+    assert done.returncode == 0, done.stderr
+    for name in ("report.json", "summary.md", "detections.jsonl", "detections.coco.json",
+                 "ground_truth.coco.json", "plots/recall_fpr_bubbles.png"):
+        assert (out / name).is_file(), name
+    report = json.loads((out / "report.json").read_text())
+    assert report["detector"]["name"] == "brightest-blobs"
+    assert report["frames"] > 0 and report["per_frame"]["frames_with_gt"] > 0
+    assert 0 <= report["per_frame"]["recall_mean"] <= 1
+    assert abs(report["iou50"]["ap"] - coco_ap50(out)) <= 1e-6
