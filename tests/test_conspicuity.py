@@ -9,6 +9,7 @@ import pytest
 import tsrkit
 from tsrkit.types import Frame
 from tsrkit_plugins.detectors import conspicuity as cs
+from tsrkit_plugins.detectors import conspicuity_kernel as ck
 from oracles.conspicuity_oracle import conspicuity_reference
 
 
@@ -54,20 +55,43 @@ def test_fast_map_matches_oracle_on_a_real_frame(shared_datasets):
     assert_matches_oracle(np.ascontiguousarray(image[y0:y0 + 60, x0:x0 + 70]))
 
 
+def window_sums(channel, pad, windows, row, prefix=ck.LIGHT_PREFIX):
+    """Kernel sums of several planned windows on one row of a channel mirrored by ``pad``."""
+    padded = cs.mirror(channel, pad)
+    tables = ck.prefix_tables(padded, padded)
+    out = np.zeros((len(windows), channel.shape[1]), np.int32)
+    for window, plan in zip(out, windows):
+        terms = np.array(cs.kernel_terms(plan, prefix), np.int32)
+        ck.window_sum(tables, terms, 0, len(terms), pad + 1 + row, pad, channel.shape[1], window)
+    return out
+
+
 def test_window_sums_are_exact_integer_sums():
-    image = random_image(4)
-    light = cs.lightness(image)
-    padded = cs.mirror(light, 20)
-    sums = cs.PrefixSums(padded, 20)
-    padded = padded.astype(np.int64)
+    light = cs.lightness(random_image(4))
+    padded = cs.mirror(light, 20).astype(np.int64)
     for r in (1, 4, 10):
-        quarters = [cs.quarter_disk_sum(sums, r, q) for q in cs.QUADRANTS]
-        direct = cs.disk_sum(sums, r)
-        assert np.array_equal(cs.disk_from_quarters(sums, r, quarters), direct)
-        assert int(direct[7, 9]) == int(np.sum(padded[27 - r:28 + r, 29 - r:30 + r]
-                                              * (np.hypot(*np.mgrid[-r:r + 1, -r:r + 1]) <= r)))
-        assert int(cs.quarter_box_sum(sums, r, (1, 1))[5, 6]) == int(
-            padded[25:26 + r, 26:27 + r].sum())
+        windows = [cs.quarter_plan(r, q) for q in cs.QUADRANTS] + [
+            cs.box_plan(r, (1, 1)), cs.box_plan(r, (1, 1)), cs.box_plan(r, (1, 1)),
+            cs.box_plan(r, (1, 1)), cs.axes_plan(r), cs.disk_plan(r)]
+        sums = window_sums(light, 20, windows, 7)
+        rebuilt = np.zeros(light.shape[1], np.int32)
+        ck.disk_from_quarters(sums, light.shape[1], rebuilt)
+        assert np.array_equal(rebuilt, sums[9])
+        disk = np.hypot(*np.mgrid[-r:r + 1, -r:r + 1]) <= r
+        assert int(sums[9, 9]) == int(np.sum(padded[27 - r:28 + r, 29 - r:30 + r] * disk))
+        assert int(sums[3, 9]) == int(np.sum((padded[27:28 + r, 29:30 + r] * disk[r:, r:])))
+        assert int(sums[4, 6]) == int(padded[27:28 + r, 26:27 + r].sum())
+
+
+def test_window_sums_survive_wrapping_integrals():
+    # Column integrals of a bright 3000 x 3000 frame pass 2**31; the window sums stay exact.
+    bright = np.full((3000, 3000), 255, np.uint8)
+    tables = ck.prefix_tables(bright, bright)
+    assert tables[ck.LIGHT_INTEGRAL].min() < 0
+    terms = np.array(cs.kernel_terms(cs.disk_plan(3), ck.LIGHT_PREFIX), np.int32)
+    out = np.zeros(4, np.int32)
+    ck.window_sum(tables, terms, 0, len(terms), 2990, 2990, 4, out)
+    assert np.all(out == 255 * cs.disk_size(3))
 
 
 @pytest.mark.parametrize("radius", [2, 4, 7])
@@ -84,12 +108,14 @@ def test_single_lit_disk_peaks_at_its_centre_with_its_radius(radius):
 
 def test_quadrant_contrast_is_zero_on_a_flat_image():
     flat = np.full((30, 40, 3), (20, 120, 200), np.uint8)
-    sums = cs.PrefixSums(cs.mirror(cs.lightness(flat), 12), 12)
+    light = cs.lightness(flat)
     for r in (1, 3, 6):
-        for q in cs.QUADRANTS:
-            contrast = cs.quadrant_contrast(cs.quarter_disk_sum(sums, r, q),
-                                            cs.quarter_box_sum(sums, r, q),
-                                            cs.quarter_disk_size(r), (r + 1) ** 2)
+        windows = [cs.quarter_plan(r, q) for q in cs.QUADRANTS] + [
+            cs.box_plan(r, q) for q in cs.QUADRANTS]
+        contrast = np.ones(40, np.int64)
+        for use_min in (False, True):
+            ck.lightness_contrast(window_sums(light, 12, windows, 5), cs.quarter_disk_size(r),
+                                  (r + 1) ** 2, use_min, 40, contrast)
             assert not contrast.any()
     assert cs.conspicuity_map(flat, radii=(1, 3, 6)).values.max() < 1e-2
 
@@ -97,10 +123,15 @@ def test_quadrant_contrast_is_zero_on_a_flat_image():
 def test_geometric_mean_ratio_is_invariant_to_feature_scales():
     rng = np.random.default_rng(5)
     features = [rng.uniform(0.05, 1.0, 50).astype(np.float32) for _ in range(3)]
-    weights = (1.0, 2.0, 0.5)
-    base = cs.weighted_root(cs.weighted_product(features, weights), weights)
-    scaled = cs.weighted_root(cs.weighted_product(
-        [f * s for f, s in zip(features, (0.3, 7.0, 0.01))], weights), weights)
+    weights = np.array((1.0, 2.0, 0.5), np.float32)
+
+    def geometric_mean(scales):
+        product = np.zeros(50, np.float32)
+        ck.weighted_product(*(f * np.float32(s) for f, s in zip(features, scales)), weights, 50,
+                            product)
+        return cs.weighted_root(product, weights)
+
+    base, scaled = geometric_mean((1, 1, 1)), geometric_mean((0.3, 7.0, 0.01))
     np.testing.assert_allclose(scaled / scaled[0], base / base[0], rtol=1e-5)
     assert not np.allclose(scaled, base)
 
@@ -108,9 +139,14 @@ def test_geometric_mean_ratio_is_invariant_to_feature_scales():
 def test_disk_and_annulus_sizes():
     assert [cs.disk_size(r) for r in (1, 2, 3)] == [5, 13, 29]
     assert cs.quarter_disk_size(1) == 3
-    image = np.zeros((20, 20, 3), np.uint8)
-    sums = cs.PrefixSums(cs.mirror(cs.saturation(image), 8), 8)
-    assert cs.annulus_saturation(cs.disk_sum(sums, 4), cs.disk_sum(sums, 2), 2).max() == 0
+    sat = np.zeros((20, 20), np.uint8)
+    sat[10, 10] = 255
+    sums = window_sums(sat, 8, [cs.disk_plan(2), cs.disk_plan(4)], 10, ck.SAT_PREFIX)
+    feature = np.zeros(20, np.float32)
+    ck.saturation_feature(sums[0], sums[1], cs.mean_scale(13), cs.mean_scale(49 - 13), 20,
+                          feature)
+    # At the lit pixel the disk mean wins (1/13); three columns away only the annulus sees it.
+    assert feature[10] == pytest.approx(1 / 13) and feature[13] == pytest.approx(1 / 36)
 
 
 @pytest.mark.parametrize("kwargs", [{"weights": (0, 0, 0)}, {"weights": (1, 1)},

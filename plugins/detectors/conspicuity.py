@@ -43,6 +43,8 @@ from tsrkit.hookspecs import hookimpl
 from tsrkit.params import Param
 from tsrkit.plugin import Detector
 from tsrkit.types import Candidate, Frame
+from tsrkit_plugins.detectors.conspicuity_kernel import (LIGHT_PREFIX, SAT_PREFIX, best_products,
+                                                           prefix_tables)
 from tsrkit_plugins.detectors.localization import (LOCALIZATION_PARAMS, ROI_PARAM, localize,
                                                      region_of_interest)
 
@@ -81,39 +83,6 @@ def quarter_disk_size(radius: int) -> int:
 def mirror(channel: np.ndarray, pad: int) -> np.ndarray:
     """The channel with ``pad`` mirrored pixels on every side (reflect-101)."""
     return cv2.copyMakeBorder(channel, pad, pad, pad, pad, cv2.BORDER_REFLECT_101)
-
-
-class PrefixSums:
-    """Exact integer window sums of one uint8 channel from its row prefix sums.
-
-    The channel comes mirrored by ``pad`` pixels (:func:`mirror`); ``prefix[y, c]`` is the sum
-    of the padded row ``y`` left of padded column ``c``. A horizontal run on row ``i + dy`` from
-    column ``j - a`` to ``j + b`` is ``prefix(dy, b + 1) - prefix(dy, -a)``, so any window made
-    of row runs is a signed sum of shifted views of this one array, and a run of equal column
-    offsets down consecutive rows is one look-up in its column prefix (``integral``).
-    """
-
-    def __init__(self, padded: np.ndarray, pad: int):
-        self.pad = pad
-        self.height, self.width = padded.shape[0] - 2 * pad, padded.shape[1] - 2 * pad
-        self.prefix = np.zeros((padded.shape[0] + 1, padded.shape[1] + 1), np.int32)
-        np.cumsum(padded, axis=1, dtype=np.int32, out=self.prefix[1:, 1:])
-        self.integral = np.cumsum(self.prefix, axis=0, dtype=np.int32)
-
-    def view(self, table: np.ndarray, dy: int, dc: int) -> np.ndarray:
-        """``table`` aligned so that pixel (i, j) reads padded row ``i + dy``, column ``j + dc``."""
-        y, x = self.pad + 1 + dy, self.pad + dc
-        return table[y:y + self.height, x:x + self.width]
-
-    def signed_sum(self, plan: Sequence[tuple[bool, int, int, int]]) -> np.ndarray:
-        """Execute a plan from :func:`compile_terms`: the signed sum of shifted table views."""
-        tables = (self.prefix, self.integral)
-        on_integral, dy, dc, _ = plan[0]
-        total = self.view(tables[on_integral], dy, dc).copy()
-        for on_integral, dy, dc, sign in plan[1:]:
-            (cv2.add if sign > 0 else cv2.subtract)(
-                total, self.view(tables[on_integral], dy, dc), dst=total)
-        return total
 
 
 def compile_terms(runs: Sequence[tuple[int, int, int]],
@@ -190,88 +159,81 @@ def axes_plan(radius: int):
                          [(-radius, radius, 1, -1), (-radius, radius, 0, 1)])
 
 
-def disk_sum(sums: PrefixSums, radius: int) -> np.ndarray:
-    """Window sum over the disk ``|d| <= radius`` (numerator of Eq. 3.3 and Eq. 3.10)."""
-    return sums.signed_sum(disk_plan(radius))
+def kernel_terms(plan, prefix_table: int) -> list[tuple[int, int, int, int]]:
+    """A plan's ``(on_integral, dy, dc, sign)`` terms as kernel rows ``(table, dy, dc, sign)``
+    for the channel whose prefix table is ``prefix_table`` (its integral follows it)."""
+    return [(prefix_table + int(on_integral), dy, dc, sign) for on_integral, dy, dc, sign in plan]
 
 
-def quarter_disk_sum(sums: PrefixSums, radius: int, quadrant: tuple[int, int]) -> np.ndarray:
-    """Window sum over quadrant ``k`` of A1, axes included (numerator of Eq. 3.7)."""
-    return sums.signed_sum(quarter_plan(radius, quadrant))
+def mean_scale(count: int) -> np.float32:
+    """The float32 factor turning a uint8 window sum over ``count`` pixels into the mean of the
+    [0, 1] feature (Eq. 3.3, 3.7, 3.8, 3.10, 3.11)."""
+    return np.float32(1.0 / (255.0 * count))
 
 
-def quarter_box_sum(sums: PrefixSums, half_side: int, quadrant: tuple[int, int]) -> np.ndarray:
-    """Window sum over quadrant ``k`` of the bounding box of side ``half_side + 1`` (A1 + A2)."""
-    return sums.signed_sum(box_plan(half_side, quadrant))
+@dataclass(frozen=True)
+class KernelPlan:
+    """Every window of every radius as kernel terms (see ``conspicuity_kernel.best_products``)."""
+
+    light_terms: np.ndarray
+    light_starts: np.ndarray
+    sat_terms: np.ndarray
+    sat_starts: np.ndarray
+    sat_inner: np.ndarray
+    sat_outer: np.ndarray
+    radii: np.ndarray
+    n_quarter: np.ndarray
+    n_box: np.ndarray
+    scales: np.ndarray
 
 
-def disk_from_quarters(sums: PrefixSums, radius: int,
-                       quarters: Sequence[np.ndarray]) -> np.ndarray:
-    """The disk sum rebuilt from its four overlapping quarters (same value as :func:`disk_sum`).
+def concatenated(plans: Sequence[list]) -> tuple[np.ndarray, np.ndarray]:
+    """Terms of several windows in one int32 array and the start index of each window."""
+    starts = np.cumsum([0] + [len(plan) for plan in plans])
+    return np.array([t for plan in plans for t in plan], np.int32).reshape(-1, 4), \
+        starts.astype(np.int64)
 
-    The quarters share the centre row and column: ``disk = sum(quarters) - column - row_left
-    - row_right`` where the column is ``|dy| <= radius, dx = 0`` and each row run
-    ``dy = 0, 0 <= +-dx <= radius`` includes the centre.
+
+@lru_cache(maxsize=16)
+def kernel_plan(radii: tuple[int, ...], margin: int) -> KernelPlan:
+    """The windows of Eq. 3.3-3.11 for the radius set RAD and margin ``m``.
+
+    Per radius: the four quarters of A1, the four quadrant boxes of A1 + A2 (half-side
+    ``r + m``) and the shared axes on lightness; the saturation disks of radius ``r`` and ``2 r``
+    are planned once per distinct radius (the annulus A3 is their difference).
     """
-    total = sums.signed_sum(axes_plan(radius))
-    for quarter in quarters:
-        cv2.add(total, quarter, dst=total)
-    return total
+    light = []
+    for r in radii:
+        light += [kernel_terms(quarter_plan(r, q), LIGHT_PREFIX) for q in QUADRANTS]
+        light += [kernel_terms(box_plan(r + margin, q), LIGHT_PREFIX) for q in QUADRANTS]
+        light.append(kernel_terms(axes_plan(r), LIGHT_PREFIX))
+    sat_radii = sorted(set(radii) | {2 * r for r in radii})
+    sat = [kernel_terms(disk_plan(r), SAT_PREFIX) for r in sat_radii]
+    n_quarter = [quarter_disk_size(r) for r in radii]
+    n_box = [(r + margin + 1) ** 2 for r in radii]
+    scales = [(mean_scale(disk_size(r)), mean_scale(nq * (nb - nq)), mean_scale(disk_size(r)),
+               mean_scale(disk_size(2 * r) - disk_size(r)))
+              for r, nq, nb in zip(radii, n_quarter, n_box)]
+    return KernelPlan(*concatenated(light), *concatenated(sat),
+                      np.array([sat_radii.index(r) for r in radii], np.int64),
+                      np.array([sat_radii.index(2 * r) for r in radii], np.int64),
+                      np.array(radii, np.int32), np.array(n_quarter, np.int64),
+                      np.array(n_box, np.int64), np.array(scales, np.float32))
 
 
-def average(window_sum: np.ndarray, count: int) -> np.ndarray:
-    """Mean of a [0, 1] feature over a window of ``count`` pixels from its uint8 sum (Eq. 3.3,
-    3.7, 3.8, 3.10, 3.11: sum of flagged values over the number of flagged pixels)."""
-    return np.multiply(window_sum, np.float32(1.0 / (255.0 * count)), dtype=np.float32)
-
-
-def quadrant_contrast(disk_part: np.ndarray, box_part: np.ndarray, n_disk: int,
-                      n_box: int) -> np.ndarray:
-    """Eq. 3.7-3.8 as an exact integer: ``n_disk * n_border * 255 * (LD_k - LB_k)``.
-
-    ``LD_k`` averages the ``n_disk`` pixels of A1 in the quadrant (Eq. 3.7), ``LB_k`` the
-    ``n_border = n_box - n_disk`` pixels of A2 in it (Eq. 3.8); with the quadrant's A1 sum ``D``
-    and whole-box sum ``B`` the difference is ``(n_box * D - n_disk * B) / (n_disk * n_border)``.
-    Keeping the numerator integral keeps a zero contrast exactly zero (the root of Eq. 3.1 would
-    magnify rounding noise near zero).
-    """
-    return cv2.addWeighted(disk_part, float(n_box), box_part, -float(n_disk), 0.0,
-                           dtype=cv2.CV_32S)
-
-
-def lightness_contrast(per_quadrant: Sequence[np.ndarray], n_disk: int, n_box: int,
-                       rule: str = "max") -> np.ndarray:
-    """Eq. 3.5-3.6: combine the four quadrant differences of :func:`quadrant_contrast`
-    (``"max"`` as printed, ``"min"`` for the prose's "all four quadrants"), round negative
-    differences up to zero and scale to lightness units. Clipping once after the combination
-    equals clipping each quadrant first, since max and min commute with ``max(0, .)``."""
-    combine = cv2.max if rule == "max" else cv2.min
-    out = combine(per_quadrant[0], per_quadrant[1])
-    for contrast in per_quadrant[2:]:
-        combine(out, contrast, dst=out)
-    return average(cv2.max(out, 0), n_disk * (n_box - n_disk))
-
-
-def annulus_saturation(outer_sum: np.ndarray, inner_sum: np.ndarray, radius: int) -> np.ndarray:
-    """Eq. 3.11: mean saturation in the annulus ``radius < |d| <= 2 radius`` (A3)."""
-    return average(cv2.subtract(outer_sum, inner_sum), disk_size(2 * radius) - disk_size(radius))
-
-
-def weighted_product(features: Sequence[np.ndarray], weights: Sequence[float]) -> np.ndarray:
-    """The product under the root of Eq. 3.1: ``LD^w_L * LC^w_LC * max(SD, SA)^w_S``."""
-    out = None
-    for feature, weight in zip(features, weights):
-        term = feature if weight == 1 else cv2.pow(feature, float(weight))
-        out = term.copy() if out is None else cv2.multiply(out, term)
-    return out
+def full_runs(height: int, width: int) -> np.ndarray:
+    """Row runs ``(row, first column, end column)`` covering a whole ``height x width`` map."""
+    runs = np.zeros((height, 3), np.int64)
+    runs[:, 0] = np.arange(height)
+    runs[:, 2] = width
+    return runs
 
 
 def weighted_root(product: np.ndarray, weights: Sequence[float]) -> np.ndarray:
-    """The ``(w_L + w_LC + w_S)``-th root of Eq. 3.1; with :func:`weighted_product` this is the
-    weighted geometric mean whose pixel ratios do not change when a feature is rescaled
-    (Appendix A)."""
+    """The ``(w_L + w_LC + w_S)``-th root of Eq. 3.1; with the product of the weighted features
+    (``conspicuity_kernel.weighted_product``) this is the weighted geometric mean whose pixel
+    ratios do not change when a feature is rescaled (Appendix A)."""
     return np.power(product, 1.0 / float(sum(weights)), dtype=np.float32)
-
 
 @dataclass(frozen=True)
 class ConspicuityMap:
@@ -327,49 +289,32 @@ def conspicuity_map(image: np.ndarray, radii: Sequence[int] = tuple(range(1, 11)
     if image.ndim != 3 or image.shape[2] != 3 or image.dtype != np.uint8:
         raise ValueError(f"expected a BGR uint8 image of shape (H, W, 3); got {image.dtype} "
                          f"{image.shape}")
-    pad = max(2 * radii[-1], radii[-1] + margin)
-    if (STRIP_ROWS + 2 * pad + 1) * (image.shape[1] + 2 * pad + 1) * 255 >= 2 ** 31:
-        raise ValueError(f"image width {image.shape[1]} too large for 32-bit window sums")
-    light, sat = mirror(lightness(image), pad), mirror(saturation(image), pad)
-    best = np.zeros(image.shape[:2], np.float32)
-    best_radius = np.full(image.shape[:2], radii[0], np.int32)
-    for top in range(0, image.shape[0], STRIP_ROWS):
-        rows = slice(top, min(top + STRIP_ROWS, image.shape[0]) + 2 * pad)
-        strip = slice(top, top + STRIP_ROWS)
-        best_products(PrefixSums(light[rows], pad), PrefixSums(sat[rows], pad), radii, weights,
-                      margin, quadrant_rule, best[strip], best_radius[strip])
+    tables, pad = channel_tables(image, radii, margin)
+    best, best_radius = products_on_runs(tables, pad, full_runs(*image.shape[:2]), radii,
+                                         weights, margin, quadrant_rule)
     return ConspicuityMap(weighted_root(best, weights), best_radius)
 
 
-#: Rows per strip: the working arrays of a strip stay in the CPU cache, and a strip's column
-#: prefix sums stay below 2**31 (int32) for frames up to about 80,000 pixels wide.
-STRIP_ROWS = 64
+def channel_tables(image: np.ndarray, radii: Sequence[int], margin: int) -> tuple[np.ndarray, int]:
+    """Prefix tables of the mirrored lightness and saturation, with the padding they need."""
+    pad = max(2 * max(radii), max(radii) + margin)
+    return prefix_tables(mirror(lightness(image), pad), mirror(saturation(image), pad)), pad
 
 
-def best_products(light: PrefixSums, sat: PrefixSums, radii: Sequence[int],
-                  weights: Sequence[float], margin: int, quadrant_rule: str, best: np.ndarray,
-                  best_radius: np.ndarray) -> None:
-    """Eq. 3.1 (under its root) for each radius and Eq. 3.2's running maximum, written into
-    ``best`` (zeros on entry) and ``best_radius``."""
-    sat_disks: dict[int, np.ndarray] = {}
-    for r in radii:
-        quarters = [quarter_disk_sum(light, r, q) for q in QUADRANTS]
-        boxes = [quarter_box_sum(light, r + margin, q) for q in QUADRANTS]
-        n_quarter, n_box = quarter_disk_size(r), (r + margin + 1) ** 2
-        contrast = lightness_contrast(
-            [quadrant_contrast(d, b, n_quarter, n_box) for d, b in zip(quarters, boxes)],
-            n_quarter, n_box, quadrant_rule)
-        light_disk = average(disk_from_quarters(light, r, quarters), disk_size(r))
-        for radius in (r, 2 * r):
-            if radius not in sat_disks:
-                sat_disks[radius] = disk_sum(sat, radius)
-        inner = sat_disks.pop(r)
-        sat_best = cv2.max(average(inner, disk_size(r)),
-                           annulus_saturation(sat_disks[2 * r], inner, r))
-        product = weighted_product((light_disk, contrast, sat_best), weights)
-        better = np.greater(product, best)
-        np.maximum(best, product, out=best)
-        np.copyto(best_radius, np.int32(r), where=better)
+def products_on_runs(tables: np.ndarray, pad: int, runs: np.ndarray, radii: Sequence[int],
+                     weights: Sequence[float], margin: int, quadrant_rule: str):
+    """Eq. 3.1 under its root, maximised over the radii (Eq. 3.2), on the pixels of ``runs``;
+    returns the float32 maximum (0 elsewhere) and the int32 arg-max radius (smallest radius
+    elsewhere and on ties)."""
+    shape = (tables.shape[1] - 1 - 2 * pad, tables.shape[2] - 1 - 2 * pad)
+    plan = kernel_plan(tuple(radii), margin)
+    best = np.zeros(shape, np.float32)
+    best_radius = np.full(shape, min(radii), np.int32)
+    best_products(tables, pad, runs, plan.light_terms, plan.light_starts, plan.sat_terms,
+                  plan.sat_starts, plan.sat_inner, plan.sat_outer, plan.radii, plan.n_quarter,
+                  plan.n_box, plan.scales, np.asarray(weights, np.float32),
+                  quadrant_rule == "min", best, best_radius)
+    return best, best_radius
 
 
 class Conspicuity(Detector):

@@ -1,0 +1,185 @@
+"""Compiled kernel of Zheng's conspicuity map (2016, 3.2.1, Eq. 3.1-3.12 under the root of
+Eq. 3.1, and the running maximum of Eq. 3.2).
+
+The window sums are the same signed sums of shifted prefix-table entries that
+``conspicuity.py`` plans (:func:`compile_terms` and the ``*_plan`` functions there); this module
+only executes them. One call walks a list of row runs (row, first column, end column): for each
+run it sums every window into short integer row buffers and combines them into the product of
+Eq. 3.1 per radius, keeping the maximum and its radius. The same float32 operations as the
+array version are applied in the same order, so the values are bit for bit those of the plain
+NumPy execution. A full frame is one run per row; pruning passes only the runs that matter.
+
+Integer sums wrap modulo 2**32 in the int32 buffers like the int32 tables do, so the true sums
+(which are small) come out exact even when the column integrals of a large frame overflow.
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+#: Row of the table stack for each (channel, kind): lightness prefix, lightness integral,
+#: saturation prefix, saturation integral.
+LIGHT_PREFIX, LIGHT_INTEGRAL, SAT_PREFIX, SAT_INTEGRAL = range(4)
+
+#: Lightness windows per radius, in this order: the four quarters of A1, the four quadrant
+#: boxes of A1 + A2, and the shared axes that rebuild the full disk from its quarters.
+LIGHT_WINDOWS = 9
+
+
+def prefix_tables(light: np.ndarray, sat: np.ndarray) -> np.ndarray:
+    """Stack of row prefix sums and their column integrals of two mirrored uint8 channels.
+
+    ``table[k, y, c]`` for a prefix table is the sum of padded row ``y - 1`` left of column
+    ``c`` (row 0 and column 0 are zero); an integral table sums the prefix rows ``0..y``.
+    int32 integrals may wrap on large frames; differences stay exact modulo 2**32.
+    """
+    height, width = light.shape
+    stack = np.zeros((4, height + 1, width + 1), np.int32)
+    for channel, (prefix, integral) in zip((light, sat), ((LIGHT_PREFIX, LIGHT_INTEGRAL),
+                                                           (SAT_PREFIX, SAT_INTEGRAL))):
+        np.cumsum(channel, axis=1, dtype=np.int32, out=stack[prefix, 1:, 1:])
+        np.cumsum(stack[prefix], axis=0, dtype=np.int32, out=stack[integral])
+    return stack
+
+
+@njit(cache=True, nogil=True)
+def window_sum(tables, terms, first, last, row, col, count, out):
+    """``out[:count]`` = the signed sum of ``terms[first:last]`` = (table, dy, dc, sign) read at
+    pixel row ``row`` (table row ``row + dy``) and columns ``col + dc ..``."""
+    out[:count] = 0
+    for t in range(first, last):
+        y, c = row + terms[t, 1], col + terms[t, 2]
+        source = tables[terms[t, 0], y, c:c + count]
+        target = out[:count]
+        if terms[t, 3] > 0:
+            for x in range(count):
+                target[x] = np.int32(target[x] + source[x])
+        else:
+            for x in range(count):
+                target[x] = np.int32(target[x] - source[x])
+
+
+@njit(cache=True, nogil=True)
+def lightness_contrast(light, n_quarter, n_box, use_min, count, out):
+    """Eq. 3.5-3.8 as exact integers: ``out[x] = max(0, comb_k(n_box * D_k - n_quarter * B_k))``
+    with ``D_k`` the sum of quarter ``k`` of A1 (rows 0-3 of ``light``) and ``B_k`` that of its
+    quadrant box A1 + A2 (rows 4-7); this is ``n_quarter * n_border * 255 * (LD_k - LB_k)``
+    with ``n_border = n_box - n_quarter``. ``comb`` is the printed maximum, or the minimum.
+    Clipping once after combining equals clipping each quadrant (max/min commute with
+    ``max(0, .)``); integers keep a zero contrast exactly zero."""
+    for x in range(count):
+        out[x] = n_box * np.int64(light[0, x]) - n_quarter * np.int64(light[4, x])
+    for q in range(1, 4):
+        for x in range(count):
+            part = n_box * np.int64(light[q, x]) - n_quarter * np.int64(light[4 + q, x])
+            out[x] = min(out[x], part) if use_min else max(out[x], part)
+    for x in range(count):
+        out[x] = max(out[x], 0)
+
+
+@njit(cache=True, nogil=True)
+def disk_from_quarters(light, count, out):
+    """The A1 sum (numerator of Eq. 3.3) from its four overlapping quarters plus the axes term
+    (row 8 of ``light``: minus the centre column and the two centre-row runs they share)."""
+    for x in range(count):
+        out[x] = light[0, x] + light[1, x] + light[2, x] + light[3, x] + light[8, x]
+
+
+@njit(cache=True, nogil=True)
+def saturation_feature(inner, outer, disk_scale, annulus_scale, count, out):
+    """Eq. 3.10-3.12: the larger of the disk mean of saturation and the mean over the annulus
+    A3 (``outer`` disk of radius ``2 r`` minus the ``inner`` disk of radius ``r``)."""
+    for x in range(count):
+        out[x] = max(np.float32(inner[x]) * disk_scale,
+                     np.float32(outer[x] - inner[x]) * annulus_scale)
+
+
+@njit(cache=True, nogil=True)
+def weighted_product(lightness, contrast, saturation, weights, count, out):
+    """The product under the root of Eq. 3.1, ``LD^w_L * LC^w_LC * S^w_S``, in float32 (a
+    unit weight multiplies the feature itself)."""
+    if weights[0] == 1 and weights[1] == 1 and weights[2] == 1:
+        for x in range(count):
+            out[x] = lightness[x] * contrast[x] * saturation[x]
+        return
+    for x in range(count):
+        out[x] = (_powered(lightness[x], weights[0]) * _powered(contrast[x], weights[1])
+                  * _powered(saturation[x], weights[2]))
+
+
+@njit(cache=True, nogil=True)
+def _powered(feature, weight):
+    """``feature ** weight`` in float32, the feature itself for a unit weight."""
+    return feature if weight == 1 else np.float32(feature ** weight)
+
+
+@njit(cache=True, nogil=True)
+def keep_best(product, radius, count, best, best_radius):
+    """Eq. 3.2's running maximum over radii; the earlier (smaller) radius wins ties."""
+    for x in range(count):
+        if product[x] > best[x]:
+            best[x] = product[x]
+            best_radius[x] = radius
+
+
+@njit(cache=True, nogil=True)
+def best_products(tables, pad, runs, light_terms, light_starts, sat_terms, sat_starts,
+                  sat_inner, sat_outer, radii, n_quarter, n_box, scales, weights, use_min,
+                  best, best_radius):
+    """Eq. 3.1 (under its root) for every radius and the maximum of Eq. 3.2 over the pixels
+    of ``runs``; ``best`` (zeros on entry) and ``best_radius`` are written in place.
+
+    Parameters
+    ----------
+    tables : ndarray
+        int32 (4, H + 2 pad + 1, W + 2 pad + 1) from :func:`prefix_tables`.
+    pad : int
+        Mirror padding of the tables.
+    runs : ndarray
+        int64 (N, 3): row, first column, end column (exclusive) of the pixels to compute.
+    light_terms, light_starts : ndarray
+        Terms (table, dy, dc, sign) of the ``LIGHT_WINDOWS`` windows of each radius, window
+        ``w`` of radius index ``k`` spanning ``light_starts[k * LIGHT_WINDOWS + w]`` to the
+        next start.
+    sat_terms, sat_starts : ndarray
+        Terms of the saturation disks, disk ``d`` spanning ``sat_starts[d:d + 2]``.
+    sat_inner, sat_outer : ndarray
+        Per radius index, the saturation disk of radius ``r`` and of ``2 r``.
+    radii, n_quarter, n_box : ndarray
+        Per radius index: the radius, the pixels of a quarter of A1, of a quadrant box.
+    scales : ndarray
+        float32 (R, 4): the factors turning the lightness disk, contrast, saturation disk and
+        annulus sums into means (Eq. 3.3, 3.6-3.8, 3.10, 3.11).
+    weights : ndarray
+        float32 (w_L, w_LC, w_S).
+    use_min : bool
+        Combine the quadrants by minimum instead of the printed maximum (Eq. 3.5).
+    """
+    longest = max(1, np.max(runs[:, 2] - runs[:, 1])) if runs.shape[0] else 1
+    light = np.zeros((LIGHT_WINDOWS, longest), np.int32)
+    sat = np.zeros((sat_starts.shape[0] - 1, longest), np.int32)
+    contrast = np.zeros(longest, np.int64)
+    disk = np.zeros(longest, np.int32)
+    features = np.zeros((3, longest), np.float32)
+    product = np.zeros(longest, np.float32)
+    for run in range(runs.shape[0]):
+        i, x0, count = runs[run, 0], runs[run, 1], runs[run, 2] - runs[run, 1]
+        row, col = pad + 1 + i, pad + x0
+        for d in range(sat.shape[0]):
+            window_sum(tables, sat_terms, sat_starts[d], sat_starts[d + 1], row, col, count,
+                        sat[d])
+        for k in range(radii.shape[0]):
+            for w in range(LIGHT_WINDOWS):
+                start = k * LIGHT_WINDOWS + w
+                window_sum(tables, light_terms, light_starts[start], light_starts[start + 1],
+                            row, col, count, light[w])
+            lightness_contrast(light, n_quarter[k], n_box[k], use_min, count, contrast)
+            disk_from_quarters(light, count, disk)
+            for x in range(count):
+                features[0, x] = np.float32(disk[x]) * scales[k, 0]
+                features[1, x] = np.float32(contrast[x]) * scales[k, 1]
+            saturation_feature(sat[sat_inner[k]], sat[sat_outer[k]], scales[k, 2], scales[k, 3],
+                               count, features[2])
+            weighted_product(features[0], features[1], features[2], weights, count, product)
+            keep_best(product, radii[k], count, best[i, x0:x0 + count],
+                      best_radius[i, x0:x0 + count])
