@@ -69,7 +69,8 @@ def test_spot_candidates_rank_by_peak_and_binarise_at_the_fraction():
     symmetry[5, 5], symmetry[20, 8:11] = 1.0, 0.6
     symmetry[25, 25] = 0.4
     spots = spot_candidates(symmetry, 0.5, 5, "red")
-    assert [(c.x, c.y, c.score) for c in spots] == [(5.5, 5.5, 1.0), (9.5, 20.5, pytest.approx(0.6))]
+    assert [(c.x, c.y, c.score) for c in spots] == [(5.5, 5.5, 1.0),
+                                                    (9.5, 20.5, pytest.approx(0.6))]
     assert spots[1].radius == 1.5
 
 

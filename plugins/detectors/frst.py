@@ -148,7 +148,7 @@ def orientation_strength(orientation: np.ndarray, k: float, alpha: float) -> np.
 
 
 def gaussian_kernel(n: int) -> np.ndarray:
-    """The 1-D factor of A_n: a normalised Gaussian with sigma = 0.25 n, half-width ceil(3 sigma)."""
+    """The 1-D factor of A_n: normalised Gaussian, sigma = 0.25 n, half-width ceil(3 sigma)."""
     sigma = 0.25 * n
     return cv2.getGaussianKernel(2 * math.ceil(3 * sigma) + 1, sigma, cv2.CV_64F)
 
@@ -207,7 +207,7 @@ def frst(image: np.ndarray, radii: Sequence[int] = tuple(range(1, 11)), alpha: f
     >>> yy, xx = np.mgrid[:31, :31]
     >>> disc = ((yy - 15) ** 2 + (xx - 15) ** 2 <= 25).astype(np.float32)
     >>> s = frst(disc, radii=[5])
-    >>> np.unravel_index(np.argmax(s), s.shape)
+    >>> tuple(int(i) for i in np.unravel_index(np.argmax(s), s.shape))
     (15, 15)
     """
     image = np.asarray(image, dtype=np.float32)
@@ -225,7 +225,7 @@ def frst(image: np.ndarray, radii: Sequence[int] = tuple(range(1, 11)), alpha: f
 
 
 def projections(voters: Voters, n: int, signs: Sequence[int]) -> tuple[np.ndarray, np.ndarray]:
-    """O_n and M_n, flat over the working grid, for radius ``n`` and the affected pixels of ``signs``."""
+    """O_n and M_n (flat, working grid) for radius ``n``, voting at the pixels of ``signs``."""
     size = voters.grid[0] * voters.grid[1]
     votes = [(affected_pixels(voters, n, sign), sign) for sign in signs]
     orientation = reduce(np.add, (orientation_projection(index, sign, size)

@@ -51,9 +51,11 @@ def spot_candidates(symmetry: np.ndarray, fraction: float, top: int,
     """The ``top`` strongest 8-connected spots of ``symmetry >= fraction * max`` (Zheng 5.2.2).
 
     Components are labelled inside the bounding box of the above-threshold pixels only (the
-    rest of the map is background). Each spot becomes a candidate at its centroid (in continuous coordinates: pixel ``(i, j)``
-    covers ``[j, j+1) x [i, i+1)``, so its centre is ``(j + 0.5, i + 0.5)``), with half the longer side of its bounding
-    box as radius and its peak symmetry value as score.
+    rest of the map is background). Each spot becomes a candidate at its centroid, in
+    continuous coordinates (pixel ``(i, j)`` covers ``[j, j+1) x [i, i+1)``, so its centre is
+    ``(j + 0.5, i + 0.5)``), with half the longer side of its bounding box as radius and its
+    peak symmetry value as score. The radius is the size of the half-maximum spot, as Zheng
+    describes, and is usually smaller than the lens.
     """
     peak = float(symmetry.max())
     if peak <= 0:
@@ -84,7 +86,8 @@ class LabFrst(Detector):
     """
 
     name = "lab-frst"
-    summary = "CIELab L*(a+b) map, fast radial symmetry transform, top bright (red) and dark (green) spots"
+    summary = ("CIELab L*(a+b) map, fast radial symmetry transform, top bright (red) and "
+               "dark (green) spots")
     section = "Zheng 2016, 5.2.2; Loy & Zelinsky 2003"
     params = (
         Param("radii", "ints", tuple(range(1, 11)), min=1, max=64,
