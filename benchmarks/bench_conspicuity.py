@@ -1,8 +1,12 @@
-"""Speed of the conspicuity and GRAY-TOPHAT detectors against the direct-correlation oracle.
+"""Speed of the conspicuity and GRAY-TOPHAT detectors against the direct-correlation oracle
+and against an earlier commit's conspicuity map (A/B in the same run).
 
 Frames: roboflow_traffic_light_kr road scenes resized to 480x356 (the thesis's size) and
-1280x720. Single thread. Prints medians of wall and CPU time per frame and the ratios measured
-in this run. Usage: python benchmarks/bench_conspicuity.py [--frames 8] [--reps 5]
+1280x720. Single thread. The timed calls are interleaved (every repetition runs each call on
+every frame in turn), so load from other processes falls on all of them alike. Prints the
+first-call cost (numba compile or cache load), medians of wall and CPU time per frame and the
+ratios measured in this run.
+Usage: python benchmarks/bench_conspicuity.py [--frames 8] [--reps 5] [--baseline e57479b]
 """
 import os
 
@@ -10,8 +14,11 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ[_var] = "1"
 
 import argparse  # noqa: E402
+import importlib.util  # noqa: E402
 import json  # noqa: E402
+import subprocess  # noqa: E402
 import sys  # noqa: E402
+import tempfile  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
@@ -38,16 +45,40 @@ def frames(count, size):
             for e in entries]
 
 
-def timed(call, images, reps):
-    """Median wall and CPU milliseconds of ``call(image)`` over all images and repetitions."""
-    wall, cpu = [], []
+def first_call_seconds():
+    """Seconds of the first conspicuity map in this process (JIT compile or cache load)."""
+    start = time.perf_counter()
+    conspicuity_map(np.zeros((8, 8, 3), np.uint8))
+    return time.perf_counter() - start
+
+
+def baseline_map(commit):
+    """``conspicuity_map`` of ``plugins/detectors/conspicuity.py`` at ``commit`` (git show)."""
+    source = subprocess.run(["git", "-C", str(REPO), "show",
+                             f"{commit}:plugins/detectors/conspicuity.py"],
+                            check=True, capture_output=True, text=True).stdout
+    path = Path(tempfile.mkdtemp()) / "conspicuity_baseline.py"
+    path.write_text(source)
+    spec = importlib.util.spec_from_file_location("conspicuity_baseline", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module.conspicuity_map
+
+
+def interleaved(calls, reps):
+    """Median wall and CPU milliseconds per item of each ``name: (call, items)``; every
+    repetition runs each call over its items in turn."""
+    wall = {name: [] for name in calls}
+    cpu = {name: [] for name in calls}
     for _ in range(reps):
-        for image in images:
-            w0, c0 = time.perf_counter(), time.process_time()
-            call(image)
-            wall.append(time.perf_counter() - w0)
-            cpu.append(time.process_time() - c0)
-    return 1e3 * float(np.median(wall)), 1e3 * float(np.median(cpu))
+        for name, (call, items) in calls.items():
+            for item in items:
+                w0, c0 = time.perf_counter(), time.process_time()
+                call(item)
+                wall[name].append(time.perf_counter() - w0)
+                cpu[name].append(time.process_time() - c0)
+    return {name: (1e3 * float(np.median(wall[name])), 1e3 * float(np.median(cpu[name])))
+            for name in calls}
 
 
 def main():
@@ -55,29 +86,39 @@ def main():
     parser.add_argument("--frames", type=int, default=8)
     parser.add_argument("--reps", type=int, default=5)
     parser.add_argument("--oracle-frames", type=int, default=2)
+    parser.add_argument("--baseline", default="e57479b",
+                        help="commit whose conspicuity map is timed alongside ('' to skip)")
     args = parser.parse_args()
+    print(f"first conspicuity_map call: {first_call_seconds():.2f} s")
     conspicuity = tsrkit.detector("conspicuity")
     tophat = tsrkit.detector("gray-tophat")
     small = frames(args.frames, (480, 356))
     large = frames(args.frames, (1280, 720))
     maps = [conspicuity_map(image) for image in small]
 
-    results = {
-        "conspicuity 480x356": timed(lambda im: conspicuity.detect(Frame(im, "b")), small,
-                                     args.reps),
-        "  map only": timed(conspicuity_map, small, args.reps),
-        "  localization only": timed(
+    def detect(detector):
+        return lambda image: detector.detect(Frame(image, "b"))
+
+    calls = {
+        "conspicuity 480x356": (detect(conspicuity), small),
+        "  map only": (conspicuity_map, small),
+        "  localization only": (
             lambda i: localize(maps[i].values, conspicuity.params, maps[i].radius),
-            range(len(maps)), args.reps),
-        "conspicuity 1280x720": timed(lambda im: conspicuity.detect(Frame(im, "b")), large,
-                                      max(1, args.reps // 2)),
-        "gray-tophat 480x356": timed(lambda im: tophat.detect(Frame(im, "b")), small,
-                                     args.reps),
-        "gray-tophat 1280x720": timed(lambda im: tophat.detect(Frame(im, "b")), large,
-                                      max(1, args.reps // 2)),
+            range(len(maps))),
+        "conspicuity 1280x720": (detect(conspicuity), large),
+        "  map only 1280x720": (conspicuity_map, large),
+        "gray-tophat 480x356": (detect(tophat), small),
+        "gray-tophat 1280x720": (detect(tophat), large),
     }
+    if args.baseline:
+        old_map = baseline_map(args.baseline)
+        calls[f"baseline {args.baseline} map"] = (old_map, small)
+        differ = sum(not np.array_equal(old_map(im).values, m.values) for im, m in zip(small, maps))
+        print(f"frames whose map differs from {args.baseline}'s: {differ} of {len(small)}")
+    results = interleaved(calls, args.reps)
     oracle_images = small[:args.oracle_frames]
-    results["oracle map 480x356"] = timed(conspicuity_reference, oracle_images, 1)
+    results["oracle map 480x356"] = interleaved(
+        {"oracle": (conspicuity_reference, oracle_images)}, 1)["oracle"]
     worst = max(float(np.abs(conspicuity_map(im).values - conspicuity_reference(im)[0]).max())
                 for im in oracle_images)
 
@@ -85,16 +126,18 @@ def main():
     for name, (wall, cpu) in results.items():
         print(f"{name:28s} {wall:10.2f} {cpu:10.2f}")
     print(f"max |fast - oracle| on {len(oracle_images)} frames: {worst:.2e}")
-    for kind in ("wall", "cpu"):
-        k = 0 if kind == "wall" else 1
-        print(f"[{kind}] oracle map / fast map: "
-              f"{results['oracle map 480x356'][k] / results['  map only'][k]:.1f}x; "
-              f"oracle map / fast detect: "
-              f"{results['oracle map 480x356'][k] / results['conspicuity 480x356'][k]:.1f}x; "
-              f"conspicuity 1280x720 / 480x356: "
-              f"{results['conspicuity 1280x720'][k] / results['conspicuity 480x356'][k]:.2f}x; "
-              f"gray-tophat 1280x720 / 480x356: "
-              f"{results['gray-tophat 1280x720'][k] / results['gray-tophat 480x356'][k]:.2f}x")
+    for k, kind in enumerate(("wall", "cpu")):
+        def ratio(a, b):
+            return results[a][k] / results[b][k]
+        line = (f"[{kind}] oracle map / fast map: {ratio('oracle map 480x356', '  map only'):.1f}x;"
+                f" oracle map / fast detect: "
+                f"{ratio('oracle map 480x356', 'conspicuity 480x356'):.1f}x; conspicuity "
+                f"1280x720 / 480x356: {ratio('conspicuity 1280x720', 'conspicuity 480x356'):.2f}x"
+                f" (map only {ratio('  map only 1280x720', '  map only'):.2f}x); gray-tophat "
+                f"1280x720 / 480x356: {ratio('gray-tophat 1280x720', 'gray-tophat 480x356'):.2f}x")
+        if args.baseline:
+            line += f"; baseline map / map: {ratio(f'baseline {args.baseline} map', '  map only'):.2f}x"
+        print(line)
 
 
 if __name__ == "__main__":
