@@ -136,7 +136,8 @@ def main():
                 f" (map only {ratio('  map only 1280x720', '  map only'):.2f}x); gray-tophat "
                 f"1280x720 / 480x356: {ratio('gray-tophat 1280x720', 'gray-tophat 480x356'):.2f}x")
         if args.baseline:
-            line += f"; baseline map / map: {ratio(f'baseline {args.baseline} map', '  map only'):.2f}x"
+            baseline = ratio(f"baseline {args.baseline} map", "  map only")
+            line += f"; baseline map / map: {baseline:.2f}x"
         print(line)
 
 

@@ -175,3 +175,50 @@ def test_region_of_interest_hides_the_lower_frame():
     image = lit_disk(4, shape=(80, 64), centre=(60, 29))
     assert not tsrkit.detector("conspicuity", roi_top=0.5).detect(Frame(image, "x"))
     assert tsrkit.detector("conspicuity").detect(Frame(image, "x"))
+
+
+#: Candidates of the round-1 NumPy implementation (commit e57479b) on 480x356 resizes of
+#: roboflow_traffic_light_kr frames: (x, y, radius, score). The compiled kernel must keep them.
+ROUND_ONE_CANDIDATES = {
+    0: [(228.531, 164.473, 2, 0.656477)],
+    5: [(303.466, 98.541, 2, 0.558103), (309.465, 77.661, 7, 0.531864),
+        (373.47, 9.464, 6, 0.523986), (302.432, 88.479, 3, 0.520394),
+        (363.456, 18.528, 6, 0.512656), (384.419, 3.8, 5, 0.507688),
+        (209.58, 58.611, 7, 0.488395), (224.146, 73.623, 9, 0.480928),
+        (371.499, 41.511, 4, 0.475431), (326.35, 98.294, 9, 0.472935)],
+    11: [(227.406, 294.412, 5, 0.498181), (123.45, 298.521, 6, 0.488416),
+         (293.029, 136.568, 7, 0.480127), (211.576, 295.528, 4, 0.47258),
+         (456.198, 26.839, 8, 0.46342), (107.498, 298.416, 6, 0.463031),
+         (431.853, 44.701, 8, 0.461131), (95.437, 298.548, 5, 0.438441),
+         (208.432, 182.492, 6, 0.431261), (292.383, 113.416, 7, 0.430705)],
+}
+
+
+def test_candidates_on_real_frames_match_the_round_one_implementation(shared_datasets):
+    root = shared_datasets / "roboflow_traffic_light_kr"
+    entries = json.loads((root / "annotations.json").read_text())
+    detector = tsrkit.detector("conspicuity")
+    for index, expected in ROUND_ONE_CANDIDATES.items():
+        image = cv2.resize(cv2.imread(str(root / entries[index]["file"])), (480, 356),
+                           interpolation=cv2.INTER_AREA)
+        found = detector.detect(Frame(image, entries[index]["file"]))
+        assert [c.radius for c in found] == [e[2] for e in expected]
+        for candidate, (x, y, _, score) in zip(found, expected):
+            assert (candidate.x, candidate.y) == (pytest.approx(x, abs=2e-3),
+                                                  pytest.approx(y, abs=2e-3))
+            assert candidate.score == pytest.approx(score, abs=2e-6)
+
+
+def test_map_does_not_depend_on_how_the_rows_are_split_into_runs():
+    image = random_image(6, (30, 41))
+    tables, pad = cs.channel_tables(image, list(range(1, 11)), 0)
+    whole = cs.products_on_runs(tables, pad, cs.full_runs(30, 41), list(range(1, 11)),
+                                (1.0, 1.0, 1.0), 0, "max")
+    pieces = np.array([(i, a, b) for i in range(30) for a, b in ((0, 7), (7, 8), (8, 41))])
+    split = cs.products_on_runs(tables, pad, pieces, list(range(1, 11)), (1.0, 1.0, 1.0), 0,
+                                "max")
+    assert np.array_equal(whole[0], split[0]) and np.array_equal(whole[1], split[1])
+    assert whole[0].max() > 0
+    partial = cs.products_on_runs(tables, pad, pieces[pieces[:, 1] == 7], list(range(1, 11)),
+                                  (1.0, 1.0, 1.0), 0, "max")
+    assert np.array_equal(partial[0][:, 7], whole[0][:, 7]) and not partial[0][:, 8:].any()

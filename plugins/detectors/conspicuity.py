@@ -21,13 +21,13 @@ Reading choices (the thesis leaves them open or prints them ambiguously):
 * A2 is the bounding box of A1 widened by the margin ``m`` (half-side ``r + m``); quadrant ``k``
   is the quarter of that box on one side of the centre's row and column, both included.
 
-Speed: every window sum is an exact integer sum of shifted views of one row-prefix array per
-channel (rows of equal half-width merged into one look-up in its column prefix; the plan of
-each window is computed once per radius), the full lightness disk is assembled from its four
-quarters, saturation disks are shared between radii, the frame is processed in strips that stay
-in cache, and the root of Eq. 3.1 is taken once after the maximum of Eq. 3.2 (the root is
-monotonic, so the arg-max is unchanged). ``tests/oracles/conspicuity_oracle.py`` is the direct
-reference these are tested against.
+Speed: every window sum is an exact integer sum of entries of one row-prefix table per
+channel (rows of equal half-width merged into one look-up in its column integral; the plan of
+each window is computed once per radius and executed by the numba kernel in
+``conspicuity_kernel.py``, one image row at a time), the full lightness disk is assembled from
+its four quarters, saturation disks are shared between radii, and the root of Eq. 3.1 is taken
+once after the maximum of Eq. 3.2 (the root is monotonic, so the arg-max is unchanged).
+``tests/oracles/conspicuity_oracle.py`` is the direct reference these are tested against.
 """
 from __future__ import annotations
 

@@ -5,9 +5,10 @@ The window sums are the same signed sums of shifted prefix-table entries that
 ``conspicuity.py`` plans (:func:`compile_terms` and the ``*_plan`` functions there); this module
 only executes them. One call walks a list of row runs (row, first column, end column): for each
 run it sums every window into short integer row buffers and combines them into the product of
-Eq. 3.1 per radius, keeping the maximum and its radius. The same float32 operations as the
-array version are applied in the same order, so the values are bit for bit those of the plain
-NumPy execution. A full frame is one run per row; pruning passes only the runs that matter.
+Eq. 3.1 per radius, keeping the maximum and its radius. The float32 operations of the earlier
+NumPy/OpenCV execution (commit e57479b) are applied in the same order, so with unit weights
+the values are bit for bit the same (other weights use ``powf`` instead of ``cv2.pow``: within
+6e-8). A full frame is one run per row; a caller may pass any subset of pixels as runs.
 
 Integer sums wrap modulo 2**32 in the int32 buffers like the int32 tables do, so the true sums
 (which are small) come out exact even when the column integrals of a large frame overflow.
