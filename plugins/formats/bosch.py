@@ -16,9 +16,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import yaml
 
 from tsrkit.datasets import DatasetError
+from tsrkit.datasets.errors import read_yaml
 from tsrkit.hookspecs import hookimpl
 from tsrkit.params import Param
 from tsrkit.plugin import DatasetFormat
@@ -40,15 +40,7 @@ COORDS = ("x_min", "y_min", "x_max", "y_max")
 def _load(file: Path):
     if file.suffix.lower() == ".json":
         return read_json(file)
-    try:
-        with open(file, encoding="utf-8") as fh:
-            return yaml.load(fh, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
-    except FileNotFoundError:
-        raise DatasetError(file, "file not found") from None
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        raise DatasetError(file, "not valid YAML",
-                           f"line {mark.line + 1}" if mark else "") from None
+    return read_yaml(file)
 
 
 def _is_bosch(data) -> bool:

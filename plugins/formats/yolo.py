@@ -18,6 +18,7 @@ import yaml
 
 from tsrkit.atomic import atomic_open
 from tsrkit.datasets import DatasetError
+from tsrkit.datasets.errors import read_yaml
 from tsrkit.datasets.imagesize import image_size
 from tsrkit.hookspecs import hookimpl
 from tsrkit.inputs import IMAGE_EXTENSIONS
@@ -36,14 +37,7 @@ def _data_yaml(path: Path) -> Path:
 
 def read_data_yaml(file: Path) -> dict:
     """The parsed ``data.yaml``; a DatasetError when it is not YAML or has no ``names``."""
-    try:
-        data = yaml.safe_load(file.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise DatasetError(file, "file not found") from None
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        raise DatasetError(file, "not valid YAML",
-                           f"line {mark.line + 1}" if mark else "") from None
+    data = read_yaml(file)
     if not isinstance(data, dict) or not isinstance(data.get("names"), (list, dict)):
         raise DatasetError(file, "expected a mapping with 'names' (list or id: name)", "names")
     return data

@@ -1,7 +1,14 @@
-"""The error a dataset reader raises for a file it cannot use, naming file, entry and problem."""
+"""The error a dataset reader raises for a file it cannot use, naming file, entry and problem.
+
+Also the YAML reading that registry and format readers share, so its errors read alike.
+"""
 from __future__ import annotations
 
 import os
+from pathlib import Path
+from typing import Any
+
+import yaml
 
 from tsrkit.errors import TsrkitError
 
@@ -29,3 +36,23 @@ class DatasetError(TsrkitError):
         self.where = where
         self.problem = problem
         super().__init__(": ".join(part for part in (self.path, where, problem) if part))
+
+
+def read_yaml(path: str | os.PathLike, missing: str = "file not found") -> Any:
+    """Parse a YAML file with the C loader when available.
+
+    Raises
+    ------
+    DatasetError
+        ``missing`` when the file does not exist; "not valid YAML" with the line otherwise.
+    """
+    path = Path(path)
+    try:
+        with open(path, encoding="utf-8") as fh:
+            return yaml.load(fh, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
+    except FileNotFoundError:
+        raise DatasetError(path, missing) from None
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        raise DatasetError(path, f"not valid YAML ({getattr(exc, 'problem', None) or exc})",
+                           f"line {mark.line + 1}" if mark else "") from None

@@ -12,9 +12,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import yaml
 
-from tsrkit.datasets.errors import DatasetError
+from tsrkit.datasets.errors import DatasetError, read_yaml
 from tsrkit.datasets.states import check_mapping
 
 REGISTRY_ENV = "TSRKIT_DATASETS_YAML"
@@ -104,15 +103,7 @@ def load_registry(path: str | os.PathLike | None = None) -> dict[str, DatasetEnt
         Naming the file, the entry and the problem (missing key, unknown box convention...).
     """
     path = Path(path) if path is not None else registry_path()
-    try:
-        data = yaml.safe_load(path.read_text(encoding="utf-8")) or {}
-    except FileNotFoundError:
-        raise DatasetError(path, f"dataset registry not found (set ${REGISTRY_ENV})") from None
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f"line {mark.line + 1}" if mark else ""
-        raise DatasetError(path, f"not valid YAML ({getattr(exc, 'problem', exc)})",
-                           where) from None
+    data = read_yaml(path, f"dataset registry not found (set ${REGISTRY_ENV})") or {}
     datasets = data.get("datasets") if isinstance(data, Mapping) else None
     if not isinstance(datasets, Mapping):
         raise DatasetError(path, "expected a top-level 'datasets:' mapping")
