@@ -40,6 +40,8 @@ WEIGHTS = ((1, 1, 1), (1, 1, 2), (1, 1, 3), (1, 1, 4), (1, 2, 1), (1, 3, 1), (1,
 LENS_SHARE = {"lens": 0.5, "housing": 0.4}
 #: Radius bins of the trimmed Table 5-2 (inclusive pixel ranges of the max target radius).
 RADIUS_BINS = ((0, 2), (3, 4), (5, 6), (7, 10), (11, 20), (21, 40), (41, 10 ** 6))
+#: Candidate budgets of the equal-budget table (top k candidates per frame by score).
+BUDGETS = (1, 3, 5)
 #: A lighting class needs this many tuning frames before its weights move off the default.
 MIN_TUNE_FRAMES = 5
 
@@ -104,17 +106,36 @@ def make_detectors(radii: list[int] | None) -> list[tsrkit.Detector]:
             tsrkit.detector("lab-frst", radii=radii)]
 
 
-def frame_scores(dataset: tsrkit.Dataset, jsonl: Path) -> dict[int, FrameScore]:
-    """Zheng 5.2.1 scores of every frame of a run, read back from its detections.jsonl."""
+def frame_scores(dataset: tsrkit.Dataset, jsonl: Path,
+                 top: int | None = None) -> dict[int, FrameScore]:
+    """Zheng 5.2.1 scores of every frame of a run, read back from its detections.jsonl;
+    with ``top``, only each frame's ``top`` highest-scored candidates count."""
     scores = {}
     with open(jsonl, encoding="utf-8") as fh:
         for line in fh:
             record = json.loads(line)
             sample = dataset.samples[record["frame"]]
-            points = [(d["x"], d["y"]) for d in record["detections"]]
-            scores[record["frame"]] = score_frame(points, [a.bbox for a in sample.annotations],
+            kept = sorted(record["detections"], key=lambda d: -d["score"])[:top]
+            scores[record["frame"]] = score_frame([(d["x"], d["y"]) for d in kept],
+                                                  [a.bbox for a in sample.annotations],
                                                   record["lighting"])
     return scores
+
+
+def budget_table(dataset: tsrkit.Dataset, out: Path) -> str:
+    """Recall / precision / hit when every method may report only its top k candidates, so
+    that a method emitting more candidates does not win recall by volume alone; the last
+    column is the paired recall test of conspicuity against lab-frst at that budget."""
+    rows = []
+    for top in BUDGETS:
+        runs = {name: frame_scores(dataset, out / name / "detections.jsonl", top)
+                for name in DETECTORS}
+        test = _paired(runs["conspicuity"], runs["lab-frst"], "conspicuity", "lab-frst",
+                       "recall")
+        rows.append([str(top)] + [triple(list(r.values())) for r in runs.values()]
+                    + [f"{test[-1]} (p = {test[-2]})"])
+    return markdown_table(["top k"] + [f"{name} R / P / hit" for name in DETECTORS]
+                          + ["recall, conspicuity vs lab-frst"], rows)
 
 
 def radius_bin(radius: int) -> str:
@@ -204,6 +225,8 @@ def comparison_section(title: str, study: StudySet, dataset: tsrkit.Dataset,
     plots = ", ".join(f"`{out / name / 'plots' / 'recall_fpr_bubbles.png'}`" for name in runs)
     return [f"### {title}: {study.label} ({len(dataset)} frames, {study.box} boxes; {rad})", "",
             headline_table(reports), "", category_table(runs), "",
+            "At most k candidates per frame (each method's highest scores):", "",
+            budget_table(dataset, out), "",
             markdown_table(PAIRED_HEADER, paired_rows(runs)), "",
             f"Figure 5-1 bubbles: {plots}", ""]
 
