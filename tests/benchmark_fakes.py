@@ -9,6 +9,7 @@ import time
 
 import numpy as np
 
+from tsrkit.errors import TsrkitError
 from tsrkit.hookspecs import hookimpl
 from tsrkit.params import Param
 from tsrkit.plugin import Classifier, Detector
@@ -47,10 +48,19 @@ class RedClassifier(Classifier):
         return [Detection(c, "red", scores) for c in candidates]
 
 
+class UntrainedDetector(Detector):
+    name = "untrained"
+    summary = "like a trainable detector run without its model: a TsrkitError on every frame"
+
+    def detect(self, frame):
+        raise TsrkitError("untrained needs a model: pass --param model=M")
+
+
 @hookimpl
 def register_detectors(register):
     register(OracleDetector)
     register(ShiftedDetector)
+    register(UntrainedDetector)
 
 
 @hookimpl

@@ -63,3 +63,13 @@ def test_bare_tsrkit_compares_the_defaults_into_tsrkit_out(fakes, tmp_path, monk
     comparison = json.loads((tmp_path / "tsrkit-out" / "compare.json").read_text())
     assert comparison["dataset"] == "sample"
     assert [t["verdict"] for t in comparison["paired_tests"]] == ["oracle better"]
+
+
+@pytest.mark.parametrize("workers", ["1", "2"])
+def test_setup_error_from_a_plugin_stops_the_run(fakes, tmp_path, workers):
+    """A TsrkitError from a plugin (e.g. no model) ends the run with one line, in workers too."""
+    result = CliRunner().invoke(cli, ["benchmark", "-d", "untrained", "--workers", workers,
+                                      "--quiet", "--out", str(tmp_path)])
+    assert result.exit_code == 2
+    assert result.stderr.strip() == "Error: untrained needs a model: pass --param model=M"
+    assert not (tmp_path / "report.json").exists()

@@ -106,3 +106,31 @@ def test_plugins_json_lists_name_kind_package_version_summary(example_plugin):
     assert entry["kind"] == "detector" and entry["package"] == "tsrkit-brightest-blobs"
     assert entry["version"] == "0.1.0" and entry["summary"].startswith("Brightest")
     assert [p["name"] for p in entry["params"]] == ["percentile", "top", "min_area"]
+
+
+@pytest.fixture
+def needs_model(registry):
+    """A detector that, like a trainable one without its model, raises TsrkitError on use."""
+    import tsrkit
+    from tsrkit.hookspecs import hookimpl
+
+    class NeedsModel(tsrkit.Detector):
+        name = "needs-model"
+
+        def detect(self, frame):
+            raise tsrkit.TsrkitError("needs-model needs a model: pass --param model=M")
+
+    class Plugin:
+        @hookimpl
+        def register_detectors(register):
+            register(NeedsModel)
+
+    registry.add(Plugin, "needs-model")
+
+
+def test_setup_error_from_a_plugin_stops_detect_with_one_line(needs_model, mixed_folder):
+    result = CliRunner().invoke(cli, ["detect", str(mixed_folder), "-d", "needs-model"])
+    assert result.exit_code == 2
+    assert result.stderr.strip() == "Error: needs-model needs a model: pass --param model=M"
+    assert result.stdout == ""
+

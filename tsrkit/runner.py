@@ -125,6 +125,8 @@ def _compute(sample: Sample, job: Job) -> dict[str, Any]:
             ms, detections = result.ms, result.detections
         else:
             ms, detections = _classify_annotations(job.classifier, frame, sample)
+    except TsrkitError:  # a setup problem (missing model...) would recur on every frame
+        raise
     except Exception as exc:  # a crashing plugin costs one frame, not the run
         return {"source": sample.source, "skipped": f"plugin error: {type(exc).__name__}: {exc}"}
     return {"source": sample.source, "width": frame.width, "height": frame.height, "ms": ms,

@@ -13,6 +13,7 @@ from rich.console import Console
 from tsrkit.atomic import atomic_open
 from tsrkit.cli.common import build_pipeline, plugin_options
 from tsrkit.draw import draw_detections
+from tsrkit.errors import TsrkitError
 from tsrkit.inputs import iter_frames
 from tsrkit.pipeline import Pipeline
 from tsrkit.types import Frame, Skipped
@@ -22,7 +23,8 @@ def run_detect(pipeline: Pipeline, paths, out, draw: Path | None = None, every: 
                start: int = 0, end: int | None = None) -> tuple[int, int, list[Skipped]]:
     """Write one JSON Lines record per frame to the text stream ``out``.
 
-    A frame on which a plugin raises is reported as skipped and the run goes on.
+    A frame on which a plugin crashes is reported as skipped and the run goes on; a
+    :class:`TsrkitError` from a plugin (a setup problem such as a mismatched model) stops it.
 
     Returns
     -------
@@ -36,6 +38,8 @@ def run_detect(pipeline: Pipeline, paths, out, draw: Path | None = None, every: 
             continue
         try:
             result = pipeline.process(item)
+        except TsrkitError:  # a setup problem (missing model...) would recur on every frame
+            raise
         except Exception as exc:  # a crashing plugin costs one frame, not the run
             skipped.append(Skipped(_label(item), f"plugin error: {type(exc).__name__}: {exc}"))
             continue
