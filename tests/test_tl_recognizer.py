@@ -36,10 +36,16 @@ def detector(**params) -> TlRecognizer:
     return tsrkit.detector("tl-recognizer", **params)
 
 
+def lens_detector(**params) -> TlRecognizer:
+    """The paper's bare-MBR validation against a lit disc: the bare discs drawn below are lenses
+    without housing, which the default housing context rightly does not accept."""
+    return detector(context="lens", **params)
+
+
 @pytest.mark.parametrize("state", ["green", "red", "yellow"])
 def test_lit_disc_found_with_its_state(state):
     image = lit_disc(scene(), (160, 100), 12, LIT[state])
-    found = detector(resize_factor=1).detect(Frame(image, "synthetic"))
+    found = lens_detector(resize_factor=1).detect(Frame(image, "synthetic"))
     assert len(found) == 1
     c = found[0]
     assert c.state == state
@@ -51,7 +57,7 @@ def test_three_lights_in_one_frame_each_get_their_state():
     image = scene()
     for (x, state) in zip((60, 160, 260), ("red", "yellow", "green")):
         lit_disc(image, (x, 120), 10, LIT[state])
-    found = detector(resize_factor=2).detect(Frame(image, "synthetic"))
+    found = lens_detector(resize_factor=2).detect(Frame(image, "synthetic"))
     assert sorted((round(c.x / 100), c.state) for c in found) == [
         (1, "red"), (2, "yellow"), (3, "green")]
 
@@ -60,7 +66,7 @@ def test_lamps_pass_extraction_but_fail_validation():
     image = scene()
     cv2.rectangle(image, (40, 60), (100, 100), SODIUM, thickness=-1)       # sodium luminaire
     cv2.rectangle(image, (200, 60), (250, 95), WARM_WHITE, thickness=-1)   # white lamp panel
-    det = detector(resize_factor=1)
+    det = lens_detector(resize_factor=1)
     scored = det.scored(Frame(image, "synthetic"))
     assert len(scored) == 2  # both survive extraction and pruning...
     assert all(c.score <= det.threshold for c in scored)  # ...and validation rejects them
@@ -157,13 +163,13 @@ def f_over(focal, distance):
 ])
 def test_metadata_pruning_by_distance(distance, height, kept):
     frame = metric_frame(distance, height, "green")
-    found = detector(resize_factor=1).detect(frame)
+    found = lens_detector(resize_factor=1).detect(frame)
     assert (len(found) == 1) == kept
 
 
 def test_rolled_frame_is_levelled_before_pruning():
     frame = metric_frame(8.0, 2.0, "red", roll_deg=20.0)
-    found = detector(resize_factor=1).detect(frame)
+    found = lens_detector(resize_factor=1).detect(frame)
     assert [c.state for c in found] == ["red"]
 
 
@@ -171,7 +177,7 @@ def test_width_property_prunes_a_wide_blob_with_metadata():
     frame = metric_frame(8.0, 2.0, "green")
     image = frame.image.copy()
     cv2.ellipse(image, (100, 150), (30, 10), 0, 0, 360, LIT["green"], -1)
-    found = detector(resize_factor=1).detect(Frame(image, "s", metadata=frame.metadata))
+    found = lens_detector(resize_factor=1).detect(Frame(image, "s", metadata=frame.metadata))
     assert len(found) == 1 and abs(found[0].x - 320) < 2
 
 
@@ -190,7 +196,7 @@ def test_resize_factor_keeps_large_lights(factor):
     image = scene(480, 640)
     for (x, state) in zip((120, 320, 520), ("red", "yellow", "green")):
         lit_disc(image, (x, 200), 18, LIT[state])
-    found = sorted(detector(resize_factor=factor).detect(Frame(image, "synthetic")),
+    found = sorted(lens_detector(resize_factor=factor).detect(Frame(image, "synthetic")),
                    key=lambda c: c.x)
     assert [c.state for c in found] == ["red", "yellow", "green"]
     for c, x in zip(found, (120, 320, 520)):
@@ -202,7 +208,7 @@ def test_two_threads_give_the_same_result():
     for (x, state) in zip((60, 160, 260), ("red", "yellow", "green")):
         lit_disc(image, (x, 120), 10, LIT[state])
     frame = Frame(image, "synthetic")
-    assert detector(threads=2).detect(frame) == detector(threads=1).detect(frame)
+    assert lens_detector(threads=2).detect(frame) == lens_detector(threads=1).detect(frame)
 
 
 def synthetic_samples(n=6, seed=0):
@@ -220,7 +226,7 @@ def synthetic_samples(n=6, seed=0):
 
 
 def test_fit_tunes_threshold_and_ranges(tmp_path):
-    det = detector(resize_factor=1)
+    det = lens_detector(resize_factor=1)
     model = det.fit(synthetic_samples())
     ranges, threshold = model.arrays["ranges"], float(model.arrays["threshold"])
     # T is the best score of the sodium rectangle, which is below every light's score
@@ -231,7 +237,7 @@ def test_fit_tunes_threshold_and_ranges(tmp_path):
     assert 50 < ranges[0, 0, 0] <= hue <= ranges[0, 1, 0] < 115
     path = save_model(tmp_path / "m", model, plugin="tl-recognizer", plugin_version="t",
                       params=det.params, training={})
-    loaded = detector(model=str(path), resize_factor=1)  # T holds for the factor it was tuned at
+    loaded = lens_detector(model=str(path), resize_factor=1)  # T holds for the factor it was tuned at
     assert loaded.threshold == pytest.approx(threshold)
     assert np.array_equal(loaded.ranges, ranges)
     assert load_model(path, "tl-recognizer").info["threshold_from_data"] is True
@@ -256,7 +262,10 @@ def test_templates_folder_is_used_and_checked(tmp_path):
     for state in ("red", "yellow", "green"):
         cv2.imwrite(str(tmp_path / f"{state}.png"), disc_template(state, 20))
     det = detector(templates=str(tmp_path), template_size=24)
-    assert det.templates["green"].shape == (24, 24, 3)
+    assert det.templates["green", "vertical"].shape == (24 * 23 // 10, 24, 3)
+    assert det.templates["green", "horizontal"].shape == (24, 24 * 23 // 10, 3)
+    det = detector(templates=str(tmp_path), template_size=24, context="lens")
+    assert det.templates["green", "vertical"].shape == (24, 24, 3)
 
 
 def test_registered_and_listed_as_trainable():

@@ -2,7 +2,9 @@
 
 Per colour pass (green and "yellowRed", 4.1) the frame reduced by the resize factor (4.2) is range
 filtered in HSV (3.3, Table 6), its contours are levelled by the horizon roll and pruned by size
-(3.4), and each survivor's full-resolution patch is compared with a template by NCC (3.5).
+(3.4), and each survivor's full-resolution patch is compared with a template by NCC (3.5). By
+default the patch covers the 3-lens housing the lens implies (``context=housing``, see
+:mod:`tl_templates`); ``context=lens`` validates the bare contour MBR against a lit disc.
 """
 from __future__ import annotations
 
@@ -19,7 +21,8 @@ from tsrkit.plugin import Detector
 from tsrkit.types import Candidate, Frame
 
 from tsrkit_plugins.detectors import tl_geometry as geo
-from tsrkit_plugins.detectors.tl_templates import extract_patch, load_templates, ncc
+from tsrkit_plugins.detectors.tl_templates import (
+    ORIENTATIONS, Layout, extract_patch, load_templates, ncc, patch_box, patch_size)
 
 #: Filters of the ranges array: rows of ``ranges[k] = [[h, s, v]_min, [h, s, v]_max]``.
 FILTERS = ("green", "yellowred_first", "yellowred_second")
@@ -105,8 +108,18 @@ class TlRecognizer(Detector):
         Param("template_size", "int", 32, min=4, max=256,
               help="side of the square templates in pixels", section="3.5"),
         Param("templates", "path", None,
-              help="folder with red.*, yellow.*, green.* template images (default: lit discs)",
-              section="3.5"),
+              help="folder with red.*, yellow.*, green.* template images, resized to the patch "
+                   "(default: generated housings or lit discs)", section="3.5"),
+        Param("context", "str", "housing", choices=("housing", "lens"),
+              help="validate the 3-lens housing the lens implies, or the bare lens MBR",
+              section="3.5, Figs. 5, 6, 15e"),
+        Param("orientation", "str", "vertical", choices=("vertical", "horizontal", "both"),
+              help="housing orientation (red top/left, green bottom/right); both: better score",
+              section="2.4"),
+        Param("lens_pitch", "float", 1.3, min=1,
+              help="centre distance of neighbouring lenses in lens diameters (housing context)"),
+        Param("margin", "float", 0.5, min=0,
+              help="margin around the housing in lens diameters (housing context)"),
         Param("focal_px", "float", None, min=1,
               help="focal length in pixels, if frames lack metadata 'focal_px'", section="3.4"),
         Param("pitch_deg", "float", 0.0, min=-90, max=90,
@@ -146,7 +159,10 @@ class TlRecognizer(Detector):
             model = load_model(p["model"], plugin=self.name)
             self.ranges = np.asarray(model.arrays["ranges"], dtype=np.float64)
             self.threshold = float(model.arrays["threshold"])
-        self.templates = load_templates(p["templates"], p["template_size"])
+        self.layout = Layout(p["context"] == "housing", p["template_size"], p["lens_pitch"],
+                             p["margin"])
+        self.orientations = ORIENTATIONS if p["orientation"] == "both" else (p["orientation"],)
+        self.templates = load_templates(p["templates"], self.layout)
 
     def camera(self, frame: Frame) -> Camera:
         """Focal length, pitch and roll from the frame's metadata, else from the parameters."""
@@ -214,18 +230,30 @@ class TlRecognizer(Detector):
 
     def _validate(self, image: np.ndarray, box_uv, colour: str, roll: float,
                   centre: tuple[float, float]) -> Candidate:
-        """Patch, red/yellow split and NCC with the colour's template (3.5, 4.1)."""
-        patch = extract_patch(image, box_uv, roll, centre, self.params["template_size"])
+        """Red/yellow split on the lens patch, then NCC with the state's template (3.5, 4.1).
+
+        The candidate's box is the lens; its score the best over the allowed orientations.
+        """
+        size = self.params["template_size"]
         state = colour
         if colour == "yellowred":
-            state = red_or_yellow(patch, self.ranges[1, 0, 1], self.ranges[1, 0, 2],
+            lens = extract_patch(image, box_uv, roll, centre, size)
+            state = red_or_yellow(lens, self.ranges[1, 0, 1], self.ranges[1, 0, 2],
                                   self.params["red_h"], self.params["yellow_h"])
-        score = ncc(patch, self.templates[state])
+        score = max(self._orientation_score(image, box_uv, state, orientation, roll, centre)
+                    for orientation in self.orientations)
         u0, v0, u1, v1 = box_uv
         corners = geo.image_coordinates(np.array([[u0, v0], [u1, v0], [u1, v1], [u0, v1]]),
                                         roll, centre)
         (x0, y0), (x1, y1) = corners.min(axis=0), corners.max(axis=0)
         return Candidate.from_box((x0, y0, x1, y1), score, state)
+
+    def _orientation_score(self, image: np.ndarray, box_uv, state: str, orientation: str,
+                           roll: float, centre: tuple[float, float]) -> float:
+        """NCC of the patch a lens of ``state`` implies in a head of ``orientation``."""
+        box = patch_box(box_uv, state, orientation, self.layout)
+        patch = extract_patch(image, box, roll, centre, patch_size(orientation, self.layout))
+        return ncc(patch, self.templates[state, orientation])
 
     def fit(self, samples) -> Model:
         """Derive range bounds (Figure 16) and T (5.2) from annotated samples."""
