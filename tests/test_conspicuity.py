@@ -222,3 +222,11 @@ def test_map_does_not_depend_on_how_the_rows_are_split_into_runs():
     partial = cs.products_on_runs(tables, pad, pieces[pieces[:, 1] == 7], list(range(1, 11)),
                                   (1.0, 1.0, 1.0), 0, "max")
     assert np.array_equal(partial[0][:, 7], whole[0][:, 7]) and not partial[0][:, 8:].any()
+
+
+def test_unusable_settings_fail_at_construction_as_a_parameter_error():
+    import tsrkit
+    from tsrkit.params import ParamError
+
+    with pytest.raises(ParamError, match="detector 'conspicuity': weights must be"):
+        tsrkit.detector("conspicuity", weights=(0, 0, 0))

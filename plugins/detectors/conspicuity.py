@@ -40,7 +40,7 @@ import cv2
 import numpy as np
 
 from tsrkit.hookspecs import hookimpl
-from tsrkit.params import Param
+from tsrkit.params import Param, ParamError
 from tsrkit.plugin import Detector
 from tsrkit.types import Candidate, Frame
 from tsrkit_plugins.detectors.conspicuity_kernel import (LIGHT_PREFIX, SAT_PREFIX, best_products,
@@ -335,10 +335,19 @@ class Conspicuity(Detector):
         ROI_PARAM,
     ) + LOCALIZATION_PARAMS
 
+    def __init__(self, **params):
+        super().__init__(**params)
+        p = self.params
+        try:
+            check_settings(p["radii"], p["weights"], p["margin"])
+        except ValueError as exc:
+            raise ParamError(f"detector 'conspicuity': {exc}") from None
+        # Load the compiled kernel now, so that the first frame's time is the detector's own.
+        conspicuity_map(np.zeros((4, 4, 3), np.uint8), (1,), p["weights"], 0, p["quadrant_rule"])
+
     def detect(self, frame: Frame) -> list[Candidate]:
         """Candidates, best first, each scored by its conspicuity with its arg-max radius."""
         p = self.params
-        check_settings(p["radii"], p["weights"], p["margin"])
         roi = region_of_interest(frame.image, p["roi_top"])
         cmap = conspicuity_map(roi, p["radii"], p["weights"], p["margin"], p["quadrant_rule"])
         return localize(cmap.values, p, radius_map=cmap.radius)
