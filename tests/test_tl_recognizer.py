@@ -73,6 +73,75 @@ def test_lamps_pass_extraction_but_fail_validation():
     assert det.detect(Frame(image, "synthetic")) == []
 
 
+DUSK_SKY = (90, 60, 50)
+LAMPS = {"sodium": SODIUM, "warm white": WARM_WHITE}
+
+
+def signal_head(image, centre, radius, state, horizontal=False):
+    """A 3-lens head (red top/left, green bottom/right) with ``state`` lit, pitch 1.3 diameters."""
+    k = ("red", "yellow", "green").index(state)
+    pitch, border = int(round(2.6 * radius)), radius // 2 - 1
+    first = np.array(centre) - (k * pitch if horizontal else 0, 0 if horizontal else k * pitch)
+    step = np.array((pitch, 0) if horizontal else (0, pitch))
+    end = first + 2 * step
+    cv2.rectangle(image, tuple(int(v) for v in first - radius - border),
+                  tuple(int(v) for v in end + radius + border), (20, 20, 20), -1)
+    for j in range(3):
+        lit_disc(image, tuple(int(v) for v in first + j * step), radius, (40, 40, 40))
+    return lit_disc(image, centre, radius, LIT[state])
+
+
+def street_lamp(image, centre, radius, colour):
+    """A round lamp on a thin dark pole."""
+    cv2.rectangle(image, (centre[0] - 2, centre[1]), (centre[0] + 2, image.shape[0]), (50, 50, 50),
+                  -1)
+    return lit_disc(image, centre, radius, colour)
+
+
+@pytest.mark.parametrize("horizontal", [False, True])
+@pytest.mark.parametrize("state", ["green", "red", "yellow"])
+def test_lit_lens_in_its_housing_is_accepted(state, horizontal):
+    image = signal_head(scene(background=DUSK_SKY), (160, 120), 10, state, horizontal)
+    det = detector(resize_factor=1, orientation="both" if horizontal else "vertical")
+    found = det.detect(Frame(image, "synthetic"))
+    assert [c.state for c in found] == [state]
+    assert abs(found[0].x - 160) <= 1.5 and abs(found[0].y - 120) <= 1.5
+    assert found[0].score > det.threshold + 0.1
+    # the vertical template does not fit a horizontal head
+    vertical = detector(resize_factor=1).scored(Frame(image, "synthetic"))
+    assert (vertical[0].score > det.threshold) != horizontal
+
+
+@pytest.mark.parametrize("lamp", sorted(LAMPS))
+def test_round_street_lamps_are_rejected_by_housing_validation(lamp):
+    hsv = cv2.cvtColor(np.uint8([[LAMPS[lamp]]]), cv2.COLOR_BGR2HSV)[0, 0]
+    assert hsv[0] <= 25 and hsv[1] >= 100 and hsv[2] >= 80      # inside the yellowRed filter
+    image = street_lamp(scene(background=DUSK_SKY), (160, 80), 10, LAMPS[lamp])
+    frame = Frame(image, "synthetic")
+    for orientation in ("vertical", "both"):
+        det = detector(resize_factor=1, orientation=orientation)
+        scored = det.scored(frame)
+        assert len(scored) == 1 and abs(scored[0].x - 160) <= 1.5   # extracted and pruned...
+        assert scored[0].score < det.threshold - 0.1                # ...but not a lens
+        assert det.detect(frame) == []
+    # the bare-lens reading of 3.5 scores the same lamp as high as a lens
+    assert lens_detector(resize_factor=1).scored(frame)[0].score > 0.586
+
+
+def test_housing_template_layout():
+    from tsrkit_plugins.detectors.tl_templates import Layout, housing_template, patch_box
+    layout = Layout(True, 20, pitch=1.5, margin=0.5)
+    t = housing_template("red", "vertical", layout)
+    assert t.shape == (20 * 5 // 2, 20, 3)           # along (2 * 1.5 + 1 + 1) / across 2
+    lens_row = 20 // 2                                 # red lens centred 1 diameter from the top
+    assert t[lens_row, 10, 2] > 200 and t[lens_row + 15, 10, 2] < 80   # lit red, dim yellow
+    assert t[1, 1].min() > 150 and t[lens_row, 3].max() < 40          # surround, screen
+    assert np.array_equal(housing_template("red", "horizontal", layout), t.transpose(1, 0, 2))
+    # green at the bottom: the patch reaches two pitches above the lens
+    assert patch_box((-5, -5, 5, 5), "green", "vertical", layout) == (-10, -40, 10, 10)
+    assert patch_box((-5, -5, 5, 5), "red", "horizontal", layout) == (-10, -10, 40, 10)
+
+
 def test_white_lamp_without_tint_never_passes_the_range_filter():
     image = lit_disc(scene(), (160, 120), 15, (250, 250, 250))
     assert detector(resize_factor=1).scored(Frame(image, "synthetic")) == []
