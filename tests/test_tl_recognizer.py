@@ -306,7 +306,8 @@ def test_fit_tunes_threshold_and_ranges(tmp_path):
     assert 50 < ranges[0, 0, 0] <= hue <= ranges[0, 1, 0] < 115
     path = save_model(tmp_path / "m", model, plugin="tl-recognizer", plugin_version="t",
                       params=det.params, training={})
-    loaded = lens_detector(model=str(path), resize_factor=1)  # T holds for the factor it was tuned at
+    # T holds for the resize factor it was tuned at
+    loaded = lens_detector(model=str(path), resize_factor=1)
     assert loaded.threshold == pytest.approx(threshold)
     assert np.array_equal(loaded.ranges, ranges)
     assert load_model(path, "tl-recognizer").info["threshold_from_data"] is True
