@@ -105,6 +105,7 @@ def _finish(image: np.ndarray, sigma: float) -> np.ndarray:
 
 
 def _check_state(state: str, size: int) -> None:
+    """Raise ValueError for a state without a default template or a size under 4 pixels."""
     if state not in LENS_BGR:
         raise ValueError(f"no default template for state {state!r}; expected one of "
                          f"{', '.join(TEMPLATE_STATES)}")
