@@ -33,13 +33,18 @@ def lit_disc(image, centre, radius, colour):
 
 
 def detector(**params) -> TlRecognizer:
-    return tsrkit.detector("tl-recognizer", **params)
+    """Housing-context validation (``context=housing``), unless the test says otherwise."""
+    return tsrkit.detector("tl-recognizer", **{"context": "housing", **params})
 
 
 def lens_detector(**params) -> TlRecognizer:
-    """The paper's bare-MBR validation against a lit disc: the bare discs drawn below are lenses
-    without housing, which the default housing context rightly does not accept."""
+    """The paper's bare-MBR validation against a lit disc (the plugin's default): the bare discs
+    drawn below are lenses without housing, which the housing context rightly does not accept."""
     return detector(context="lens", **params)
+
+
+def test_default_context_is_the_papers_bare_lens():
+    assert tsrkit.detector("tl-recognizer").params["context"] == "lens"
 
 
 @pytest.mark.parametrize("state", ["green", "red", "yellow"])
