@@ -106,3 +106,15 @@ def test_model_round_trip_and_wrong_models(tmp_path, model_path):
     with pytest.raises(ModelError, match="corrupt"):
         make(model=str(tmp_path / "bad")).classify(frame, cands)
 
+
+
+def test_warm_red_prior_reads_orange_red_as_red(tmp_path):
+    classifier = make(smooth=4)
+    path = tmp_path / "smooth"
+    save_model(path, classifier.fit(training_set()), plugin="ab-hist", plugin_version="t",
+               params=classifier.params, training={})
+    orange_red = lamp((10, 150, 240), size=40, radius=8, seed=4)  # a-b angle 70, red 34, yellow 90
+    cand = [Candidate.from_circle(20, 20, 8, 1.0)]
+    states = {prior: make(model=str(path), smooth=4, red_prior=prior)
+              .classify(Frame(orange_red, "t"), cand)[0].state for prior in (True, False)}
+    assert states == {True: "red", False: "yellow"}

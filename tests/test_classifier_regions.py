@@ -117,3 +117,10 @@ def test_shipped_models_classify_real_mit_housing_crops(shared_datasets, name):
             right += classifier.classify(Frame(image, str(path)), [box])[0].state == state
             total += 1
     assert total == 80 and right / total >= 0.85
+
+
+def test_find_lens_passes_over_blue_sky():
+    image = housing(COLOURS["green"], 2)
+    image[:20] = (235, 190, 90)  # bright saturated sky blue where the top lens would be
+    lens = find_lens(image, (0, 0, 20, 60))
+    assert abs(lens.y - 50) <= 2

@@ -67,12 +67,21 @@ def test_low_pass_weights_the_previous_frame():
 
 @pytest.mark.parametrize("state", ["red", "yellow", "green"])
 def test_pure_disks_get_their_state(model_path, state):
-    classifier = make(model=str(model_path))
-    det = classify_one(classifier, lamp(COLOURS[state], size=40, radius=8, seed=4),
-                       Candidate.from_circle(20, 20, 8, 1.0))
+    image = lamp(COLOURS[state], size=40, radius=8, seed=4)
+    cand = Candidate.from_circle(20, 20, 8, 1.0)
+    assert classify_one(make(model=str(model_path)), image, cand).state == state
+    det = classify_one(make(model=str(model_path), red_prior=False), image, cand)
     assert det.state == state
     others = [v for k, v in det.state_scores.items() if k != state]
     assert max(others) < 0.5 * det.state_scores[state]
+
+
+def test_warm_red_prior_reads_orange_red_as_red(model_path):
+    orange_red = lamp((10, 120, 240), size=40, radius=8, seed=4)  # OpenCV hue 14
+    cand = Candidate.from_circle(20, 20, 8, 1.0)
+    assert classify_one(make(model=str(model_path)), orange_red, cand).state == "red"
+    assert classify_one(make(model=str(model_path), red_prior=False), orange_red,
+                        cand).state == "yellow"
 
 
 @pytest.mark.parametrize("lit,state", [(0, "red"), (1, "yellow"), (2, "green")])

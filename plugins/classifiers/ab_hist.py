@@ -16,6 +16,7 @@ from tsrkit.params import Param
 from tsrkit.plugin import Classifier
 from tsrkit.types import Candidate, Detection, Frame, Sample
 from tsrkit_plugins.classifiers.decision import UNKNOWN, best_state, discriminative_ratio
+from tsrkit_plugins.classifiers.priors import warm_red
 from tsrkit_plugins.classifiers.regions import REGION_PARAMS, labelled_lenses, lens_of, rings
 
 DEFAULT_MODEL = Path(__file__).parent / "models" / "ab_hist_default"
@@ -37,6 +38,13 @@ def smooth_histogram(h: np.ndarray, sigma: float) -> np.ndarray:
     """Gaussian blur of a histogram by ``sigma`` bins (0: unchanged), so that nearby a-b
     colours of another camera still overlap the trained ones."""
     return cv2.GaussianBlur(h, (0, 0), sigma, borderType=cv2.BORDER_CONSTANT) if sigma else h
+
+
+def bin_angles(bins: int) -> np.ndarray:
+    """The a-b hue angle, in degrees [0, 360), of every bin centre of a ``bins`` x ``bins``
+    histogram (a along rows, b along columns)."""
+    centre = (np.arange(bins) + 0.5) * 256.0 / bins - 128.0
+    return np.mod(np.degrees(np.arctan2(centre[None, :], centre[:, None])), 360.0)
 
 
 def similarity(h: np.ndarray, h_ref: np.ndarray) -> float:
@@ -107,31 +115,41 @@ class AbHist(Classifier):
         Param("min_chroma", "float", 10.0, min=0.0, max=180.0, help="leave pixels of lower "
               "CIELab chroma (grey housing, white-hot centres) out of the histograms; 0 keeps "
               "every pixel as Zheng does"),
-        Param("smooth", "float", 3.0, min=0.0, max=16.0, help="Gaussian sigma, in bins, "
+        Param("smooth", "float", 1.0, min=0.0, max=16.0, help="Gaussian sigma, in bins, "
               "applied to every histogram before matching; 0 matches raw histograms as Zheng "
               "does"),
+        Param("red_prior", "bool", True, help="warm-red prior: a-b angles between the trained "
+              "red and yellow modes count as red (see priors.py); off: Zheng's histograms as "
+              "trained"),
         Param("min_ratio", "float", 0.0, min=0.0, max=1.0, help="discriminative ratio below "
               "which the state is unknown", section="5.3"),
     ) + REGION_PARAMS
 
     def __init__(self, **params):
         super().__init__(**params)
-        self._model: Model | None = None
+        self._trained: np.ndarray | None = None
 
     @property
-    def model(self) -> Model:
-        """The trained histograms, loaded on first use."""
-        if self._model is None:
-            self._model = load_model(self.params["model"] or DEFAULT_MODEL, plugin=self.name)
-            hist = self._model.arrays.get("histograms")
+    def trained(self) -> np.ndarray:
+        """The trained histograms, one per state, loaded on first use (with the warm-red
+        prior applied when ``red_prior`` is set)."""
+        if self._trained is None:
+            model = load_model(self.params["model"] or DEFAULT_MODEL, plugin=self.name)
+            hist = model.arrays.get("histograms")
             if hist is None or hist.ndim != 3 or hist.shape[0] != len(self.states):
                 raise ModelError(f"model {self.params['model'] or DEFAULT_MODEL}: expected "
                                  f"'histograms' of shape ({len(self.states)}, bins, bins)")
-        return self._model
+            if self.params["red_prior"]:
+                red, yellow = self.states.index("red"), self.states.index("yellow")
+                hist = hist.copy()
+                hist[red], hist[yellow] = warm_red(hist[red], hist[yellow],
+                                                   bin_angles(hist.shape[1]))
+            self._trained = hist
+        return self._trained
 
     def scores(self, image: np.ndarray, lens: Candidate) -> dict[str, float]:
         """Eq. 3.19 score of every colour for one lens."""
-        trained = self.model.arrays["histograms"]
+        trained = self.trained
         a1, a3, a1_saturated = lens_histograms(image, lens, trained.shape[1],
                                                  self.params["min_chroma"], self.params["smooth"])
         return {state: colour_score(a1, a3, a1_saturated, trained[i], self.params["mode"])

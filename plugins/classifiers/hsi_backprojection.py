@@ -18,12 +18,15 @@ from tsrkit.params import Param
 from tsrkit.plugin import Classifier
 from tsrkit.types import Candidate, Detection, Frame, Sample
 from tsrkit_plugins.classifiers.decision import UNKNOWN, best_state, fuse_lights
+from tsrkit_plugins.classifiers.priors import warm_red
 from tsrkit_plugins.classifiers.regions import (REGION_PARAMS, clip_box, disk_kernel, is_housing,
                                                 labelled_lenses, rings)
 
 DEFAULT_MODEL = Path(__file__).parent / "models" / "hsi_backprojection_default"
 #: OpenCV 8-bit HSV ranges: hue 0-179, saturation and value 0-255 (Lee 5.3.3).
 HUE_BINS, SV_BINS = 180, 256
+#: The hue angle, in degrees, of every OpenCV hue bin.
+HUE_ANGLES = np.arange(HUE_BINS) * 2.0
 
 
 def scaled_histogram(values: np.ndarray, bins: int) -> np.ndarray:
@@ -101,6 +104,8 @@ class HsiBackprojection(Classifier):
               "sample; 0: the smallest lens of the training set (Lee 5.3.3)", section="5.3.3"),
         Param("hue_smooth", "float", 5.0, min=0.0, max=30.0, help="circular Gaussian sigma, "
               "in hue bins, applied to the trained hue histograms (0: Lee's raw histograms)"),
+        Param("red_prior", "bool", True, help="warm-red prior: hues between the trained red "
+              "and yellow modes count as red (see priors.py); off: Lee's histograms as trained"),
         Param("threshold", "float", 0.0, min=0.0, max=1.0, help="unknown when the best state's "
               "probability is below this (t of 5.3.4)", section="5.3.4"),
         Param("lens_size_m", "float", 0.15, min=0.0, help="D of Eq. 5.8 in metres (lens "
@@ -118,15 +123,22 @@ class HsiBackprojection(Classifier):
 
     @property
     def model(self) -> Model:
-        """The trained histograms, loaded on first use."""
+        """The trained histograms, loaded on first use (the hue histograms under the warm-red
+        prior when ``red_prior`` is set)."""
         if self._model is None:
             path = self.params["model"] or DEFAULT_MODEL
-            self._model = load_model(path, plugin=self.name)
-            shapes = {k: v.shape for k, v in self._model.arrays.items()}
+            model = load_model(path, plugin=self.name)
+            shapes = {k: v.shape for k, v in model.arrays.items()}
             if shapes.get("hue") != (len(self.states), HUE_BINS) or \
                     shapes.get("saturation") != (SV_BINS,) or shapes.get("intensity") != (SV_BINS,):
                 raise ModelError(f"model {path}: expected hue ({len(self.states)}, {HUE_BINS}), "
                                  f"saturation and intensity ({SV_BINS},); got {shapes}")
+            if self.params["red_prior"]:
+                hue = model.arrays["hue"].copy()
+                red, yellow = self.states.index("red"), self.states.index("yellow")
+                hue[red], hue[yellow] = warm_red(hue[red], hue[yellow], HUE_ANGLES)
+                model = Model({**model.arrays, "hue": hue}, model.info, model.meta)
+            self._model = model
         return self._model
 
     def filter_diameter(self, frame: Frame, candidate: Candidate, housing: bool) -> float:

@@ -2,7 +2,8 @@
 (Zheng 3.3, Eq. 3.17), and the lit lens inside a box that holds the whole signal housing.
 
 A housing box (KR, cinTA and MIT sets) is searched along its long axis for the disk with the
-highest mean HSV saturation x value^2, i.e. the most saturated bright disk: the lit lens.
+highest mean HSV saturation x value^2 over its non-blue pixels, i.e. the most saturated bright
+disk that is not sky or a blue housing: the lit lens.
 """
 from __future__ import annotations
 
@@ -81,12 +82,23 @@ def rings(image: np.ndarray, x: float, y: float, radius: float) -> Rings:
     return Rings(image[y0:y1, x0:x1], disk, annulus)
 
 
+def is_blue(bgr: np.ndarray) -> np.ndarray:
+    """Pixels whose CIELab a-b angle lies within 45 degrees of the -b axis (blue), a colour no
+    signal lamp has: green lamps sit near -150 degrees, sky and blue housings near -90 to -130.
+    """
+    lab = cv2.cvtColor(bgr, cv2.COLOR_BGR2LAB)
+    a = lab[..., 1].astype(np.int16) - 128
+    b = lab[..., 2].astype(np.int16) - 128
+    return -b > np.abs(a)
+
+
 def lit_map(bgr: np.ndarray) -> np.ndarray:
-    """Per-pixel HSV saturation x value^2 in [0, 1]: high on a lit, coloured lens (the squared
-    value keeps a bright lens ahead of a saturated but dimmer sky or housing)."""
+    """Per-pixel HSV saturation x value^2 in [0, 1], 0 on blue pixels: high on a lit, coloured
+    lens (the squared value keeps a bright lens ahead of a saturated but dimmer housing; blue
+    sky seen through or beside a housing is left out, see :func:`is_blue`)."""
     hsv = cv2.cvtColor(bgr, cv2.COLOR_BGR2HSV)
     v = hsv[..., 2].astype(np.float32) / 255.0
-    return hsv[..., 1].astype(np.float32) / 255.0 * v * v
+    return hsv[..., 1].astype(np.float32) / 255.0 * v * v * ~is_blue(bgr)
 
 
 def disk_kernel(radius: float) -> np.ndarray:
