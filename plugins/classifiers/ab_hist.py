@@ -115,7 +115,7 @@ class AbHist(Classifier):
         Param("min_chroma", "float", 10.0, min=0.0, max=180.0, help="leave pixels of lower "
               "CIELab chroma (grey housing, white-hot centres) out of the histograms; 0 keeps "
               "every pixel as Zheng does"),
-        Param("smooth", "float", 1.0, min=0.0, max=16.0, help="Gaussian sigma, in bins, "
+        Param("smooth", "float", 3.0, min=0.0, max=16.0, help="Gaussian sigma, in bins, "
               "applied to every histogram before matching; 0 matches raw histograms as Zheng "
               "does"),
         Param("red_prior", "bool", True, help="warm-red prior: a-b angles between the trained "
