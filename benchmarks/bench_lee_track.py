@@ -92,7 +92,7 @@ def trained_detector() -> AdaBoostHSV:
         samples.append(Sample(f"train-{i}", (Annotation(box, "orange"),), image=image))
         samples.append(Sample(f"empty-{i}", (), image=background(np.random.default_rng(i))))
     values = {p.name: p.default for p in AdaBoostHSV.params}
-    values.update(target="orange", min_size=10, max_boxes=1, threshold=0.9)
+    values.update(target="orange", labels="box", min_size=10, max_boxes=1, threshold=0.9)
     det = AdaBoostHSV(**values)
     det.use_model(det.fit(samples))
     return det

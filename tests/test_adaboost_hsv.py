@@ -1,6 +1,7 @@
 """adaboost-hsv: learning a colour on synthetic scenes, the lookup table, blobs, model I/O."""
 from __future__ import annotations
 
+import cv2
 import numpy as np
 import pytest
 
@@ -50,7 +51,7 @@ def make(**params):
 
 @pytest.fixture(scope="module")
 def trained():
-    det = make(n_estimators=20, min_size=5, max_boxes=3)
+    det = make(target="red", labels="box", n_estimators=20, min_size=5, max_boxes=3)
     model = det.fit(samples(1) + background_samples(11))
     det.use_model(model)
     return det, model
@@ -58,10 +59,10 @@ def trained():
 
 def test_learns_patch_to_near_perfect_pixel_accuracy(trained):
     det, model = trained
-    counts = ab.pixel_histograms(samples(2), "red", 50)
-    positive, negative = counts.positive, counts.negative
-    assert counts.images == counts.target_images == 6 and model.info["prior"] == 0.5
-    stumps = {k: model.arrays[k] for k in ab.STUMP_KEYS}
+    counts = ab.pixel_histograms(samples(2), ("red",), 50, "box")
+    positive, negative = counts.positive[0], counts.negative[0]
+    assert counts.images == counts.target_images[0] == 6 and model.info["priors"]["red"] == 0.5
+    stumps = {k: model.arrays[f"red_{k}"] for k in ab.STUMP_KEYS}
     f = ab.boosted_margin(ab.plane_features(), stumps)
     true_pos, true_neg = positive[f > 0].sum(), negative[f <= 0].sum()
     assert true_pos / positive.sum() > 0.99
@@ -96,12 +97,13 @@ def test_probability_is_monotone_in_margin():
 def test_table_lookup_equals_direct_evaluation(trained):
     det, model = trained
     image = samples(3, n=1)[0].image
-    stumps = {k: model.arrays[k] for k in ab.STUMP_KEYS}
+    stumps = {k: model.arrays[f"red_{k}"] for k in ab.STUMP_KEYS}
     hue, sat, val = ab.hsv_planes(image)
     direct = ab.posterior(ab.margin_probability(
-        ab.boosted_margin(ab.color_features(hue, sat), stumps)), model.info["prior"])
+        ab.boosted_margin(ab.color_features(hue, sat), stumps)), model.info["priors"]["red"])
     direct[val.ravel() < 50] = 0
-    fast = ab.probability_map(image, det.table(), 50)
+    fast, colour = ab.probability_map(image, det.table(), det._colour, 50)
+    assert not colour.any()
     np.testing.assert_allclose(fast.ravel(), direct, rtol=1e-6, atol=1e-7)
 
 
@@ -137,18 +139,91 @@ def test_model_round_trip(tmp_path, trained):
     det, model = trained
     path = save_model(tmp_path / "m", model, plugin="adaboost-hsv", plugin_version="0",
                       params=det.params, training={})
-    loaded = make(model=str(path), min_size=5, max_boxes=3)
+    loaded = make(model=str(path), target="red", min_size=5, max_boxes=3)
     image = samples(5, n=1)[0].image
     np.testing.assert_array_equal(loaded.table(), det.table())
     assert loaded.detect(Frame(image, "x")) == det.detect(Frame(image, "x"))
-    assert load_model(path, "adaboost-hsv").info["target"] == "red"
+    assert load_model(path, "adaboost-hsv").info["targets"] == ["red"]
 
 
 def test_errors():
-    with pytest.raises(TsrkitError, match="needs a model"):
-        make().detect(Frame(np.zeros((4, 4, 3), np.uint8), "x"))
     with pytest.raises(ValueError, match="target and background"):
         ab.fit_stumps(np.zeros(ab.LEVELS ** 2), np.ones(ab.LEVELS ** 2), 3, 0)
-    det, model = make(target="green"), make().fit(samples(1, n=2))
-    with pytest.raises(TsrkitError, match="detects 'red'"):
+    det, model = make(target="green"), make(target="red", labels="box").fit(samples(1, n=2))
+    with pytest.raises(TsrkitError, match="needs \\['green'\\]"):
         det.use_model(model)
+    with pytest.raises(ValueError, match="'box' or 'lens'"):
+        ab.box_target_mask(np.zeros((2, 2)), np.zeros((2, 2)), "ring", 50)
+
+
+def lit_housing(rng, lit, size=(30, 12)):
+    """A dark housing with three lenses: the ``lit`` one (0 top .. 2 bottom) bright and vivid."""
+    image = np.full((*size, 3), 40, np.uint8) + rng.integers(0, 10, (*size, 3)).astype(np.uint8)
+    colours = (RED, (20, 200, 240), GREEN)
+    for i, colour in enumerate(colours):
+        centre = (6, 5 + 10 * i)
+        shade = colour if i == lit else tuple(c // 8 for c in colour)
+        cv2.circle(image, centre, 3, shade, -1)
+    return image
+
+
+def test_lens_mask_finds_the_lit_lens_only():
+    rng = np.random.default_rng(0)
+    image = lit_housing(rng, lit=2)
+    _, sat, val = ab.hsv_planes(image)
+    mask = ab.lens_mask(sat, val, 50)
+    lens = np.zeros(mask.shape, bool)
+    cv2.circle(lens.view(np.uint8), (6, 25), 3, 1, -1)
+    assert (mask == lens).mean() > 0.97 and mask[lens].mean() > 0.9
+    assert not ab.lens_mask(sat, np.zeros_like(val), 50).any()
+
+
+def test_pixel_labels_lens_other_colours_and_hard_negatives():
+    rng = np.random.default_rng(1)
+    image = np.full((40, 40, 3), 120, np.uint8)
+    image[2:32, 2:14] = lit_housing(rng, lit=0)
+    image[2:32, 20:32] = lit_housing(rng, lit=2)
+    anns = (Annotation((2, 2, 14, 32), "red"), Annotation((20, 2, 32, 32), "green"))
+    _, sat, val = ab.hsv_planes(image)
+    (red_pos, red_neg), (green_pos, green_neg) = ab.pixel_labels(
+        sat, val, anns, ("red", "green"), "lens", False, 10)
+    assert red_pos[2:12, 2:14].sum() > 20 and not red_pos[12:].any() and not red_pos[:, 14:].any()
+    assert red_neg[green_pos].all() and green_neg[red_pos].all()
+    assert not red_neg[12:32, 2:14].any()
+    _, (_, hard) = ab.pixel_labels(sat, val, anns, ("red", "green"), "lens", True, 10)
+    assert hard[12:32, 2:14].sum() > 100 and not (hard & green_pos).any()
+    (box_pos, box_neg), = ab.pixel_labels(sat, val, anns, ("red",), "box", False, 10)
+    assert box_pos[2:32, 2:14].all() and not box_neg[2:32, 20:32].any()
+
+
+def test_lights_mode_gives_each_blob_its_colour():
+    rng = np.random.default_rng(2)
+    train = []
+    for i in range(6):
+        lit = i % 3
+        image = np.full((60, 60, 3), 110, np.uint8) + rng.integers(0, 20, (60, 60, 3)).astype(
+            np.uint8)
+        x, y = int(rng.integers(2, 44)), int(rng.integers(2, 26))
+        image[y:y + 30, x:x + 12] = lit_housing(rng, lit)
+        train.append(Sample(f"l{i}", (Annotation((x, y, x + 12, y + 30),
+                                                 ("red", "yellow", "green")[lit]),), image=image))
+    det = make(n_estimators=30, min_size=3, max_boxes=5, threshold=0.5)
+    det.use_model(det.fit(train))
+    scene_image = np.full((60, 90, 3), 110, np.uint8)
+    for k, lit in enumerate((2, 0, 1)):
+        scene_image[10:40, 5 + 30 * k:17 + 30 * k] = lit_housing(rng, lit)
+    found = sorted(det.detect(Frame(scene_image, "x")), key=lambda c: c.x)
+    assert [c.state for c in found] == ["green", "red", "yellow"]
+    assert [c.y for c in found] == [35.5, 15.5, 25.5]
+
+
+def test_shipped_default_model_detects_lights():
+    det = make()
+    assert det.params["model"] is None and det.colours == ("red", "yellow", "green")
+    image = np.full((80, 80, 3), 90, np.uint8)
+    cv2.circle(image, (20, 40), 6, (80, 60, 255), -1)  # lit red lenses lean to magenta
+    cv2.circle(image, (60, 40), 6, (120, 255, 60), -1)
+    found = sorted(det.detect(Frame(image, "x")), key=lambda c: c.x)
+    assert [c.state for c in found] == ["red", "green"]
+    info = load_model(ab.DEFAULT_MODEL, "adaboost-hsv").info
+    assert info["data_licence"] == "CC BY 4.0" and info["targets"] == ["red", "yellow", "green"]

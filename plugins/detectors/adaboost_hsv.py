@@ -2,12 +2,15 @@
 
 A boosted set of decision stumps scores every (hue, saturation) pair; the score becomes a
 probability, the probability map is thresholded, and connected blobs become candidate boxes.
-Lee 2017, section 3.2 (Eq. 3.1 and the two unnumbered equations after it).
+Lee 2017, section 3.2 (Eq. 3.1 and the two unnumbered equations after it). One model file holds
+one booster per colour; ``target=lights`` runs red, yellow and green together and gives each
+blob the colour whose posterior wins. Shipped default: ``models/adaboost_hsv_default``.
 """
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 import cv2
 import numpy as np
@@ -26,6 +29,11 @@ from tsrkit.types import STATES, Candidate, Frame, Sample
 #: OpenCV's full-range 8-bit hue and saturation both take 256 values.
 LEVELS = 256
 STUMP_KEYS = ("feature", "threshold", "left", "right", "alpha")
+#: The colours each ``target`` value trains and detects.
+TARGET_COLOURS = {"lights": ("red", "yellow", "green"), "red": ("red",),
+                  "yellow": ("yellow",), "green": ("green",), "orange": ("orange",)}
+#: Trained with ``tsrkit train adaboost-hsv`` on roboflow_cinta_v2_id (CC BY 4.0); see its JSON.
+DEFAULT_MODEL = Path(__file__).parent / "models" / "adaboost_hsv_default"
 
 
 def hsv_planes(image: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -59,49 +67,115 @@ def plane_features() -> np.ndarray:
 
 @dataclass(frozen=True)
 class PixelCounts:
-    """Target and background pixel counts over the (hue, saturation) plane, and image counts."""
+    """Per-colour target and background pixel counts over the (hue, saturation) plane.
+
+    ``positive`` and ``negative`` have shape (colours, 65536); ``target_images`` counts, per
+    colour, the images holding a box of that colour.
+    """
 
     positive: np.ndarray
     negative: np.ndarray
     images: int
-    target_images: int
+    target_images: np.ndarray
 
     @property
-    def image_prior(self) -> float:
-        """P(sign) of Eq. 3.1 read as the share of training images that hold a target box.
+    def image_priors(self) -> np.ndarray:
+        """P(sign) of Eq. 3.1 per colour, read as the share of training images with that colour.
 
         Clipped to [0.01, 0.99]: a training set of only target images (or none) would
         otherwise make every pixel certain.
         """
-        return float(np.clip(self.target_images / max(self.images, 1), 0.01, 0.99))
+        return np.clip(self.target_images / max(self.images, 1), 0.01, 0.99)
 
 
-def pixel_histograms(samples: Iterable[Sample], target: str, min_value: int) -> PixelCounts:
-    """Count target and background pixels over the (hue, saturation) plane.
+def lens_mask(sat: np.ndarray, val: np.ndarray, min_value: int) -> np.ndarray:
+    """The lit lens inside one box: the brightest saturated blob.
 
-    Target pixels lie inside a box whose state is ``target``; background pixels lie outside
-    every box; pixels inside boxes of other states are not used. Pixels darker than
-    ``min_value`` (V) are not used either: their hue is undefined. The histograms have 65536
-    cells, indexed by :func:`hs_index`.
+    Both Roboflow sets box the whole housing, so most of a box is dark housing or sky. Each
+    pixel is scored by ``S * V / 255`` (vivid and bright), the box's scores are split by Otsu's
+    threshold, and the largest 8-connected part above it is the lens. Pixels darker than
+    ``min_value`` never belong to it. A box with no usable pixel gives an empty mask.
     """
-    positive = np.zeros(LEVELS * LEVELS, np.int64)
+    usable = val >= min_value
+    if usable.sum() < 2:
+        return np.zeros(sat.shape, bool)
+    score = ((sat.astype(np.uint16) * val) // 255).astype(np.uint8)
+    cut, _ = cv2.threshold(score[usable].reshape(-1, 1), 0, 255,
+                           cv2.THRESH_BINARY | cv2.THRESH_OTSU)
+    bright = (score > cut) & usable
+    count, labels, stats, _ = cv2.connectedComponentsWithStats(bright.astype(np.uint8),
+                                                               connectivity=8)
+    if count < 2:
+        return bright
+    return labels == 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
+
+
+def box_target_mask(sat: np.ndarray, val: np.ndarray, labels: str,
+                    min_value: int) -> np.ndarray:
+    """Which pixels of one box are target pixels: all (``box``) or the lit lens (``lens``)."""
+    if labels == "box":
+        return np.ones(sat.shape, bool)
+    if labels == "lens":
+        return lens_mask(sat, val, min_value)
+    raise ValueError(f"pixel labelling must be 'box' or 'lens', not {labels!r}")
+
+
+def pixel_labels(sat: np.ndarray, val: np.ndarray, annotations, targets: Sequence[str],
+                 labels: str, hard_negatives: bool,
+                 min_value: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Target and background masks of one image, one pair per colour in ``targets``.
+
+    Target pixels of colour c: the :func:`box_target_mask` pixels of boxes whose state is c.
+    Background: pixels outside every box; with ``lens`` labelling also the lenses of other
+    colours' boxes; with ``hard_negatives`` also every box's non-target (unlit housing)
+    pixels. Pixels darker than ``min_value`` are neither (their hue is undefined).
+    """
+    outside = np.ones(sat.shape, bool)
+    unlit = np.zeros(sat.shape, bool)
+    lit: dict[str, np.ndarray] = {}
+    for ann in annotations:
+        region = _box_slice(ann.bbox, sat.shape)
+        target = box_target_mask(sat[region], val[region], labels, min_value)
+        outside[region] = False
+        lit.setdefault(ann.state, np.zeros(sat.shape, bool))[region] |= target
+        unlit[region] |= ~target
+    any_lit = np.logical_or.reduce(list(lit.values())) if lit else np.zeros(sat.shape, bool)
+    usable = val >= min_value
+    out = []
+    for colour in targets:
+        positive = lit.get(colour, np.zeros(sat.shape, bool)) & usable
+        negative = outside.copy()
+        if labels == "lens":
+            negative |= any_lit
+        if hard_negatives:
+            negative |= unlit & ~any_lit
+        out.append((positive, negative & usable & ~positive))
+    return out
+
+
+def pixel_histograms(samples: Iterable[Sample], targets: Sequence[str], min_value: int,
+                     labels: str = "lens", hard_negatives: bool = False) -> PixelCounts:
+    """Count each colour's target and background pixels over the (hue, saturation) plane.
+
+    One pass over ``samples``; the masks come from :func:`pixel_labels`. The histograms have
+    65536 cells, indexed by :func:`hs_index`.
+    """
+    cells = LEVELS * LEVELS
+    positive = np.zeros((len(targets), cells), np.int64)
     negative = np.zeros_like(positive)
-    images = target_images = 0
+    target_images = np.zeros(len(targets), np.int64)
+    images = 0
     for sample in samples:
         hue, sat, val = hsv_planes(sample.load().image)
-        inside = np.zeros(hue.shape, bool)
-        any_box = np.zeros(hue.shape, bool)
-        for ann in sample.annotations:
-            region = _box_slice(ann.bbox, hue.shape)
-            any_box[region] = True
-            if ann.state == target:
-                inside[region] = True
-        usable = val >= min_value
         index = hs_index(hue, sat)
-        positive += np.bincount(index[inside & usable], minlength=LEVELS * LEVELS)
-        negative += np.bincount(index[~any_box & usable], minlength=LEVELS * LEVELS)
+        masks = pixel_labels(sat, val, sample.annotations, targets, labels, hard_negatives,
+                             min_value)
+        for t, (pos, neg) in enumerate(masks):
+            positive[t] += np.bincount(index[pos], minlength=cells)
+            negative[t] += np.bincount(index[neg], minlength=cells)
+        states = {ann.state for ann in sample.annotations}
+        target_images += [colour in states for colour in targets]
         images += 1
-        target_images += any(ann.state == target for ann in sample.annotations)
     return PixelCounts(positive, negative, images, target_images)
 
 
@@ -200,12 +274,39 @@ def probability_table(stumps: dict[str, np.ndarray], prior: float) -> np.ndarray
                      prior).astype(np.float32)
 
 
-def probability_map(image: np.ndarray, table: np.ndarray, min_value: int) -> np.ndarray:
-    """Per-pixel target probability of a BGR image by table lookup; dark pixels get 0."""
+def winning_colour(tables: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per (hue, saturation) cell, the highest posterior over colours and that colour's index.
+
+    ``tables`` has shape (colours, 65536); returns the float32 maximum and the uint8 argmax.
+    """
+    return tables.max(axis=0).astype(np.float32), tables.argmax(axis=0).astype(np.uint8)
+
+
+def probability_map(image: np.ndarray, table: np.ndarray, colour: np.ndarray,
+                    min_value: int) -> tuple[np.ndarray, np.ndarray]:
+    """Per-pixel target probability and colour index of a BGR image by table lookup.
+
+    Pixels darker than ``min_value`` get probability 0.
+    """
     hue, sat, val = hsv_planes(image)
-    prob = table[hs_index(hue, sat)]
+    index = hs_index(hue, sat)
+    prob = table[index]
     prob[val < min_value] = 0.0
-    return prob
+    return prob, colour[index]
+
+
+def blob_colours(label_image: np.ndarray, prob: np.ndarray, colour: np.ndarray,
+                 labels: np.ndarray, colours: int) -> tuple[np.ndarray, np.ndarray]:
+    """Mean probability and probability-weighted majority colour of the blobs ``labels``."""
+    fg = np.flatnonzero(label_image)
+    blob = label_image.ravel()[fg]
+    weight = prob.ravel()[fg]
+    size = int(label_image.max()) + 1
+    means = np.bincount(blob, weights=weight, minlength=size) / \
+        np.maximum(np.bincount(blob, minlength=size), 1)
+    votes = np.bincount(blob * colours + colour.ravel()[fg], weights=weight,
+                        minlength=size * colours).reshape(size, colours)
+    return means[labels], votes[labels].argmax(axis=1)
 
 
 def blob_boxes(binary: np.ndarray,
@@ -253,29 +354,44 @@ def expand_two_colour(box: np.ndarray, ratio: float, height: int) -> np.ndarray:
 
 
 class AdaBoostHSV(Detector):
-    """Per-pixel AdaBoost colour classifier with blob extraction (Lee 2017, 3.2)."""
+    """Per-pixel AdaBoost colour classifier with blob extraction (Lee 2017, 3.2).
+
+    Detection defaults suit traffic lights (lenses of 5-20 px) and were chosen by validation on
+    the shipped model's training set (benchmarks/RESULTS.lee.md). Lee's work-zone values are
+    ``min_size=30, max_boxes=1, threshold=0.5`` (3.2: "the largest bounding box when the width
+    or height is bigger than 30 pixels").
+    """
 
     name = "adaboost-hsv"
     summary = "AdaBoost stumps on hue/saturation per pixel, probability map, largest blobs"
     section = "Lee 2017, 3.2 (Eq. 3.1)"
     params = (
-        Param("model", "path", None, help="trained model (tsrkit train adaboost-hsv ...)"),
-        Param("target", "str", "red", choices=("red", "yellow", "green", "orange"),
-              help="target colour; training uses boxes of this state", section="3.2"),
+        Param("model", "path", None, help="trained model (tsrkit train adaboost-hsv ...); "
+              "unset: the shipped red/yellow/green model (trained on roboflow_cinta_v2_id)"),
+        Param("target", "str", "lights", choices=tuple(TARGET_COLOURS),
+              help="colour to train and detect; lights = red, yellow and green, each box "
+              "taking the colour whose posterior wins", section="3.2"),
+        Param("labels", "str", "lens", choices=("lens", "box"),
+              help="training target pixels: the lit lens in each box (Otsu on S*V, largest "
+              "blob) or every pixel of the box (round 1; right for filled signs)"),
+        Param("hard_negatives", "bool", False,
+              help="training: also use the unlit housing pixels of boxes as background"),
         Param("n_estimators", "int", 50, min=1, max=1000, help="number of weak learners H",
               section="3.2"),
         Param("min_value", "int", 50, min=0, max=255,
               help="pixels darker than this V are background (hue undefined); training too"),
         Param("prior", "float", None, min=0.001, max=0.999,
-              help="P(sign) of Eq. 3.1; default: the share of training images with a target",
-              section="Eq. 3.1"),
-        Param("threshold", "float", 0.5, min=0, max=1, help="probability threshold"),
-        Param("min_size", "int", 30, min=1,
-              help="keep blobs whose width or height reaches this many pixels", section="3.2"),
+              help="P(sign) of Eq. 3.1 for every colour; default: the share of training "
+              "images holding the colour", section="Eq. 3.1"),
+        Param("threshold", "float", 0.9, min=0, max=1,
+              help="probability threshold (Lee: 0.5)"),
+        Param("min_size", "int", 3, min=1,
+              help="keep blobs whose width or height reaches this many pixels (Lee: 30)",
+              section="3.2"),
         Param("nms_overlap", "float", 0.3, min=0, max=1,
               help="a box overlapping a larger kept box by more IoU is dropped"),
-        Param("max_boxes", "int", 1, min=1,
-              help="boxes kept per frame, largest first (Lee keeps the largest)", section="3.2"),
+        Param("max_boxes", "int", 3, min=1,
+              help="boxes kept per frame, largest first (Lee: 1, the largest)", section="3.2"),
         Param("expand_ratio", "float", 0.0, min=0,
               help="two-colour signs: grow wide blobs to height = ratio * width (0: off)",
               section="3.2"),
@@ -285,53 +401,71 @@ class AdaBoostHSV(Detector):
     def __init__(self, **params):
         super().__init__(**params)
         self._table: np.ndarray | None = None
+        self._colour: np.ndarray | None = None
+
+    @property
+    def colours(self) -> tuple[str, ...]:
+        """The colours this instance trains and detects (from ``target``)."""
+        return TARGET_COLOURS[self.params["target"]]
 
     def fit(self, samples: Iterable[Sample]) -> Model:
-        """Learn the target colour from annotated boxes; see :func:`pixel_histograms`."""
+        """Learn one booster per colour from annotated boxes; see :func:`pixel_labels`.
+
+        When ``samples`` is a :class:`~tsrkit.types.Dataset`, its licence and citation are
+        recorded in the model's info (the shipped model's data terms travel with it).
+        """
         p = self.params
-        counts = pixel_histograms(samples, p["target"], p["min_value"])
-        stumps = fit_stumps(counts.positive, counts.negative, p["n_estimators"], p["seed"])
-        return Model(arrays=stumps, info={
-            "target": p["target"], "prior": counts.image_prior,
-            "target_pixels": int(counts.positive.sum()),
-            "background_pixels": int(counts.negative.sum()),
-            "images": counts.images, "target_images": counts.target_images})
+        source = getattr(samples, "info", {})
+        counts = pixel_histograms(samples, self.colours, p["min_value"], p["labels"],
+                                  p["hard_negatives"])
+        arrays = {}
+        for t, colour in enumerate(self.colours):
+            stumps = fit_stumps(counts.positive[t], counts.negative[t], p["n_estimators"],
+                                p["seed"])
+            arrays.update({f"{colour}_{key}": value for key, value in stumps.items()})
+        return Model(arrays=arrays, info={
+            "targets": list(self.colours), "labels": p["labels"],
+            "priors": dict(zip(self.colours, counts.image_priors.tolist())),
+            "target_pixels": dict(zip(self.colours, counts.positive.sum(axis=1).tolist())),
+            "background_pixels": dict(zip(self.colours, counts.negative.sum(axis=1).tolist())),
+            "images": counts.images,
+            "target_images": dict(zip(self.colours, counts.target_images.tolist())),
+            "data_licence": source.get("licence"), "data_citation": source.get("citation")})
 
     def use_model(self, model: Model) -> None:
-        """Build the lookup table from ``model`` (a fitted or loaded model)."""
-        if model.info.get("target") != self.params["target"]:
-            raise TsrkitError(f"adaboost-hsv: the model detects '{model.info.get('target')}' "
-                              f"but target={self.params['target']!r}")
-        prior = self.params["prior"] if self.params["prior"] is not None \
-            else float(model.info["prior"])
-        stumps = {key: np.asarray(model.arrays[key]) for key in STUMP_KEYS}
-        self._table = probability_table(stumps, prior)
+        """Build the lookup tables from ``model`` (a fitted or loaded model)."""
+        missing = [c for c in self.colours if c not in model.info.get("targets", ())]
+        if missing:
+            raise TsrkitError(f"adaboost-hsv: the model detects {model.info.get('targets')} "
+                              f"but target={self.params['target']!r} needs {missing}")
+        tables = np.stack([probability_table(
+            {key: np.asarray(model.arrays[f"{colour}_{key}"]) for key in STUMP_KEYS},
+            self.params["prior"] if self.params["prior"] is not None
+            else float(model.info["priors"][colour])) for colour in self.colours])
+        self._table, self._colour = winning_colour(tables)
 
     def table(self) -> np.ndarray:
-        """The (hue, saturation) posterior table, loading the model on first use."""
+        """The (hue, saturation) posterior table (best colour), loading the model on first use."""
         if self._table is None:
-            if self.params["model"] is None:
-                raise TsrkitError("adaboost-hsv needs a model: train one with "
-                                  "'tsrkit train adaboost-hsv --dataset ... --param target=... "
-                                  "--out M' and pass --param model=M")
-            self.use_model(load_model(self.params["model"], plugin=self.name))
+            self.use_model(load_model(self.params["model"] or DEFAULT_MODEL, plugin=self.name))
         return self._table
 
     def detect(self, frame: Frame) -> list[Candidate]:
         p = self.params
-        prob = probability_map(frame.image, self.table(), p["min_value"])
+        prob, colour = probability_map(frame.image, self.table(), self._colour, p["min_value"])
         boxes, labels, label_image = blob_boxes(prob > p["threshold"], p["min_size"])
         if not len(boxes):
             return []
-        means = np.bincount(label_image.ravel(), weights=prob.ravel())[labels] / \
-            np.bincount(label_image.ravel())[labels]
-        state = p["target"] if p["target"] in STATES else None
+        kept = largest_first_nms(boxes, p["nms_overlap"], p["max_boxes"])
+        means, winners = blob_colours(label_image, prob, colour, labels[kept],
+                                      len(self.colours))
         out = []
-        for i in largest_first_nms(boxes, p["nms_overlap"], p["max_boxes"]):
+        for i, mean, winner in zip(kept, means, winners):
             box = boxes[i]
             if p["expand_ratio"] > 0:
                 box = expand_two_colour(box, p["expand_ratio"], frame.height)
-            out.append(Candidate.from_box(box, float(means[i]), state))
+            state = self.colours[winner]
+            out.append(Candidate.from_box(box, float(mean), state if state in STATES else None))
         return out
 
 
