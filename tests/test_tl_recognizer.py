@@ -13,9 +13,9 @@ from tsrkit.models import load_model, save_model
 from tsrkit.registry import get_registry
 from tsrkit.types import Annotation, Frame, Sample
 from tsrkit_plugins.detectors import tl_geometry as geo
-from tsrkit_plugins.detectors.tl_recognizer import TlRecognizer, red_or_yellow
+from tsrkit_plugins.detectors.tl_recognizer import TlRecognizer, enclosed_cores, red_or_yellow
 from tsrkit_plugins.detectors.tl_templates import disc_template, extract_patch, ncc
-from tsrkit_plugins.detectors.tl_tuning import smallest_ranges
+from tsrkit_plugins.detectors.tl_tuning import patch_scores, smallest_ranges, tune_threshold
 
 #: Lit-lens colours as a camera records them (BGR), distinct from the templates' own colours.
 LIT = {"green": (170, 250, 40), "red": (50, 30, 235), "yellow": (20, 180, 245)}
@@ -297,6 +297,46 @@ def synthetic_samples(n=6, seed=0):
         samples.append(Sample(f"s{i}", (Annotation((x - 9, y - 9, x + 10, y + 10), state),),
                               image=image))
     return samples
+
+
+def test_patch_scores_split_lights_from_others():
+    det = lens_detector(resize_factor=1)
+    samples = synthetic_samples()
+    lights, others = patch_scores(det, samples)
+    assert len(lights) == len(others) == len(samples)     # one lens and one sodium panel each
+    assert lights.min() > others.max()
+    assert tune_threshold(det, samples) == (others.max(), 6, 6)
+
+
+def overexposed_lens(colour, arc, centre=(160, 120), radius=12):
+    """A white lens core with a 2 px coloured fringe only on an arc (degrees, 0 = right)."""
+    image = lit_disc(scene(), centre, radius, (255, 255, 255))
+    cv2.ellipse(image, centre, (radius + 1, radius + 1), 0, arc[0], arc[1], colour, thickness=2)
+    return image
+
+
+def test_enclosed_cores_joins_ringed_white_blobs_only():
+    hsv = np.zeros((9, 9, 3), np.uint8)
+    hsv[2:5, 2:5] = (0, 0, 250)                     # white core, fully ringed
+    hsv[6:8, 6:8] = (0, 0, 250)                     # white blob with no coloured border
+    mask = np.zeros((9, 9), np.uint8)
+    mask[1:6, 1:6] = 255
+    mask[2:5, 2:5] = 0
+    out = enclosed_cores(hsv, mask, 230, 0.5)
+    assert out[2:5, 2:5].all() and not out[6:8, 6:8].any()
+    assert np.array_equal(enclosed_cores(hsv, mask, 251, 0.5), mask)   # core too dark
+
+
+def test_fill_cores_recovers_the_whole_overexposed_lens():
+    # a fringe on the left 200 degrees: the range filter keeps a C whose box misses the right
+    # part of the lens; with the white core added the box is the whole lens
+    frame = Frame(overexposed_lens(LIT["red"], arc=(80, 280)), "synthetic")
+    (plain,) = lens_detector(resize_factor=1).scored(frame)
+    (filled,) = lens_detector(resize_factor=1, fill_cores=True).scored(frame)
+    assert filled.state == "red"
+    assert abs(filled.x - 159) <= 1 and abs(filled.radius - 13) <= 1
+    assert plain.x <= 156 and plain.radius <= 11
+    assert filled.score > plain.score
 
 
 def test_fit_tunes_threshold_and_ranges(tmp_path):

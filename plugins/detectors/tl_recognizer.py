@@ -54,6 +54,36 @@ def reduced_hsv(image: np.ndarray, factor: int) -> np.ndarray:
     return cv2.cvtColor(small, cv2.COLOR_BGR2HSV)
 
 
+def enclosed_cores(hsv: np.ndarray, mask: np.ndarray, core_v: int,
+                   ring_share: float) -> np.ndarray:
+    """``mask`` plus the bright blobs outside it that are mostly ringed by ``mask`` pixels.
+
+    An overexposed lens records as a white core (low S, V near 255) inside a coloured ring, and
+    the range filter keeps only the ring (3.3). A core is an 8-connected blob of pixels with
+    V >= ``core_v`` outside ``mask``; it joins the mask when at least ``ring_share`` of the pixels
+    bordering it are in ``mask``. Not in the paper, whose fixed exposure (3.2) avoids white cores.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> hsv = np.zeros((5, 5, 3), np.uint8); hsv[2, 2] = (0, 0, 255)
+    >>> ring = np.full((5, 5), 255, np.uint8); ring[2, 2] = 0
+    >>> int(enclosed_cores(hsv, ring, 230, 0.5)[2, 2])
+    255
+    """
+    core = ((hsv[..., 2] >= core_v) & (mask == 0)).astype(np.uint8)
+    count, labels = cv2.connectedComponents(core, connectivity=8)
+    if count <= 1:
+        return mask
+    grown = cv2.dilate(labels.astype(np.float32), np.ones((3, 3), np.uint8)).astype(np.int64)
+    border = (core == 0) & (grown > 0)
+    total = np.bincount(grown[border], minlength=count)
+    ringed = np.bincount(grown[border & (mask > 0)], minlength=count)
+    accept = ringed >= ring_share * np.maximum(total, 1)
+    accept[0] = False
+    return np.where(accept[labels], np.uint8(255), mask)
+
+
 def extract_contours(mask: np.ndarray) -> list[np.ndarray]:
     """Outer contours of the white blobs (Suzuki-Abe border following, 3.3 / Algorithm 1 line 5)."""
     contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
@@ -122,6 +152,14 @@ class TlRecognizer(Detector):
               help="centre distance of neighbouring lenses in lens diameters (housing context)"),
         Param("margin", "float", 0.5, min=0,
               help="margin around the housing in lens diameters (housing context)"),
+        Param("fill_cores", "bool", False,
+              help="add white lens cores ringed by the colour to the range-filter mask "
+                   "(not in the paper; false is the paper's extraction)", section="3.3"),
+        Param("core_v", "int", 230, min=0, max=255,
+              help="smallest V of a white lens core (fill_cores)"),
+        Param("ring_share", "float", 0.5, min=0, max=1,
+              help="share of a core's border pixels that must pass the colour filter "
+                   "(fill_cores)"),
         Param("focal_px", "float", None, min=1,
               help="focal length in pixels, if frames lack metadata 'focal_px'", section="3.4"),
         Param("pitch_deg", "float", 0.0, min=-90, max=90,
@@ -195,6 +233,8 @@ class TlRecognizer(Detector):
                      camera: Camera) -> list[Candidate]:
         """Extraction, pruning and validation for one colour (Algorithm 1, lines 3-16)."""
         mask = range_mask(hsv, self.ranges, PASSES[colour])
+        if self.params["fill_cores"]:
+            mask = enclosed_cores(hsv, mask, self.params["core_v"], self.params["ring_share"])
         scale = (image.shape[1] / hsv.shape[1], image.shape[0] / hsv.shape[0])
         centre = ((image.shape[1] - 1) / 2, (image.shape[0] - 1) / 2)
         out = []

@@ -95,12 +95,13 @@ def _rounded(ranges: np.ndarray) -> np.ndarray:
     return out
 
 
-def tune_threshold(detector, samples) -> tuple[float | None, int, int]:
-    """Highest NCC of a pruned patch centred in no annotated box (5.2), and the patch counts.
+def patch_scores(detector, samples) -> tuple[np.ndarray, np.ndarray]:
+    """NCC of every pruned patch, split into lights and others by the annotations (5.2).
 
-    Returns ``(T, lights, others)``; T is None when no patch outside the boxes survived pruning.
+    A patch is a light when its centre lies in the minimum enclosing circle of an annotated box
+    (Zheng 5.2.1). Returns ``(lights, others)``, two float arrays.
     """
-    best, lights, others = None, 0, 0
+    lights, others = [], []
     for sample in samples:
         candidates = detector.scored(sample.load())
         if not candidates:
@@ -109,12 +110,18 @@ def tune_threshold(detector, samples) -> tuple[float | None, int, int]:
         centres = [(c.x, c.y) for c in candidates]
         inside = (centre_hits(centres, boxes).any(axis=1) if boxes
                   else np.zeros(len(candidates), bool))
-        lights += int(inside.sum())
-        others += int((~inside).sum())
-        outside = [c.score for c, hit in zip(candidates, inside) if not hit]
-        if outside:
-            best = max(outside) if best is None else max(best, *outside)
-    return best, lights, others
+        for candidate, hit in zip(candidates, inside):
+            (lights if hit else others).append(candidate.score)
+    return np.array(lights, dtype=np.float64), np.array(others, dtype=np.float64)
+
+
+def tune_threshold(detector, samples) -> tuple[float | None, int, int]:
+    """Highest NCC of a pruned patch centred in no annotated box (5.2), and the patch counts.
+
+    Returns ``(T, lights, others)``; T is None when no patch outside the boxes survived pruning.
+    """
+    lights, others = patch_scores(detector, samples)
+    return (float(others.max()) if len(others) else None), len(lights), len(others)
 
 
 def fit_model(detector, samples) -> Model:
