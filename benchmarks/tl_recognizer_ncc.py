@@ -1,4 +1,4 @@
-"""How well TL-recognizer's NCC separates lights from other patches on a tuning split (Mascetti 5.2).
+"""How well TL-recognizer's NCC separates lights from other patches on a tuning split (5.2).
 
 For each validation setting (bare lens MBR or housing context; core filling off or on) the script
 scores every pruned patch of the tuning split, splits them into lights and others by the

@@ -361,6 +361,16 @@ def test_fit_tunes_threshold_and_ranges(tmp_path):
         assert [c.state for c in found] == [sample.annotations[0].state]
 
 
+def test_fit_without_ranges_tunes_t_alone():
+    det = lens_detector(resize_factor=1, fit_ranges=False)
+    table6 = det.ranges.copy()
+    model = det.fit(synthetic_samples())
+    assert np.array_equal(model.arrays["ranges"], table6)
+    assert float(model.arrays["threshold"]) == pytest.approx(
+        tune_threshold(lens_detector(resize_factor=1), synthetic_samples())[0])
+    assert model.info["lens_pixels"] == {"green": 0, "yellowred": 0}
+
+
 def test_smallest_ranges_cover_all_pixels():
     pixels = {"green": np.array([[72, 120, 90], [90, 200, 254], [80, 150, 255]], np.uint8),
               "yellowred": np.array([[5, 110, 100], [170, 130, 200], [20, 255, 130]], np.uint8)}

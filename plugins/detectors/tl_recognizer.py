@@ -183,6 +183,9 @@ class TlRecognizer(Detector):
         Param("threads", "int", 1, min=1, max=2,
               help="threads for the colour passes (2 runs green and yellowRed together)",
               section="4.2"),
+        Param("fit_ranges", "bool", True,
+              help="training: derive the range-filter bounds (Figure 16) before T; false "
+                   "tunes T alone on the current ranges", section="5.2"),
         Param("fit_coverage", "float", 1.0, min=0.5, max=1,
               help="training: share of annotated lens pixels the derived ranges include",
               section="5.2, Figure 16"),

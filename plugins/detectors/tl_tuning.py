@@ -125,13 +125,18 @@ def tune_threshold(detector, samples) -> tuple[float | None, int, int]:
 
 
 def fit_model(detector, samples) -> Model:
-    """Fit ``detector`` (a TlRecognizer) on annotated ``samples``: ranges, then T (5.2)."""
+    """Fit ``detector`` (a TlRecognizer) on annotated ``samples``: ranges, then T (5.2).
+
+    The ranges stay as they are when the detector's ``fit_ranges`` is false.
+    """
     samples = list(samples)
     if not samples:
         raise ValueError("tl-recognizer: cannot train on an empty dataset")
-    factor = detector.params["resize_factor"]
-    pixels = annotated_lens_pixels(samples, factor)
-    detector.ranges = smallest_ranges(pixels, detector.ranges, detector.params["fit_coverage"])
+    pixels = {colour: np.zeros((0, 3), np.uint8) for colour in PASSES}
+    if detector.params["fit_ranges"]:
+        pixels = annotated_lens_pixels(samples, detector.params["resize_factor"])
+        detector.ranges = smallest_ranges(pixels, detector.ranges,
+                                          detector.params["fit_coverage"])
     threshold, lights, others = tune_threshold(detector, samples)
     if threshold is not None:
         detector.threshold = threshold
