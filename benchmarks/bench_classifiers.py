@@ -37,6 +37,17 @@ def by_lighting(dataset: Dataset, lighting: str) -> Dataset:
                    dataset.info)
 
 
+def benchmark_sets() -> tuple[Dataset, dict[str, Dataset]]:
+    """The training split (MIT train) and the named test sets of this benchmark."""
+    mit = open_dataset("udacity_mit_tl_crops", format="crops")
+    vgis = open_dataset("lisa_vgis_bulb_crops", format="crops")
+    return mit.split("train"), {
+        "mit test": mit.split("test"),
+        "vgis day": by_lighting(vgis, "day"), "vgis night": by_lighting(vgis, "night"),
+        "kr boxes": open_dataset("roboflow_traffic_light_kr"),
+        "cinta boxes": open_dataset("roboflow_cinta_v2_id")}
+
+
 def evaluate(classifier, dataset: Dataset) -> dict:
     """Accuracy, per-class recall and confusion (true -> predicted) over red/yellow/green."""
     confusion: dict[str, dict[str, int]] = {s: {} for s in STATES}
@@ -87,13 +98,7 @@ def main() -> None:
     args = parser.parse_args()
     cv2.setNumThreads(1)
     registry = get_registry()
-    mit = open_dataset("udacity_mit_tl_crops", format="crops")
-    vgis = open_dataset("lisa_vgis_bulb_crops", format="crops")
-    train = mit.split("train")
-    sets = {"mit test": mit.split("test"),
-            "vgis day": by_lighting(vgis, "day"), "vgis night": by_lighting(vgis, "night"),
-            "kr boxes": open_dataset("roboflow_traffic_light_kr"),
-            "cinta boxes": open_dataset("roboflow_cinta_v2_id")}
+    train, sets = benchmark_sets()
     tmp = tempfile.mkdtemp(prefix="bench_classifiers_")
     runs = [(name, dict(p.split(":", 1)[1].split("=", 1) for p in args.param
                         if p.split(":", 1)[0] == name)) for name in CLASSIFIERS]

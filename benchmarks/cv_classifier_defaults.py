@@ -1,43 +1,105 @@
-"""Check ab-hist's defaults without test data: 5-fold stratified CV on the MIT *train* split.
+"""Choose a state classifier's defaults without test data: 5-fold stratified cross-validation
+on the ``udacity_mit_tl_crops`` *train* split, over a grid of parameter values.
 
-Crosses four lens-search scores (regions.lit_map variants) with Eq. 3.19 mode, min_chroma and
-histogram smoothing, and prints the cross-validated accuracy of each setting.
+Every grid point is trained on four folds and scored on the fifth (annotated boxes as
+candidates, as in ``bench_classifiers.py``); the accuracy and per-class recall pooled over the
+five folds are printed, best accuracy last.
 
-    python benchmarks/cv_classifier_defaults.py
+Run::
+
+    python benchmarks/cv_classifier_defaults.py hsi-backprojection \\
+        --grid min_saturation=0,40,80 --grid clip=250,256
 """
-import itertools, sys, cv2, numpy as np, tsrkit
-from sklearn.model_selection import StratifiedKFold
-from tsrkit.datasets import open_dataset
-from tsrkit.types import Candidate, Dataset
-import tsrkit_plugins.classifiers.regions as regions
-cv2.setNumThreads(1)
-train = open_dataset("udacity_mit_tl_crops").split("train")
-samples = list(train); labels = [s.annotations[0].state for s in samples]
-frames = {s.source: s.load() for s in samples}
-orig = regions.lit_map
-def v2(bgr):
-    v = cv2.cvtColor(bgr, cv2.COLOR_BGR2HSV)[..., 2].astype(np.float32) / 255; return v * v
-def sv2_noblue(bgr):
-    hsv = cv2.cvtColor(bgr, cv2.COLOR_BGR2HSV); m = orig(bgr)
-    blue = (hsv[..., 0] >= 85) & (hsv[..., 0] <= 135)
-    return np.where(blue, 0, m)
-def v2_noblue(bgr):
-    hsv = cv2.cvtColor(bgr, cv2.COLOR_BGR2HSV); v = hsv[..., 2].astype(np.float32) / 255
-    blue = (hsv[..., 0] >= 85) & (hsv[..., 0] <= 135) & (hsv[..., 1] > 40)
-    return np.where(blue, 0, v * v)
-variants = {"sv2": orig, "v2": v2, "sv2_noblue": sv2_noblue, "v2_noblue": v2_noblue}
-folds = list(StratifiedKFold(5, shuffle=True, random_state=0).split(samples, labels))
-grid = [dict(mode=m, min_chroma=c, smooth=s) for m, c, s in itertools.product(["saturation", "max"], [0.0, 10.0], [0.0, 3.0])]
-for vname, fn in variants.items():
-    regions.lit_map = fn
-    for g in grid:
-        correct = 0
-        for tr, te in folds:
-            cls = tsrkit.classifier("ab-hist", **g)
-            model = cls.fit(Dataset("f", tuple(samples[i] for i in tr)))
-            cls._model = model
-            for i in te:
-                s = samples[i]; f = frames[s.source]
-                d = cls.classify(f, [Candidate.from_box(s.annotations[0].bbox, 1.0)])[0]
-                correct += d.state == labels[i]
-        print(f"{vname:11s} {g} cv_acc={correct/len(samples):.4f}", flush=True)
+from __future__ import annotations
+
+import os
+
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ[_var] = "1"
+
+import argparse  # noqa: E402
+import itertools  # noqa: E402
+import tempfile  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import cv2  # noqa: E402
+from sklearn.model_selection import StratifiedKFold  # noqa: E402
+
+from tsrkit.datasets import open_dataset  # noqa: E402
+from tsrkit.registry import get_registry  # noqa: E402
+from tsrkit.training import train as train_model  # noqa: E402
+from tsrkit.types import Candidate, Dataset  # noqa: E402
+
+STATES = ("red", "yellow", "green")
+
+
+def grid_points(grid: list[str]) -> list[dict[str, str]]:
+    """Every combination of ``KEY=V1,V2,...`` values, as parameter dicts."""
+    axes = [(key, values.split(",")) for key, values in (g.split("=", 1) for g in grid)]
+    return [dict(zip([k for k, _ in axes], combo))
+            for combo in itertools.product(*[v for _, v in axes])]
+
+
+def cross_validate(name: str, params: dict[str, str], samples: list, frames: dict,
+                   folds: list, workdir: Path) -> dict[str, int]:
+    """Pooled ``(state, predicted) -> count`` over the folds for one parameter setting."""
+    registry = get_registry()
+    counts: dict[str, int] = {}
+    for k, (train_idx, test_idx) in enumerate(folds):
+        fold = Dataset(f"fold{k}", tuple(samples[i] for i in train_idx))
+        path = train_model(name, fold, workdir / f"{name}-{k}", params)
+        classifier = registry.create("classifier", name, {**params, "model": str(path)})
+        for i in test_idx:
+            truth = samples[i].annotations[0]
+            found = classifier.classify(frames[i], [Candidate.from_box(truth.bbox, 1.0)])[0]
+            key = f"{truth.state}>{found.state}"
+            counts[key] = counts.get(key, 0) + 1
+    return counts
+
+
+def summary(counts: dict[str, int]) -> tuple[float, str]:
+    """Accuracy and a per-class recall line from pooled confusion counts."""
+    total = sum(counts.values())
+    correct = sum(counts.get(f"{s}>{s}", 0) for s in STATES)
+    recalls = []
+    for state in STATES:
+        n = sum(v for k, v in counts.items() if k.startswith(f"{state}>"))
+        recalls.append(f"{state}={counts.get(f'{state}>{state}', 0) / n:.3f}" if n else
+                       f"{state}=-")
+    return correct / total, " ".join(recalls)
+
+
+def grid_parser(description: str) -> argparse.ArgumentParser:
+    """Command line of a grid search: a classifier name and repeatable ``--grid`` options."""
+    parser = argparse.ArgumentParser(description=description,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("classifier")
+    parser.add_argument("--grid", action="append", default=[], metavar="KEY=V1,V2",
+                        help="values to try for one parameter (repeat for more)")
+    return parser
+
+
+def main() -> None:
+    parser = grid_parser(__doc__)
+    parser.add_argument("--folds", type=int, default=5)
+    args = parser.parse_args()
+    cv2.setNumThreads(1)
+    train = open_dataset("udacity_mit_tl_crops", format="crops").split("train")
+    samples = [s for s in train if s.annotations and s.annotations[0].state in STATES]
+    labels = [s.annotations[0].state for s in samples]
+    frames = {i: s.load() for i, s in enumerate(samples)}
+    folds = list(StratifiedKFold(args.folds, shuffle=True, random_state=0)
+                 .split(samples, labels))
+    results = []
+    with tempfile.TemporaryDirectory(prefix="cv_classifier_") as tmp:
+        for params in grid_points(args.grid) or [{}]:
+            accuracy, recalls = summary(cross_validate(args.classifier, params, samples,
+                                                       frames, folds, Path(tmp)))
+            results.append((accuracy, params, recalls))
+            print(f"{params} cv_acc={accuracy:.4f} recall {recalls}", flush=True)
+    best = max(results, key=lambda r: r[0])
+    print(f"best: {best[1]} cv_acc={best[0]:.4f} recall {best[2]}")
+
+
+if __name__ == "__main__":
+    main()

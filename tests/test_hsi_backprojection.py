@@ -1,16 +1,17 @@
 """hsi-backprojection (Lee 5.3.3-5.3.4): back-projection, training, filter size, video, files."""
 from __future__ import annotations
 
+import cv2
 import numpy as np
 import pytest
 
-from oracles.lamps import COLOURS, housing, lamp, training_set
-from tsrkit.models import ModelError, load_model, save_model
+from oracles.lamps import COLOURS, crop_sample, housing, lamp, training_set
+from tsrkit.models import Model, ModelError, load_model, save_model
 from tsrkit.registry import get_registry
 from tsrkit.types import Candidate, Frame
 from tsrkit_plugins.classifiers.hsi_backprojection import (back_project, expected_diameter,
                                                            low_pass, scaled_histogram,
-                                                           smooth_hue)
+                                                           smooth_hue, unclipped)
 
 
 def make(**params):
@@ -154,3 +155,62 @@ def test_model_round_trip_and_wrong_models(tmp_path, model_path):
     with pytest.raises(ModelError, match="expected hue"):
         classify_one(make(model=str(tmp_path / "short")), lamp(COLOURS["red"]), cand)
 
+
+
+def test_unclipped_keeps_order_and_falls_back_when_all_are_clipped():
+    pixels = np.array([[0, 200, 255], [5, 180, 240], [3, 100, 250], [2, 90, 120]], np.uint8)
+    assert unclipped(pixels, 250).tolist() == [[5, 180, 240], [2, 90, 120]]
+    assert unclipped(pixels, 256).tolist() == pixels.tolist()
+    assert unclipped(pixels[[0, 2]], 250).tolist() == pixels[[0, 2]].tolist()
+
+
+#: An over-exposed red lamp's core (BGR): red clipped at 255 and green risen, OpenCV hue 23.
+CLIPPED_CORE = (20, 200, 255)
+
+
+def overexposed_red(size: int = 40, radius: int = 10) -> np.ndarray:
+    """A red lamp whose core (80% of the radius) is clipped to :data:`CLIPPED_CORE`."""
+    image = np.full((size, size, 3), 35, np.uint8)
+    cv2.circle(image, (size // 2, size // 2), radius, (40, 30, 230), -1)
+    cv2.circle(image, (size // 2, size // 2), radius * 8 // 10, CLIPPED_CORE, -1)
+    return image
+
+
+@pytest.fixture
+def hand_model(tmp_path):
+    """Hue windows red 0-10 and 170-179, yellow 18-32, green 60-90; S and I rising with
+    saturation and value, so that grey pixels weigh nothing and the brightest (clipped) ones
+    most, as trained S and I histograms do."""
+    hue = np.zeros((3, 180), np.float32)
+    hue[0, :11] = hue[0, 170:] = hue[1, 18:33] = hue[2, 60:91] = 1
+    rising = np.arange(256, dtype=np.float32) / 255
+    model = Model(arrays={"hue": hue, "saturation": rising, "intensity": rising})
+    return save_model(tmp_path / "hand", model, plugin="hsi-backprojection", plugin_version="t",
+                      params={}, training={})
+
+
+def test_clipped_core_is_left_out_so_an_overexposed_red_stays_red(hand_model):
+    image, cand = overexposed_red(), Candidate.from_circle(20, 20, 10, 1.0)
+    common = dict(model=str(hand_model), red_prior=False)
+    assert classify_one(make(**common, clip=256), image, cand).state == "yellow"  # Lee as printed
+    det = classify_one(make(**common, clip=250), image, cand)
+    assert det.state == "red" and det.state_scores["yellow"] == 0.0
+
+
+def test_a_fully_clipped_lamp_falls_back_to_its_clipped_pixels(hand_model):
+    image = np.full((40, 40, 3), 35, np.uint8)
+    cv2.circle(image, (20, 20), 10, CLIPPED_CORE, -1)
+    det = classify_one(make(model=str(hand_model), red_prior=False, clip=250), image,
+                       Candidate.from_circle(20, 20, 10, 1.0))
+    assert det.state == "yellow" and det.state_scores["yellow"] > 0.5
+    assert det.state_scores["red"] == det.state_scores["green"] == 0.0
+
+
+def test_training_leaves_clipped_pixels_out():
+    samples = [crop_sample(overexposed_red(size=20), "red")] + [
+        crop_sample(lamp(COLOURS[state], size=20, radius=10), state) for state in
+        ("yellow", "green")]
+    kept = make(clip=250, hue_smooth=0).fit(samples).arrays["hue"][0]
+    every = make(clip=256, hue_smooth=0).fit(samples).arrays["hue"][0]
+    assert every.argmax() == 23  # Lee as printed: the clipped core's hue dominates red
+    assert kept.argmax() == 179 and kept[23] == 0  # the rim's red, OpenCV hue 179

@@ -17,7 +17,7 @@ from tsrkit.plugin import Classifier
 from tsrkit.types import Candidate, Detection, Frame, Sample
 from tsrkit_plugins.classifiers.decision import UNKNOWN, best_state, discriminative_ratio
 from tsrkit_plugins.classifiers.priors import warm_red
-from tsrkit_plugins.classifiers.regions import REGION_PARAMS, labelled_lenses, lens_of, rings
+from tsrkit_plugins.classifiers.regions import labelled_lenses, lens_of, region_params, rings
 
 DEFAULT_MODEL = Path(__file__).parent / "models" / "ab_hist_default"
 MODES = ("max", "saturation")
@@ -123,7 +123,7 @@ class AbHist(Classifier):
               "trained"),
         Param("min_ratio", "float", 0.0, min=0.0, max=1.0, help="discriminative ratio below "
               "which the state is unknown", section="5.3"),
-    ) + REGION_PARAMS
+    ) + region_params(lens_fraction=0.4)
 
     def __init__(self, **params):
         super().__init__(**params)

@@ -19,8 +19,8 @@ from tsrkit.plugin import Classifier
 from tsrkit.types import Candidate, Detection, Frame, Sample
 from tsrkit_plugins.classifiers.decision import UNKNOWN, best_state, fuse_lights
 from tsrkit_plugins.classifiers.priors import warm_red
-from tsrkit_plugins.classifiers.regions import (REGION_PARAMS, clip_box, disk_kernel, is_housing,
-                                                labelled_lenses, rings)
+from tsrkit_plugins.classifiers.regions import (clip_box, disk_kernel, is_housing,
+                                                labelled_lenses, region_params, rings)
 
 DEFAULT_MODEL = Path(__file__).parent / "models" / "hsi_backprojection_default"
 #: OpenCV 8-bit HSV ranges: hue 0-179, saturation and value 0-255 (Lee 5.3.3).
@@ -55,6 +55,19 @@ def lit_pixels(image: np.ndarray, lens: Candidate) -> np.ndarray:
     pixels = cv2.cvtColor(area.patch, cv2.COLOR_BGR2HSV)[area.disk]
     order = np.argsort(-(pixels[:, 1].astype(np.int32) * pixels[:, 2]), kind="stable")
     return pixels[order]
+
+
+def unclipped(pixels: np.ndarray, clip: int) -> np.ndarray:
+    """The HSV ``pixels`` (``(n, 3)``, order kept) whose value is below ``clip``, or all of
+    them when none is.
+
+    A deviation from Lee 5.3.3, for cameras other than the training one: a clipped pixel's
+    hue is the sensor's, not the lamp's (an over-exposed red lamp images orange to
+    yellow-white where its red channel saturates), yet the learned I histogram favours exactly
+    those brightest pixels.
+    """
+    below = pixels[:, 2] < clip
+    return pixels[below] if below.any() else pixels
 
 
 def back_project(hsv: np.ndarray, hue: np.ndarray, saturation: np.ndarray,
@@ -102,8 +115,12 @@ class HsiBackprojection(Classifier):
               "trained on udacity_mit_tl_crops train"),
         Param("pixels_per_sample", "int", 0, min=0, help="lit pixels taken from each training "
               "sample; 0: the smallest lens of the training set (Lee 5.3.3)", section="5.3.3"),
-        Param("hue_smooth", "float", 5.0, min=0.0, max=30.0, help="circular Gaussian sigma, "
+        Param("hue_smooth", "float", 8.0, min=0.0, max=30.0, help="circular Gaussian sigma, "
               "in hue bins, applied to the trained hue histograms (0: Lee's raw histograms)"),
+        Param("clip", "int", 250, min=1, max=SV_BINS, help="pixels whose HSV value "
+              "(brightest channel, 0-255) reaches this count as sensor-clipped and get "
+              "probability 0 unless nothing else is lit; training leaves them out likewise "
+              "(256: every pixel, as Lee does; see unclipped())"),
         Param("red_prior", "bool", True, help="warm-red prior: hues between the trained red "
               "and yellow modes count as red (see priors.py); off: Lee's histograms as trained"),
         Param("threshold", "float", 0.0, min=0.0, max=1.0, help="unknown when the best state's "
@@ -114,7 +131,7 @@ class HsiBackprojection(Classifier):
               "frame's probabilities (0: off)", section="5.3.4"),
         Param("fuse", "bool", False, help="fuse the candidates of a frame as lights of one "
               "approach: consensus, else the most probable, else unknown", section="5.3.4"),
-    ) + REGION_PARAMS
+    ) + region_params(lens_fraction=0.3)
 
     def __init__(self, **params):
         super().__init__(**params)
@@ -162,10 +179,17 @@ class HsiBackprojection(Classifier):
         x0, y0, x1, y1 = clip_box(bbox, frame.width, frame.height)
         hsv = cv2.cvtColor(frame.image[y0:y1, x0:x1], cv2.COLOR_BGR2HSV)
         arrays = self.model.arrays
-        maps = back_project(hsv, arrays["hue"], arrays["saturation"], arrays["intensity"])
         kernel = disk_kernel(self.filter_diameter(frame, candidate, housing) / 2)
-        return np.array([cv2.filter2D(m, -1, kernel, borderType=cv2.BORDER_CONSTANT).max()
-                         for m in maps])
+        clip = self.params["clip"]
+        for cut in ((clip, SV_BINS) if clip < SV_BINS else (SV_BINS,)):
+            intensity = arrays["intensity"].copy()
+            intensity[cut:] = 0  # clipped pixels out, unless nothing else is lit
+            maps = back_project(hsv, arrays["hue"], arrays["saturation"], intensity)
+            probs = np.array([cv2.filter2D(m, -1, kernel, borderType=cv2.BORDER_CONSTANT).max()
+                              for m in maps])
+            if probs.any():
+                break
+        return probs
 
     def smoothed(self, frame: Frame, candidates: Sequence[Candidate],
                  current: list[np.ndarray]) -> list[np.ndarray]:
@@ -206,15 +230,16 @@ class HsiBackprojection(Classifier):
             raise ValueError("hsi-backprojection: no training samples with a red, yellow or "
                              "green label")
         count = self.params["pixels_per_sample"] or min(len(p) for _, p in taken)
-        pixels = {s: np.concatenate([p[:count] for st, p in taken if st == s] or
+        kept = [(st, unclipped(p, self.params["clip"])[:count]) for st, p in taken]
+        pixels = {s: np.concatenate([p for st, p in kept if st == s] or
                                     [np.zeros((0, 3), np.uint8)]) for s in self.states}
         missing = [s for s in self.states if not len(pixels[s])]
         if missing:
             raise ValueError(f"hsi-backprojection: no training samples for {', '.join(missing)}")
         every = np.concatenate(list(pixels.values()))
-        return Model(arrays={"hue": np.stack([smooth_hue(scaled_histogram(pixels[s][:, 0], HUE_BINS),
-                                                         self.params["hue_smooth"])
-                                              for s in self.states]),
+        hue = [smooth_hue(scaled_histogram(pixels[s][:, 0], HUE_BINS), self.params["hue_smooth"])
+               for s in self.states]
+        return Model(arrays={"hue": np.stack(hue),
                              "saturation": scaled_histogram(every[:, 1], SV_BINS),
                              "intensity": scaled_histogram(every[:, 2], SV_BINS)},
                      info={"states": list(self.states), "pixels_per_sample": int(count),

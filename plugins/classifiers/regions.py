@@ -19,15 +19,19 @@ from tsrkit.types import Candidate, Frame, Sample
 #: How a candidate's box is read: as the lens itself, as a housing to search, or decided by shape.
 REGIONS = ("lens", "housing", "auto")
 
-REGION_PARAMS = (
-    Param("region", "str", "auto", choices=REGIONS,
-          help="lens: the candidate is the lit lens; housing: search its box for the lit lens; "
-               "auto: housing when the box is elongated (see elongation)"),
-    Param("elongation", "float", 1.5, min=1.0,
-          help="auto region: a box whose long/short side ratio reaches this is a housing"),
-    Param("lens_fraction", "float", 0.4, min=0.05, max=0.5,
-          help="lens radius in a housing box, as a fraction of the box's short side"),
-)
+
+def region_params(lens_fraction: float) -> tuple[Param, ...]:
+    """The parameters saying how a classifier reads a candidate's box, with the plugin's own
+    default ``lens_fraction`` (each classifier's is chosen by its own cross-validation)."""
+    return (
+        Param("region", "str", "auto", choices=REGIONS,
+              help="lens: the candidate is the lit lens; housing: search its box for the lit "
+                   "lens; auto: housing when the box is elongated (see elongation)"),
+        Param("elongation", "float", 1.5, min=1.0,
+              help="auto region: a box whose long/short side ratio reaches this is a housing"),
+        Param("lens_fraction", "float", lens_fraction, min=0.05, max=0.5,
+              help="lens radius in a housing box, as a fraction of the box's short side"),
+    )
 
 
 @dataclass(frozen=True)
