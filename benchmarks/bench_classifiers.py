@@ -26,7 +26,7 @@ from tsrkit.types import Candidate, Dataset  # noqa: E402
 CLASSIFIERS = ("ab-hist", "hsi-backprojection")
 #: The papers' methods as printed (Zheng 3.3, Lee 5.3.3), run beside the defaults.
 PAPER_EXACT = {"ab-hist": {"smooth": "0", "min_chroma": "0", "red_prior": "false"},
-               "hsi-backprojection": {"hue_smooth": "0", "red_prior": "false"}}
+               "hsi-backprojection": {"hue_smooth": "0", "red_prior": "false", "clip": "256"}}
 STATES = ("red", "yellow", "green")
 
 
