@@ -170,7 +170,9 @@ class HsiBackprojection(Classifier):
         return 2 * candidate.radius
 
     def probabilities(self, frame: Frame, candidate: Candidate) -> np.ndarray:
-        """The filtered maximum of ``P_state`` over the candidate's region, per state."""
+        """The filtered maximum of ``P_state`` over the candidate's region, per state, with
+        pixels of value >= ``clip`` weighted 0 unless that leaves every probability 0 (see
+        :func:`unclipped`)."""
         housing = is_housing(candidate, self.params["region"], self.params["elongation"])
         bbox = candidate.bbox if housing else (candidate.x - candidate.radius,
                                                candidate.y - candidate.radius,
