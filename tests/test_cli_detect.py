@@ -12,7 +12,7 @@ from tsrkit.cli.main import cli
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "tsrkit-brightest-blobs"
 RECORD_KEYS = {"source", "frame", "width", "height", "ms", "detections"}
-DETECTION_KEYS = {"x", "y", "radius", "bbox", "score", "state", "state_scores", "origin"}
+DETECTION_KEYS = {"x", "y", "radius", "bbox", "lens_bbox", "score", "state", "state_scores", "origin"}
 
 
 @pytest.fixture

@@ -76,3 +76,25 @@ def test_classifier_sees_tracked_objects_and_keeps_their_identity():
     pipeline.process(frame("a.mp4", 0))
     (tracked,) = pipeline.process(frame("a.mp4", 1)).detections
     assert (tracked.state, tracked.origin, tracked.track_id) == ("green", "tracked", 1)
+
+
+class KeepFirstWithHousing(tsrkit.Verifier):
+    """Keeps the best candidate and gives it a housing three lenses tall."""
+
+    name = "keep-first"
+
+    def verify(self, frame, candidates):
+        from dataclasses import replace
+
+        c = candidates[0]
+        housing = (c.x - 2 * c.radius, c.y - 2 * c.radius, c.x + 2 * c.radius, c.y + 8 * c.radius)
+        return [replace(c, housing=housing, housing_score=0.8)]
+
+
+def test_verifier_rejects_and_adds_a_housing_reported_as_bbox():
+    result = tsrkit.Pipeline(Fixed(), verifier=KeepFirstWithHousing()).process(frame())
+    (only,) = result.to_record()["detections"]
+    assert only["bbox"] == [1.0, 2.0, 9.0, 22.0]
+    assert only["lens_bbox"] == [3.0, 4.0, 7.0, 8.0]
+    assert only["housing_score"] == 0.8
+    assert only["state"] == "red"

@@ -18,7 +18,7 @@ from tsrkit.inputs import ImageReadError, iter_frames, read_image
 from tsrkit.models import Model, ModelError, load_model, save_model
 from tsrkit.params import Param, ParamError
 from tsrkit.pipeline import FrameResult, Pipeline
-from tsrkit.plugin import Classifier, DatasetFormat, Detector, Tracker
+from tsrkit.plugin import Classifier, DatasetFormat, Detector, Tracker, Verifier
 from tsrkit.registry import PluginNotFound, get_registry
 from tsrkit.types import (STATES, Annotation, Candidate, Dataset, Detection, Frame, Sample,
                           Skipped)
@@ -37,6 +37,11 @@ def detector(name: str, **params: Any) -> Detector:
 def classifier(name: str, **params: Any) -> Classifier:
     """An installed classifier, its parameters validated against its schema."""
     return get_registry().create("classifier", name, params)
+
+
+def verifier(name: str, **params: Any) -> Verifier:
+    """An installed verifier, its parameters validated against its schema."""
+    return get_registry().create("verifier", name, params)
 
 
 def tracker(name: str, **params: Any) -> Tracker:
@@ -65,7 +70,10 @@ def dataset(ref: str, format: str | None = None, images: str | None = None) -> D
 
 def benchmark(dataset: Dataset, detector: Detector, classifier: Classifier | None = None,
               **options: Any) -> dict[str, Any]:
-    """Run a detector (and classifier) over a dataset and return the report dict."""
+    """Run a detector (and verifier, classifier) over a dataset and return the report dict.
+
+    ``options`` are those of :func:`tsrkit.runner.benchmark` (``verifier=``, ``workers=``...).
+    """
     from tsrkit.runner import benchmark as _benchmark
 
     return _benchmark(dataset, detector, classifier, **options)
@@ -81,7 +89,7 @@ def train(name: str, dataset: Dataset, out: str, **params: Any):
 __all__ = [
     "STATES", "Annotation", "Candidate", "Classifier", "Dataset", "DatasetFormat", "Detection",
     "Detector", "Frame", "FrameResult", "ImageReadError", "Model", "ModelError", "Param",
-    "ParamError", "Pipeline", "PluginNotFound", "Sample", "Skipped", "Tracker", "TsrkitError",
+    "ParamError", "Pipeline", "PluginNotFound", "Sample", "Skipped", "Tracker", "TsrkitError", "Verifier",
     "benchmark", "classifier", "dataset", "detector", "iter_frames", "load_model", "plugins",
-    "read_frame", "read_image", "save_model", "tracker", "train",
+    "read_frame", "read_image", "save_model", "tracker", "train", "verifier",
 ]

@@ -15,6 +15,11 @@ def register_detectors(register):
 
 
 @hookspec
+def register_verifiers(register):
+    """Register :class:`tsrkit.plugin.Verifier` subclasses."""
+
+
+@hookspec
 def register_classifiers(register):
     """Register :class:`tsrkit.plugin.Classifier` subclasses."""
 

@@ -1,4 +1,4 @@
-"""Detector -> tracker -> classifier on one frame, timed.
+"""Detector -> verifier -> tracker -> classifier on one frame, timed.
 
 ``FrameResult.ms`` is the compute time of the plugins on that frame (decoding and I/O excluded).
 """
@@ -8,7 +8,7 @@ import time
 from dataclasses import dataclass, replace
 from typing import Any
 
-from tsrkit.plugin import Classifier, Detector, Tracker
+from tsrkit.plugin import Classifier, Detector, Tracker, Verifier
 from tsrkit.types import Candidate, Detection, Frame
 
 
@@ -37,17 +37,19 @@ def as_detections(candidates: list[Candidate]) -> list[Detection]:
 
 @dataclass
 class Pipeline:
-    """A detector with an optional classifier and tracker."""
+    """A detector with an optional classifier, tracker and verifier."""
 
     detector: Detector
     classifier: Classifier | None = None
     tracker: Tracker | None = None
+    verifier: Verifier | None = None
     _video: str | None = None
 
     def process(self, frame: Frame) -> FrameResult:
-        """Detect, track, then classify ``frame``; exceptions from a plugin propagate.
+        """Detect, verify, track, then classify ``frame``; exceptions from a plugin propagate.
 
-        The tracker sees the detector's candidates; the classifier then sees every reported
+        The verifier rescores, refines or rejects the detector's candidates; the tracker sees
+        what it kept; the classifier then sees every reported
         object, tracked ones included, and its states replace the detector's own.
         """
         start = time.perf_counter()
@@ -55,7 +57,10 @@ class Pipeline:
             self.tracker.reset()
             self._video = frame.source
         detect = self.tracker is None or self.tracker.needs_detection()
-        detections = as_detections(self.detector.detect(frame) if detect else [])
+        candidates = self.detector.detect(frame) if detect else []
+        if self.verifier is not None and candidates:
+            candidates = self.verifier.verify(frame, candidates)
+        detections = as_detections(candidates)
         if self.tracker is not None:
             detections = self.tracker.update(frame, detections)
         if self.classifier is not None:

@@ -1,4 +1,4 @@
-"""Base classes a plugin subclasses: Detector, Classifier, Tracker and DatasetFormat.
+"""Base classes a plugin subclasses: Detector, Verifier, Classifier, Tracker, DatasetFormat.
 
 A subclass sets the class attributes ``name``, ``summary``, ``section`` (the document section it
 implements) and ``params`` (a tuple of :class:`tsrkit.params.Param`), then implements the one
@@ -46,6 +46,21 @@ class Detector(Plugin):
     @abstractmethod
     def detect(self, frame: Frame) -> list[Candidate]:
         """Return the candidates of ``frame``, best first."""
+
+
+class Verifier(Plugin):
+    """Rescores or rejects the candidates of any detector (the stage after detection).
+
+    A verifier may also add facts to a candidate, such as its housing box
+    (:attr:`tsrkit.types.Candidate.housing`). A trainable verifier defines ``fit`` like a
+    trainable classifier.
+    """
+
+    kind = "verifier"
+
+    @abstractmethod
+    def verify(self, frame: Frame, candidates: Sequence[Candidate]) -> list[Candidate]:
+        """Return the candidates kept, rescored and possibly refined, best first."""
 
 
 class Classifier(Plugin):

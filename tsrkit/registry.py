@@ -23,7 +23,8 @@ from tsrkit.plugin import Plugin, is_trainable
 
 ENTRY_POINT_GROUP = "tsrkit"
 LOAD_ENV = "TSRKIT_LOAD_PLUGINS"
-KINDS = {"detector": "register_detectors", "classifier": "register_classifiers",
+KINDS = {"detector": "register_detectors", "verifier": "register_verifiers",
+         "classifier": "register_classifiers",
          "tracker": "register_trackers", "format": "register_dataset_formats"}
 
 

@@ -26,7 +26,7 @@ from tsrkit.eval.aggregate import Evaluation
 from tsrkit.inputs import ImageReadError
 from tsrkit.lighting import light_condition
 from tsrkit.pipeline import Pipeline
-from tsrkit.plugin import Classifier, Detector, Plugin
+from tsrkit.plugin import Classifier, Detector, Plugin, Verifier
 from tsrkit.registry import PluginNotFound, get_registry
 from tsrkit.types import Candidate, Dataset, Sample
 
@@ -50,6 +50,7 @@ class Job:
     classifier: Classifier | None
     identity: str
     cache_dir: str | None
+    verifier: Verifier | None = None
 
 
 def plugin_identity(plugin: Plugin | None) -> dict[str, Any] | None:
@@ -121,7 +122,7 @@ def _compute(sample: Sample, job: Job) -> dict[str, Any]:
     lighting = sample.metadata.get("lighting") or light_condition(frame.image)
     try:
         if job.detector is not None:
-            result = Pipeline(job.detector, job.classifier).process(frame)
+            result = Pipeline(job.detector, job.classifier, verifier=job.verifier).process(frame)
             ms, detections = result.ms, result.detections
         else:
             ms, detections = _classify_annotations(job.classifier, frame, sample)
@@ -234,7 +235,8 @@ def evaluate(dataset: Dataset, detector: Detector | None, classifier: Classifier
              *, workers: int = 1, engine: str = "local", scheduler: Any = None,
              out: str | os.PathLike | None = None, cache: bool = True,
              cache_dir: str | os.PathLike | None = None, progress: bool = False,
-             iou_threshold: float = 0.5) -> tuple[dict[str, Any], Evaluation]:
+             iou_threshold: float = 0.5,
+             verifier: Verifier | None = None) -> tuple[dict[str, Any], Evaluation]:
     """Run and evaluate; return the report and the :class:`Evaluation` (per-frame scores).
 
     Parameters are those of :func:`benchmark`.
@@ -243,10 +245,13 @@ def evaluate(dataset: Dataset, detector: Detector | None, classifier: Classifier
 
     if detector is None and classifier is None:
         raise BenchmarkError("a benchmark needs a detector, a classifier, or both")
-    identity = json.dumps({"detector": plugin_identity(detector),
-                           "classifier": plugin_identity(classifier)}, sort_keys=True)
+    identities = {"detector": plugin_identity(detector),
+                  "classifier": plugin_identity(classifier)}
+    if verifier is not None:
+        identities["verifier"] = plugin_identity(verifier)
+    identity = json.dumps(identities, sort_keys=True)
     folder = (Path(cache_dir) if cache_dir else default_cache_dir(out)) if cache else None
-    job = Job(detector, classifier, identity, str(folder) if folder else None)
+    job = Job(detector, classifier, identity, str(folder) if folder else None, verifier)
     evaluation = Evaluation(dataset.name, iou_threshold)
     skipped, counts = [], {"computed": 0, "cached": 0}
     start = time.perf_counter()
@@ -264,6 +269,8 @@ def evaluate(dataset: Dataset, detector: Detector | None, classifier: Classifier
             sink.write(json.dumps(_jsonl_record(record)) + "\n")
     wall = time.perf_counter() - start
     report = base_report(dataset, plugin_identity(detector), plugin_identity(classifier))
+    if verifier is not None:
+        report["verifier"] = plugin_identity(verifier)
     metrics = evaluation.metrics()
     median = metrics.pop("ms_per_frame_median")
     if detector is None:
@@ -290,8 +297,8 @@ def benchmark(dataset: Dataset, detector: Detector | None, classifier: Classifie
               *, workers: int = 1, engine: str = "local", scheduler: Any = None,
               out: str | os.PathLike | None = None, cache: bool = True,
               cache_dir: str | os.PathLike | None = None, progress: bool = False,
-              iou_threshold: float = 0.5) -> dict[str, Any]:
-    """Run a detector (and classifier) over ``dataset`` and return the report dict.
+              iou_threshold: float = 0.5, verifier: Verifier | None = None) -> dict[str, Any]:
+    """Run a detector (and verifier, classifier) over ``dataset`` and return the report dict.
 
     Parameters
     ----------
@@ -312,10 +319,12 @@ def benchmark(dataset: Dataset, detector: Detector | None, classifier: Classifie
         Show a progress bar with frames/s on stderr.
     iou_threshold : float
         Threshold of the ``iou`` section (Lee 3.6.2); ``iou50`` always uses 0.5.
+    verifier : Verifier, optional
+        Rescores, refines (housing box) or rejects the detector's candidates.
     """
     report, _ = evaluate(dataset, detector, classifier, workers=workers, engine=engine,
                          scheduler=scheduler, out=out, cache=cache, cache_dir=cache_dir,
-                         progress=progress, iou_threshold=iou_threshold)
+                         progress=progress, iou_threshold=iou_threshold, verifier=verifier)
     return report
 
 

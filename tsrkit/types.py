@@ -34,6 +34,11 @@ class Candidate:
         The detector's confidence or saliency; higher is more likely (scale is the detector's).
     state : str or None
         A state the detector itself can tell (e.g. TL-recognizer's colour filters), else None.
+    housing : tuple of float or None
+        The signal housing around the lens, ``(x_min, y_min, x_max, y_max)``, once a housing
+        stage has fitted one; ``bbox`` stays the lens box.
+    housing_score : float or None
+        How well that housing fits, in [0, 1].
     """
 
     x: float
@@ -42,6 +47,18 @@ class Candidate:
     bbox: Box
     score: float
     state: str | None = None
+    housing: Box | None = None
+    housing_score: float | None = None
+
+    @property
+    def lens_bbox(self) -> Box:
+        """The lens box (what the detector found)."""
+        return self.bbox
+
+    @property
+    def object_bbox(self) -> Box:
+        """The box a record reports: the housing when one was fitted, else the lens box."""
+        return self.housing if self.housing is not None else self.bbox
 
     @classmethod
     def from_circle(cls, x: float, y: float, radius: float, score: float,
@@ -74,15 +91,22 @@ class Detection:
     track_id: int | None = None
 
     def to_record(self) -> dict[str, Any]:
-        """The JSON object ``tsrkit detect`` writes for this detection."""
+        """The JSON object ``tsrkit detect`` writes for this detection.
+
+        ``bbox`` is the housing when a housing stage fitted one, else the lens box;
+        ``lens_bbox`` is always the lens box.
+        """
         c = self.candidate
         record = {
             "x": round(c.x, 3), "y": round(c.y, 3), "radius": round(c.radius, 3),
-            "bbox": [round(v, 3) for v in c.bbox], "score": float(c.score),
+            "bbox": [round(v, 3) for v in c.object_bbox],
+            "lens_bbox": [round(v, 3) for v in c.bbox], "score": float(c.score),
             "state": self.state,
             "state_scores": {k: float(v) for k, v in self.state_scores.items()},
             "origin": self.origin,
         }
+        if c.housing_score is not None:
+            record["housing_score"] = round(float(c.housing_score), 4)
         if self.track_id is not None:
             record["track_id"] = self.track_id
         return record

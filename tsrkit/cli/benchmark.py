@@ -71,10 +71,10 @@ def load_dataset(ref: str, format_name: str | None, images: str | None, split: s
 
 
 def build_plugins(detector: str | None, classifier: str | None, params: Sequence[str],
-                  config_path: str | None):
-    """The detector (None for a classifier-only run on crops) and classifier to benchmark."""
+                  config_path: str | None, verifier: str | None = None):
+    """The detector (None for a classifier-only run on crops), classifier and verifier."""
     config = load_config(config_path) if config_path else None
-    chosen = selected_plugins(detector, classifier, None, config)
+    chosen = selected_plugins(detector, classifier, None, config, verifier)
     if classifier and not detector and not (config or {}).get("detector"):
         del chosen["detector"]
     registry = get_registry()
@@ -82,7 +82,7 @@ def build_plugins(detector: str | None, classifier: str | None, params: Sequence
         registry.get(kind, name)
     routed = route_params(chosen, params, config)
     plugins = {kind: registry.create(kind, name, routed[kind]) for kind, name in chosen.items()}
-    return plugins.get("detector"), plugins.get("classifier")
+    return plugins.get("detector"), plugins.get("classifier"), plugins.get("verifier")
 
 
 def _run_kwargs(workers, engine, scheduler, no_cache, iou_threshold, quiet) -> dict:
@@ -95,8 +95,8 @@ def _run_kwargs(workers, engine, scheduler, no_cache, iou_threshold, quiet) -> d
 @dataset_options
 @plugin_options
 @run_options
-def benchmark_command(dataset_ref, format_name, images, split, detector, classifier, tracker,
-                      params, config, workers, engine, scheduler, out, no_cache, iou_threshold,
+def benchmark_command(dataset_ref, format_name, images, split, detector, verifier, classifier,
+                      tracker, params, config, workers, engine, scheduler, out, no_cache, iou_threshold,
                       quiet) -> None:
     """Run a detector (and classifier) over a dataset and write an evaluated report.
 
@@ -108,9 +108,9 @@ def benchmark_command(dataset_ref, format_name, images, split, detector, classif
 
     if tracker:
         raise UserError("benchmark evaluates frames independently; --tracker is not supported")
-    det, cls = build_plugins(detector, classifier, params, config)
+    det, cls, ver = build_plugins(detector, classifier, params, config, verifier)
     dataset = load_dataset(dataset_ref, format_name, images, split)
-    report = benchmark(dataset, det, cls, out=out,
+    report = benchmark(dataset, det, cls, out=out, verifier=ver,
                        **_run_kwargs(workers, engine, scheduler, no_cache, iou_threshold, quiet))
     print_table([report])
     click.echo(f"report: {os.path.join(out, 'report.json')}", err=True)

@@ -15,15 +15,18 @@ DEFAULT_DETECTOR = "conspicuity"
 
 
 def plugin_options(func):
-    """Add ``--detector``, ``--classifier``, ``--tracker``, ``--param`` and ``--config``."""
+    """Add ``--detector``, ``--verifier``, ``--classifier``, ``--tracker``, ``--param``,
+    ``--config``."""
     options = [
         click.option("--detector", "-d", default=None,
                      help=f"Detector plugin (default {DEFAULT_DETECTOR})."),
+        click.option("--verifier", "-V", default=None,
+                     help="Verifier plugin: rescores, refines or rejects candidates."),
         click.option("--classifier", "-c", default=None, help="Classifier plugin."),
         click.option("--tracker", "-t", default=None, help="Tracker plugin (videos)."),
         click.option("--param", "-p", "params", multiple=True, metavar="KEY=VALUE",
-                     help="Plugin parameter; repeatable. Prefix with detector., classifier. "
-                          "or tracker. when two plugins share a key."),
+                     help="Plugin parameter; repeatable. Prefix with detector., verifier., "
+                          "classifier. or tracker. when two plugins share a key."),
         click.option("--config", type=click.Path(dir_okay=False), default=None,
                      help="YAML run configuration (plugins and their params)."),
     ]
@@ -66,12 +69,13 @@ def route_params(selected: Mapping[str, str], assignments: Sequence[str],
 
 
 def selected_plugins(detector: str | None, classifier: str | None, tracker: str | None,
-                     config: Mapping[str, Any] | None) -> dict[str, str]:
+                     config: Mapping[str, Any] | None,
+                     verifier: str | None = None) -> dict[str, str]:
     """Plugin names by kind: the command line wins over the config, which wins over defaults."""
     config = config or {}
     chosen = {}
-    for kind, given in (("detector", detector), ("classifier", classifier),
-                        ("tracker", tracker)):
+    for kind, given in (("detector", detector), ("verifier", verifier),
+                        ("classifier", classifier), ("tracker", tracker)):
         name = given or (config.get(kind) or {}).get("name")
         if kind == "detector":
             name = name or DEFAULT_DETECTOR
@@ -81,16 +85,18 @@ def selected_plugins(detector: str | None, classifier: str | None, tracker: str 
 
 
 def build_pipeline(detector: str | None, classifier: str | None, tracker: str | None,
-                   params: Sequence[str], config_path: str | None) -> Pipeline:
+                   params: Sequence[str], config_path: str | None,
+                   verifier: str | None = None) -> Pipeline:
     """Instantiate the selected plugins with validated parameters."""
     config = load_config(config_path) if config_path else None
-    chosen = selected_plugins(detector, classifier, tracker, config)
+    chosen = selected_plugins(detector, classifier, tracker, config, verifier)
     registry = get_registry()
     for kind, name in chosen.items():
         registry.get(kind, name)  # a clear error for an unknown name before routing params
     routed = route_params(chosen, params, config)
     plugins = {kind: registry.create(kind, name, routed[kind]) for kind, name in chosen.items()}
-    return Pipeline(plugins["detector"], plugins.get("classifier"), plugins.get("tracker"))
+    return Pipeline(plugins["detector"], plugins.get("classifier"), plugins.get("tracker"),
+                    plugins.get("verifier"))
 
 
 class UserError(click.ClickException):

@@ -83,14 +83,14 @@ def default_inputs() -> list[str]:
 @click.option("--start", type=click.IntRange(min=0), default=0, help="First video frame.")
 @click.option("--end", type=click.IntRange(min=0), default=None,
               help="Video frame to stop before.")
-def detect_command(paths, detector, classifier, tracker, params, config, out, draw, every,
+def detect_command(paths, detector, verifier, classifier, tracker, params, config, out, draw, every,
                    start, end) -> None:
     """Detect lit signal lenses in images, folders (recursive) or videos.
 
     Writes one JSON record per frame: source, frame, width, height, ms and detections (x, y,
     radius, bbox, score, state, state_scores). With no PATHS, runs on the bundled sample.
     """
-    pipeline = build_pipeline(detector, classifier, tracker, params, config)
+    pipeline = build_pipeline(detector, classifier, tracker, params, config, verifier)
     inputs = list(paths) or default_inputs()
     draw_dir = Path(draw) if draw else None
     if draw_dir is not None:
