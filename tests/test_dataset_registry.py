@@ -11,7 +11,7 @@ from tsrkit.datasets import DatasetError, load_registry, open_dataset
 from tsrkit.errors import TsrkitError
 
 REAL = ["roboflow_traffic_light_kr", "roboflow_cinta_v2_id", "udacity_mit_tl_crops",
-        "lisa_vgis_bulb_crops", "gtsrb_test_35px_subset"]
+        "lisa_vgis_bulb_crops", "gtsrb_test_35px_subset", "dtld_fridtjofs"]
 
 
 def _write_registry(tmp_path, monkeypatch, text):

@@ -97,7 +97,7 @@ def test_dtld_states_and_attributes(tmp_path):
     file.write_text(json.dumps(_dtld(labels)))
     ds = open_dataset(file)
     first, second = ds.samples[0].annotations
-    assert first.bbox == (10, 20, 15, 32) and first.state == "red"
+    assert first.bbox == (10, 20, 15, 32) and first.state == "red_yellow"
     assert first.attributes["label"] == "red_yellow" and first.attributes["pictogram"] == "circle"
     assert first.attributes["unique_id"] == 7 and second.state == "off"
     assert ds.samples[0].metadata["timestamp"] == 12.5

@@ -11,8 +11,9 @@ from typing import Any
 
 import numpy as np
 
-#: The signal states every classifier and dataset reader maps its labels onto.
-STATES = ("red", "yellow", "green", "off", "unknown")
+#: The signal states every classifier and dataset reader maps its labels onto. ``red_yellow``
+#: is the red+amber phase (Germany, UK...) where a dataset labels it.
+STATES = ("red", "yellow", "green", "red_yellow", "off", "unknown")
 
 Box = tuple[float, float, float, float]
 

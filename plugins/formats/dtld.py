@@ -20,7 +20,7 @@ from tsrkit_plugins.formats.common import (annotation, checked_box, field, json_
                                            read_json, resolve_image, sniff_json)
 
 STATES = {"red": "red", "yellow": "yellow", "green": "green", "off": "off",
-          "red_yellow": "red", "unknown": "unknown"}
+          "red_yellow": "red_yellow", "unknown": "unknown"}
 
 
 def _is_dtld(data) -> bool:

@@ -14,7 +14,8 @@ from tsrkit.types import STATES
 #: matching maps e.g. Bosch ``RedLeft`` to red, LISA ``goLeft`` to green, ``warningLeft`` to
 #: yellow. ``left`` alone (the Korean Roboflow arrow) is NOT here: its colour is a dataset fact
 #: and belongs in that dataset's registry entry.
-PREFIXES = (("red", "red"), ("stop", "red"), ("yellow", "yellow"), ("amber", "yellow"),
+PREFIXES = (("red_yellow", "red_yellow"), ("redyellow", "red_yellow"), ("red-yellow", "red_yellow"),
+            ("red", "red"), ("stop", "red"), ("yellow", "yellow"), ("amber", "yellow"),
             ("warning", "yellow"), ("green", "green"), ("go", "green"), ("off", "off"),
             ("dark", "off"), ("black", "off"))
 
@@ -29,6 +30,8 @@ def to_state(label: str, mapping: Mapping[str, str] | None = None) -> str:
     --------
     >>> to_state("GreenStraightLeft"), to_state("stop"), to_state("left")
     ('green', 'red', 'unknown')
+    >>> to_state("red_yellow")
+    'red_yellow'
     >>> to_state("left", {"left": "green"})
     'green'
     """
