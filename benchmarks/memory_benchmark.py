@@ -73,7 +73,7 @@ def measure(frames: int, data: Path, detector: str, workers: int) -> tuple[float
 
 def ensure_data(folder: Path) -> Path:
     """Generate the 2,000-frame synthetic set once (outside the repository)."""
-    from tsrkit.datasets.synth import generate
+    from tsrkit.synth import generate
 
     if not (folder / "annotations.json").is_file():
         print(f"generating {max(SIZES)} synthetic frames into {folder} ...", flush=True)

@@ -23,7 +23,7 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 
 import tsrkit  # noqa: E402
-from tsrkit.datasets.synth import generate  # noqa: E402
+from tsrkit.synth import generate  # noqa: E402
 from tsrkit.eval.perframe import FrameScore, score_frame, summarise  # noqa: E402
 from tsrkit.eval.stats import paired_test  # noqa: E402
 from tsrkit.report import fmt, markdown_table  # noqa: E402

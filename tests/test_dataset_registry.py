@@ -2,8 +2,6 @@
 from __future__ import annotations
 
 import json
-import sys
-import types
 
 import pytest
 
@@ -91,10 +89,7 @@ def test_sample_resolves_through_synth(tmp_path, monkeypatch):
     file = tmp_path / "annotations.json"
     file.write_text(json.dumps([{"file": "f.jpg", "split": "train", "width": 4, "height": 4,
                                  "boxes": []}]))
-    fake = types.ModuleType("tsrkit.datasets.synth")
-    fake.sample_path = lambda: file
-    monkeypatch.setitem(sys.modules, "tsrkit.datasets.synth", fake)
-    monkeypatch.setattr("tsrkit.datasets.synth", fake, raising=False)
+    monkeypatch.setattr("tsrkit.synth.scenes.sample_path", lambda: file)
     ds = open_dataset("sample")
     assert ds.name == "sample" and ds.format == "normalized" and len(ds) == 1
     assert ds.info["box"] == "lens"

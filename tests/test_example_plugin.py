@@ -73,7 +73,7 @@ def coco_ap50(folder: Path) -> float:
 def test_installed_plugin_benchmarks_real_coco_and_sample(installed, tmp_path, dataset,
                                                           shared_datasets):
     if dataset == "coco-file":  # a COCO path: the bundled sample's coco.json
-        from tsrkit.datasets.synth import sample_path
+        from tsrkit.synth import sample_path
 
         dataset = str(sample_path().parent / "coco.json")
     out = tmp_path / "bench"

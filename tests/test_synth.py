@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from tsrkit.datasets import synth
+from tsrkit.synth import scenes as synth
 from tsrkit.errors import TsrkitError
 from tsrkit.lighting import mean_v
 from tsrkit.registry import get_registry

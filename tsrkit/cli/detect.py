@@ -67,7 +67,7 @@ def _write_overlay(folder: Path, frame: Frame, number: int, detections) -> None:
 
 def default_inputs() -> list[str]:
     """The bundled synthetic sample's images (generated on first use)."""
-    from tsrkit.datasets.synth import sample_path
+    from tsrkit.synth import sample_path
 
     return [str(sample_path().parent / "images")]
 

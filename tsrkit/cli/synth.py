@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from tsrkit.datasets.synth import LIGHTINGS, generate
+from tsrkit.synth import LIGHTINGS, generate
 from tsrkit.errors import TsrkitError
 
 

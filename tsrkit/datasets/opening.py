@@ -128,6 +128,6 @@ def _registry_entry(ref: str | os.PathLike) -> DatasetEntry | None:
 
 
 def _sample_path() -> Path:
-    from tsrkit.datasets import synth
+    from tsrkit.synth import scenes as synth
 
     return Path(synth.sample_path())

@@ -51,10 +51,10 @@ class DatasetEntry:
         """The dataset folder: ``root`` if absolute, else under :func:`data_dir`.
 
         The root ``"generated:sample"`` is the synthetic sample's folder, generated on first
-        use by :func:`tsrkit.datasets.synth.sample_path`.
+        use by :func:`tsrkit.synth.sample_path`.
         """
         if self.root == GENERATED_SAMPLE:
-            from tsrkit.datasets import synth
+            from tsrkit.synth import scenes as synth
 
             return Path(synth.sample_path()).parent
         root = Path(self.root).expanduser()

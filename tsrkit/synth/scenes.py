@@ -662,7 +662,7 @@ def _check_size(frames: int, width: int, height: int) -> None:
 
 
 def _stamp(frames: int, seed: int, width: int, height: int, options: SynthOptions) -> dict:
-    return {"generator": "tsrkit.datasets.synth", "version": GENERATOR_VERSION,
+    return {"generator": "tsrkit.synth", "version": GENERATOR_VERSION,
             "frames": int(frames), "seed": int(seed), "width": int(width),
             "height": int(height), "options": {**asdict(options),
                                                "lighting": list(options.lighting)}}
