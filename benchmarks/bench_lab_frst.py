@@ -28,8 +28,8 @@ from oracles.frst_oracle import frst_oracle  # noqa: E402
 
 import tsrkit  # noqa: E402
 from tsrkit.types import Frame  # noqa: E402
-from tsrkit_plugins.detectors.frst import frst  # noqa: E402
-from tsrkit_plugins.detectors.lab_frst import lab_feature_map  # noqa: E402
+from tsrkit_plugins.detectors.frst.frst import frst  # noqa: E402
+from tsrkit_plugins.detectors.frst.lab_frst import lab_feature_map  # noqa: E402
 
 SIZES = ((480, 356), (1280, 720))
 

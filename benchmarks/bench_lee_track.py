@@ -21,7 +21,7 @@ from pathlib import Path  # noqa: E402
 import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
-from tsrkit.eval.matching import iou_matrix  # noqa: E402
+from tsrkit.geometry import iou_matrix  # noqa: E402
 from tsrkit.eval.overlap import score_overlap, summarise_overlap  # noqa: E402
 from tsrkit.inputs import iter_frames  # noqa: E402
 from tsrkit.pipeline import Pipeline  # noqa: E402

@@ -1,6 +1,6 @@
 """Zheng 2016, 5.2.1-5.2.3: accuracy of conspicuity against GRAY-TOPHAT and LAB-FRST.
 
-Compares the three detectors with ``tsrkit.runner.compare`` on two real sets and two synthetic
+Compares the three detectors with ``tsrkit.comparison.compare`` on two real sets and two synthetic
 ones, again with the radius range scaled to each real set's lens sizes, then evaluates a grid of
 conspicuity weights (w_L, w_LC, w_S), chosen per lighting class on one split and reported on the
 other (the 5.2.3 tuning rules). Prints Markdown tables; every run's outputs go under OUT.
@@ -27,7 +27,9 @@ from tsrkit.synth import generate  # noqa: E402
 from tsrkit.eval.perframe import FrameScore, score_frame, summarise  # noqa: E402
 from tsrkit.eval.stats import paired_test  # noqa: E402
 from tsrkit.report import fmt, markdown_table  # noqa: E402
-from tsrkit.runner import compare, evaluate  # noqa: E402
+from tsrkit.benchmarking import run_benchmark  # noqa: E402
+from tsrkit.comparison import compare  # noqa: E402
+from tsrkit.eval.perframe import frame_score  # noqa: E402
 
 DETECTORS = ("conspicuity", "gray-tophat", "lab-frst")
 #: Weight triplets (w_L, w_LC, w_S): Table 5-1's default first, then the settings of Zheng
@@ -210,7 +212,7 @@ PAIRED_HEADER = ["A", "B", "per-frame", "frames", "mean A - B", "p", "verdict"]
 
 def run_compare(dataset: tsrkit.Dataset, radii: list[int] | None, out: Path,
                 options: dict) -> tuple[list[dict], dict[str, dict[int, FrameScore]]]:
-    """``tsrkit.runner.compare`` of the three detectors; the reports and per-frame scores."""
+    """``tsrkit.comparison.compare`` of the three detectors; the reports and per-frame scores."""
     comparison = compare(dataset, make_detectors(radii), out=out, **options)
     runs = {name: frame_scores(dataset, out / name / "detections.jsonl") for name in DETECTORS}
     return comparison["reports"], runs
@@ -238,8 +240,8 @@ def grid_scores(dataset: tsrkit.Dataset, radii: list[int] | None,
     for weights in WEIGHTS:
         extra = {"radii": radii} if radii else {}
         detector = tsrkit.detector("conspicuity", weights=weights, **extra)
-        _, evaluation = evaluate(dataset, detector, **options)
-        scores[weights] = {i - 1: s for i, s in evaluation.scores.items()}
+        run = run_benchmark(dataset, detector, **options)
+        scores[weights] = {r.index: frame_score(sample, r) for sample, r in run.pairs()}
     return scores
 
 

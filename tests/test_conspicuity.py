@@ -8,8 +8,8 @@ import pytest
 
 import tsrkit
 from tsrkit.types import Frame
-from tsrkit_plugins.detectors import conspicuity as cs
-from tsrkit_plugins.detectors import conspicuity_kernel as ck
+from tsrkit_plugins.detectors.conspicuity import conspicuity as cs
+from tsrkit_plugins.detectors.conspicuity import conspicuity_kernel as ck
 from oracles.conspicuity_oracle import conspicuity_reference
 
 

@@ -8,8 +8,8 @@ from benchmark_fakes import OracleDetector, hand_dataset, make
 from pycocotools.coco import COCO
 from pycocotools.cocoeval import COCOeval
 
-from tsrkit.eval.coco import coco_ap, xywh
-from tsrkit.runner import benchmark
+from tsrkit.eval.coco import coco_ap
+from tsrkit.benchmarking import benchmark
 
 
 def pycocotools_stats(gt_path, dt_path):
@@ -44,6 +44,3 @@ def test_ap_edge_cases():
                             "score": 1.0}])
     assert perfect["ap50"] == pytest.approx(1.0) and perfect["ap"] == pytest.approx(1.0)
 
-
-def test_xywh():
-    assert xywh((1, 2, 4, 8)) == [1.0, 2.0, 3.0, 6.0]

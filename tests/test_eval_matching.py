@@ -2,7 +2,8 @@
 import numpy as np
 import pytest
 
-from tsrkit.eval.matching import centre_hits, enclosing_circles, greedy_match, iou_matrix
+from tsrkit.eval.matching import centre_hits, greedy_match
+from tsrkit.geometry import enclosing_circles, iou_matrix
 from tsrkit.eval.overlap import score_overlap, summarise_overlap
 
 

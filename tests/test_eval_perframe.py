@@ -1,8 +1,8 @@
 """Zheng 5.2.1 per-frame recall/precision and the Table 5-2 breakdown on hand-built frames."""
 import pytest
 
-from tsrkit.eval.perframe import (FrameScore, category_table, max_target_radius, precision_bound,
-                                  recall_label, score_frame, summarise)
+from tsrkit.eval.categories import category_table, precision_bound, recall_label
+from tsrkit.eval.perframe import FrameScore, max_target_radius, score_frame, summarise
 
 BOXES = [(0, 0, 10, 10), (20, 0, 30, 10), (40, 0, 50, 10), (60, 0, 70, 10)]
 

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from oracles.frst_oracle import frst_oracle
-from tsrkit_plugins.detectors.frst import (affected_pixels, frst, kappa,
+from tsrkit_plugins.detectors.frst.frst import (affected_pixels, frst, kappa,
                                            orientation_projection, radial_strength,
                                            select_voters, sobel_gradient)
 

@@ -7,7 +7,7 @@ import pytest
 
 import tsrkit
 from tsrkit.types import Frame
-from tsrkit_plugins.detectors.lab_frst import lab_feature_map, spot_candidates
+from tsrkit_plugins.detectors.frst.lab_frst import lab_feature_map, spot_candidates
 
 RED = (40, 40, 235)
 GREEN = (170, 230, 40)

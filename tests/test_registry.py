@@ -92,8 +92,10 @@ def test_wrong_kind_is_refused():
 def test_entry_points_load_builtins_and_respect_the_filter():
     reg = Registry()
     reg.load_entry_points("format-*")
-    assert reg.plugins() or reg.failures  # the filter admitted the format entry points
-    assert all(info.kind == "format" for info in reg.plugins())
+    assert reg.plugins("format") or reg.failures  # the filter admitted the format entry points
+    # Report writers and the core's metrics and verbs load whatever the filter says.
+    always = {"format", "metric", "writer"}
+    assert {info.kind for info in reg.plugins()} == always
     assert all(f.plugin.startswith("format-") for f in reg.failures)
     everything = Registry()
     everything.load_entry_points(None)
@@ -101,7 +103,9 @@ def test_entry_points_load_builtins_and_respect_the_filter():
     assert {"conspicuity", "gray-tophat", "lab-frst"} <= names
     none = Registry()
     none.load_entry_points("")
-    assert none.plugins() == [] and none.failures == []
+    assert {info.kind for info in none.plugins()} == {"metric", "writer"}
+    assert none.plugins("detector") == [] and none.failures == []
+    assert len(none.pm.hook.register_commands.get_hookimpls()) == 1  # the built-in verbs
 
 
 def test_plugins_json_lists_a_failing_entry_point(tmp_path):

@@ -13,7 +13,9 @@ import pytest
 from benchmark_fakes import (OracleDetector, RedClassifier, ShiftedDetector, hand_dataset,
                              make)
 
-from tsrkit.runner import BenchmarkError, benchmark, compare
+from tsrkit.benchmarking import benchmark
+from tsrkit.comparison import compare
+from tsrkit.engine import BenchmarkError
 from tsrkit.types import Annotation, Dataset, Sample
 
 TESTS = Path(__file__).resolve().parent
@@ -126,7 +128,7 @@ SCRIPT = """
 import sys
 sys.path.insert(0, {tests!r})
 from benchmark_fakes import OracleDetector, hand_dataset, make
-from tsrkit.runner import benchmark
+from tsrkit.benchmarking import benchmark
 benchmark(hand_dataset(30), make(OracleDetector, delay=0.04), out=sys.argv[1])
 """
 

@@ -12,10 +12,10 @@ import tsrkit
 from tsrkit.models import load_model, save_model
 from tsrkit.registry import get_registry
 from tsrkit.types import Annotation, Frame, Sample
-from tsrkit_plugins.detectors import tl_geometry as geo
+from tsrkit_plugins.detectors.tl_recognizer import tl_geometry as geo
 from tsrkit_plugins.detectors.tl_recognizer import TlRecognizer, enclosed_cores, red_or_yellow
-from tsrkit_plugins.detectors.tl_templates import disc_template, extract_patch, ncc
-from tsrkit_plugins.detectors.tl_tuning import patch_scores, smallest_ranges, tune_threshold
+from tsrkit_plugins.detectors.tl_recognizer.tl_templates import disc_template, extract_patch, ncc
+from tsrkit_plugins.detectors.tl_recognizer.tl_tuning import patch_scores, smallest_ranges, tune_threshold
 
 #: Lit-lens colours as a camera records them (BGR), distinct from the templates' own colours.
 LIT = {"green": (170, 250, 40), "red": (50, 30, 235), "yellow": (20, 180, 245)}
@@ -134,7 +134,7 @@ def test_round_street_lamps_are_rejected_by_housing_validation(lamp):
 
 
 def test_housing_template_layout():
-    from tsrkit_plugins.detectors.tl_templates import Layout, housing_template, patch_box
+    from tsrkit_plugins.detectors.tl_recognizer.tl_templates import Layout, housing_template, patch_box
     layout = Layout(True, 20, pitch=1.5, margin=0.5)
     t = housing_template("red", "vertical", layout)
     assert t.shape == (20 * 5 // 2, 20, 3)           # along (2 * 1.5 + 1 + 1) / across 2

@@ -1,39 +1,61 @@
 """The hooks a tsrkit plugin may implement (pluggy specifications).
 
 Each ``register_*`` hook receives a ``register`` callable; call it once per plugin class.
-``register_commands`` receives the root click group so a plugin can add a verb.
+``register_commands`` receives the root click group so a plugin can add a verb. The built-in
+methods, metrics, report writers and verbs are registered through these same hooks.
 """
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import TYPE_CHECKING
+
 import pluggy
+
+if TYPE_CHECKING:
+    import click
+
+    from tsrkit.plugin import (Classifier, DatasetFormat, Detector, Metric, ReportWriter,
+                               Tracker, Verifier)
 
 hookspec = pluggy.HookspecMarker("tsrkit")
 hookimpl = pluggy.HookimplMarker("tsrkit")
 
 
 @hookspec
-def register_detectors(register):
-    """Register :class:`tsrkit.plugin.Detector` subclasses: ``register(MyDetector)``."""
+def register_detectors(register: Callable[[type[Detector]], None]) -> None:
+    """Register :class:`tsrkit.Detector` subclasses: ``register(MyDetector)``."""
 
 
 @hookspec
-def register_verifiers(register):
-    """Register :class:`tsrkit.plugin.Verifier` subclasses."""
+def register_verifiers(register: Callable[[type[Verifier]], None]) -> None:
+    """Register :class:`tsrkit.Verifier` subclasses."""
 
 
 @hookspec
-def register_classifiers(register):
-    """Register :class:`tsrkit.plugin.Classifier` subclasses."""
+def register_classifiers(register: Callable[[type[Classifier]], None]) -> None:
+    """Register :class:`tsrkit.Classifier` subclasses."""
 
 
 @hookspec
-def register_trackers(register):
-    """Register :class:`tsrkit.plugin.Tracker` subclasses."""
+def register_trackers(register: Callable[[type[Tracker]], None]) -> None:
+    """Register :class:`tsrkit.Tracker` subclasses."""
 
 
 @hookspec
-def register_dataset_formats(register):
-    """Register :class:`tsrkit.plugin.DatasetFormat` subclasses."""
+def register_dataset_formats(register: Callable[[type[DatasetFormat]], None]) -> None:
+    """Register :class:`tsrkit.DatasetFormat` subclasses."""
 
 
 @hookspec
-def register_commands(cli):
+def register_metrics(register: Callable[[type[Metric]], None]) -> None:
+    """Register :class:`tsrkit.Metric` subclasses; each adds its sections to ``report.json``."""
+
+
+@hookspec
+def register_report_writers(register: Callable[[type[ReportWriter]], None]) -> None:
+    """Register :class:`tsrkit.ReportWriter` subclasses; each writes files of a run's folder."""
+
+
+@hookspec
+def register_commands(cli: click.Group) -> None:
     """Add click commands to the ``tsrkit`` group ``cli``."""

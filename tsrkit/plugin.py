@@ -1,4 +1,5 @@
-"""Base classes a plugin subclasses: Detector, Verifier, Classifier, Tracker, DatasetFormat.
+"""Base classes a plugin subclasses: Detector, Verifier, Classifier, Tracker, DatasetFormat,
+Metric and ReportWriter; and the :class:`Trainable` protocol of plugins ``tsrkit train`` fits.
 
 A subclass sets the class attributes ``name``, ``summary``, ``section`` (the document section it
 implements) and ``params`` (a tuple of :class:`tsrkit.params.Param`), then implements the one
@@ -10,10 +11,16 @@ from __future__ import annotations
 from abc import ABC, abstractmethod
 from collections.abc import Iterable, Sequence
 from pathlib import Path
-from typing import ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar, Protocol, runtime_checkable
 
 from tsrkit.params import Param
+from tsrkit.records import FrameRecord
 from tsrkit.types import Candidate, Dataset, Detection, Frame, Sample
+
+if TYPE_CHECKING:
+    from tsrkit.eval.settings import EvalSettings
+    from tsrkit.models import Model
+    from tsrkit.report import RunResult
 
 
 class Plugin(ABC):
@@ -37,8 +44,8 @@ class Plugin(ABC):
 class Detector(Plugin):
     """Finds candidate lit lenses in a frame. Detectors are stateless between frames.
 
-    A trainable detector also defines ``fit(samples) -> tsrkit.models.Model`` and reads a saved
-    model from its ``model`` parameter.
+    A trainable detector is also :class:`Trainable` and reads a saved model from its ``model``
+    parameter.
     """
 
     kind = "detector"
@@ -52,8 +59,8 @@ class Verifier(Plugin):
     """Rescores or rejects the candidates of any detector (the stage after detection).
 
     A verifier may also add facts to a candidate, such as its housing box
-    (:attr:`tsrkit.types.Candidate.housing`). A trainable verifier defines ``fit`` like a
-    trainable classifier.
+    (:attr:`tsrkit.types.Candidate.housing`). A trainable verifier is :class:`Trainable`: its
+    ``fit`` receives the detector whose candidates it learns to verify.
     """
 
     kind = "verifier"
@@ -66,8 +73,8 @@ class Verifier(Plugin):
 class Classifier(Plugin):
     """Assigns a state to each candidate of a frame.
 
-    A trainable classifier defines ``fit(samples) -> tsrkit.models.Model`` and reads a saved
-    model from its ``model`` parameter (falling back to a default model it ships).
+    A trainable classifier is :class:`Trainable` and reads a saved model from its ``model``
+    parameter (falling back to a default model it ships).
     """
 
     kind = "classifier"
@@ -126,9 +133,64 @@ class DatasetFormat(Plugin):
         raise TypeError(f"format '{self.name}' cannot be written")
 
 
+class Metric(Plugin):
+    """A figure of ``report.json``: fed one frame at a time, computed at the end.
+
+    :meth:`reset` starts an evaluation with its settings (dataset, IoU threshold, which box
+    is evaluated, whether false positives count); :meth:`update` folds in one frame's ground
+    truth and record; :meth:`compute` returns report sections, e.g. ``{"iou50": {...}}``.
+    Sections that two metrics share (``iou50``) are merged key by key.
+    """
+
+    kind = "metric"
+
+    @abstractmethod
+    def reset(self, settings: EvalSettings) -> None:
+        """Forget every frame; the next :meth:`update` starts a new evaluation."""
+
+    @abstractmethod
+    def update(self, sample: Sample, record: FrameRecord) -> None:
+        """Fold in one evaluated frame: ``sample`` is the ground truth, ``record`` the result."""
+
+    @abstractmethod
+    def compute(self) -> dict[str, Any]:
+        """The report sections of the frames seen so far."""
+
+
+class ReportWriter(Plugin):
+    """Writes files of a benchmark's output folder from the finished run.
+
+    :meth:`files` names what :meth:`write` will write (paths relative to the folder), so that
+    ``report.json`` can list every file before any is written. Writers with ``default =
+    False`` run only when asked for by name (``benchmark(writers=[...])``, ``--writer``).
+    """
+
+    kind = "writer"
+    #: Whether the writer runs when no writer list is given.
+    default: ClassVar[bool] = True
+
+    @abstractmethod
+    def files(self, run: RunResult) -> list[str]:
+        """The paths (relative to the output folder) :meth:`write` writes for ``run``."""
+
+    @abstractmethod
+    def write(self, run: RunResult, folder: Path) -> None:
+        """Write the files into ``folder`` (atomically, :mod:`tsrkit.atomic`)."""
+
+
+@runtime_checkable
+class Trainable(Protocol):
+    """A plugin ``tsrkit train`` can fit: one signature for every kind.
+
+    ``detector`` is given to a trainable verifier (it learns to verify that detector's
+    candidates: ``tsrkit train NAME --detector X``); detectors and classifiers ignore it.
+    """
+
+    def fit(self, samples: Iterable[Sample], *, detector: Detector | None = None) -> Model:
+        """Fit on annotated ``samples``; return the model to save."""
+        ...
+
+
 def is_trainable(cls: type[Plugin]) -> bool:
     """True when the plugin class can be fitted with ``tsrkit train``."""
     return callable(getattr(cls, "fit", None))
-
-
-TrainingSamples = Iterable[Sample]

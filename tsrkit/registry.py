@@ -1,13 +1,16 @@
 """The plugin manager: discovery through the ``tsrkit`` entry-point group, and look-up by name.
 
-Built-ins load through the same entry points a third-party package declares. A plugin that fails
-to import or to register is recorded as a :class:`PluginFailure` and the others still load.
-``TSRKIT_LOAD_PLUGINS`` (comma-separated entry-point names or shell patterns; empty for none)
-limits which installed plugins load.
+Built-ins load through the same entry points a third-party package declares; the core's own
+metrics and verbs are internal plugins (:data:`INTERNAL`) registered through the same hooks. A
+plugin that fails to import or to register is recorded as a :class:`PluginFailure` and the
+others still load. ``TSRKIT_LOAD_PLUGINS`` (comma-separated entry-point names or shell patterns;
+empty for none) limits which installed plugins load; report writers (``writer-*``) and the
+internal plugins always load, since every report needs them.
 """
 from __future__ import annotations
 
 import fnmatch
+import importlib
 import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -24,8 +27,13 @@ from tsrkit.plugin import Plugin, is_trainable
 ENTRY_POINT_GROUP = "tsrkit"
 LOAD_ENV = "TSRKIT_LOAD_PLUGINS"
 KINDS = {"detector": "register_detectors", "verifier": "register_verifiers",
-         "classifier": "register_classifiers",
-         "tracker": "register_trackers", "format": "register_dataset_formats"}
+         "classifier": "register_classifiers", "tracker": "register_trackers",
+         "format": "register_dataset_formats", "metric": "register_metrics",
+         "writer": "register_report_writers"}
+#: The core's own plugin modules: the built-in metrics and command-line verbs.
+INTERNAL = {"tsrkit-metrics": "tsrkit.eval.builtin", "tsrkit-commands": "tsrkit.cli.commands"}
+#: Entry points that load whatever ``TSRKIT_LOAD_PLUGINS`` says.
+ALWAYS_LOAD = ("writer-*",)
 
 
 class PluginNotFound(TsrkitError):
@@ -88,8 +96,15 @@ class Registry:
     _plugins: dict[str, dict[str, PluginInfo]] | None = None
 
     def load_entry_points(self, only: str | None = None) -> None:
-        """Import and register every entry point of the group that ``only`` admits."""
+        """Register the internal plugins, then import and register every entry point of the
+        group that ``only`` admits."""
+        version = _tsrkit_version()
+        for name, module in INTERNAL.items():
+            if name not in self._origin:
+                self.add(importlib.import_module(module), name, "tsrkit", version)
         patterns = None if only is None else [p.strip() for p in only.split(",") if p.strip()]
+        if patterns is not None:
+            patterns += ALWAYS_LOAD
         for ep in sorted(metadata.entry_points(group=ENTRY_POINT_GROUP), key=lambda e: e.name):
             if patterns is not None and not any(fnmatch.fnmatch(ep.name, p) for p in patterns):
                 continue
@@ -165,6 +180,13 @@ def _new_manager() -> pluggy.PluginManager:
     pm = pluggy.PluginManager("tsrkit")
     pm.add_hookspecs(hookspecs)
     return pm
+
+
+def _tsrkit_version() -> str:
+    try:
+        return metadata.version("tsrkit")
+    except metadata.PackageNotFoundError:
+        return "0+unknown"
 
 
 def _describe(exc: BaseException) -> str:

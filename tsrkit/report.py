@@ -1,14 +1,16 @@
-"""Benchmark outputs: report.json, summary.md (Table 5-2 layout), COCO files, plots, rich tables.
+"""report.json built in one place (:func:`build_report`), the finished run writers receive, and
+the headline figures as tables (rich on the terminal, Markdown for the writers).
 
-Every file is written atomically (:mod:`tsrkit.atomic`), so a killed run never leaves half a
-report. ``summary_markdown`` and ``report_table`` render the same headline figures.
+The files of a run's folder are written by report writers (``register_report_writers``; the
+built-in ones are in ``tsrkit_plugins.writers``), each atomically (:mod:`tsrkit.atomic`).
 """
 from __future__ import annotations
 
 import platform
 import sys
+from collections.abc import Iterable, Iterator, Mapping, Sequence
+from dataclasses import dataclass
 from importlib import metadata
-from pathlib import Path
 from typing import Any
 
 from rich import box
@@ -17,9 +19,10 @@ from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TextColumn,
                            TimeRemainingColumn)
 from rich.table import Table
 
-from tsrkit.atomic import atomic_open, write_json
-from tsrkit.eval.perframe import recall_sort_key
-from tsrkit.types import Dataset
+from tsrkit.errors import TsrkitError
+from tsrkit.eval.settings import EvalSettings
+from tsrkit.records import FrameRecord
+from tsrkit.types import Dataset, Sample
 
 #: (section, key, column label, format) of the headline figures.
 HEADLINE = (("per_frame", "recall_mean", "recall", ".3f"),
@@ -51,6 +54,12 @@ class ProgressBar:
         speed = self.progress.tasks[0].speed
         self.progress.update(self.task, rate=f"{speed:.1f}" if speed else "-")
 
+    def track(self, items: Iterable[Any]) -> Iterator[Any]:
+        """Yield ``items``, advancing the bar after each."""
+        for item in items:
+            self.advance()
+            yield item
+
 
 def versions() -> dict[str, str]:
     """Versions of Python and the libraries that shape the numbers."""
@@ -64,33 +73,80 @@ def versions() -> dict[str, str]:
     return found
 
 
-def base_report(dataset: Dataset, detector: dict | None, classifier: dict | None) -> dict:
-    """The descriptive keys of report.json (the metrics are added by the runner)."""
-    return {
+@dataclass(frozen=True)
+class RunResult:
+    """A finished benchmark run: what every report writer receives.
+
+    ``records`` are the evaluated frames in dataset order (skipped ones are listed in
+    ``report["skipped"]``); ``dataset.samples[record.index]`` is a record's ground truth.
+    """
+
+    report: dict[str, Any]
+    dataset: Dataset
+    settings: EvalSettings
+    records: tuple[FrameRecord, ...] = ()
+
+    def pairs(self) -> Iterator[tuple[Sample, FrameRecord]]:
+        """``(sample, record)`` of every evaluated frame."""
+        return ((self.dataset.samples[r.index], r) for r in self.records)
+
+
+def merge_sections(results: Iterable[tuple[str, Mapping[str, Any]]]) -> dict[str, Any]:
+    """The report sections of several metrics, given as ``(metric name, sections)``.
+
+    A section two metrics fill (``iou50``) is merged key by key; a key both set is an error.
+    """
+    merged: dict[str, Any] = {}
+    for name, sections in results:
+        for section, value in sections.items():
+            if section not in merged:
+                merged[section] = dict(value) if isinstance(value, Mapping) else value
+            elif (isinstance(value, Mapping) and isinstance(merged[section], dict)
+                  and not value.keys() & merged[section].keys()):
+                merged[section].update(value)
+            else:
+                raise TsrkitError(f"metric '{name}' writes report section '{section}', which "
+                                  "another metric already wrote")
+    return merged
+
+
+def build_report(dataset: Dataset, plugins: Mapping[str, dict | None], settings: EvalSettings,
+                 sections: Mapping[str, Any], frames: int, timing: Mapping[str, Any],
+                 skipped: Sequence[Mapping[str, str]], files: Sequence[str] = (),
+                 notes: Sequence[str] = ()) -> dict[str, Any]:
+    """``report.json``: the run's description, the metrics' sections, timing and outputs.
+
+    Parameters
+    ----------
+    plugins : mapping
+        ``{"detector": identity, "classifier": identity[, "verifier": identity]}`` (identities
+        from :func:`tsrkit.engine.plugin_identity`, None for a missing stage).
+    sections : mapping
+        The merged metric sections (:func:`merge_sections`).
+    files : sequence of str
+        Every file the writers write; those under ``plots/`` are listed as ``plots``.
+    notes : sequence of str
+        Caveats a reader must see (e.g. a dataset that is not exhaustively labelled).
+    """
+    report: dict[str, Any] = {
         "dataset": {"name": dataset.name, "format": dataset.format, "root": dataset.root,
                     "samples": len(dataset),
-                    "box_convention": (dataset.info.get("box") or dataset.info.get("box_convention")
-                                       or "unknown")},
-        "detector": detector, "classifier": classifier,
-        "params": {kind: plugin["params"] for kind, plugin in
-                   (("detector", detector), ("classifier", classifier)) if plugin},
+                    "box_convention": (dataset.info.get("box")
+                                       or dataset.info.get("box_convention") or "unknown")},
+        **{kind: identity for kind, identity in plugins.items()},
+        "params": {kind: identity["params"] for kind, identity in plugins.items() if identity},
         "versions": versions(),
+        "evaluated_box": settings.box if settings.detection else None,
+        "frames": frames,
+        **sections,
+        "timing": dict(timing),
+        "skipped": list(skipped),
+        "plots": [f for f in files if f.startswith("plots/")],
+        "files": sorted(f for f in files if not f.startswith("plots/")),
     }
-
-
-def write_outputs(out: Path, report: dict, evaluation) -> None:
-    """report.json, summary.md, detections.coco.json, ground_truth.coco.json and plots/."""
-    from tsrkit.plots import write_plots
-
-    out.mkdir(parents=True, exist_ok=True)
-    write_json(out / "ground_truth.coco.json", evaluation.ground_truth())
-    write_json(out / "detections.coco.json", evaluation.results)
-    report["plots"] = write_plots(out / "plots", report, evaluation.pr_curve)
-    report["files"] = sorted(["report.json", "summary.md", "detections.jsonl",
-                              "detections.coco.json", "ground_truth.coco.json"])
-    write_json(out / "report.json", report)
-    with atomic_open(out / "summary.md") as fh:
-        fh.write(summary_markdown(report))
+    if notes:
+        report["notes"] = list(notes)
+    return report
 
 
 def fmt(value: Any, spec: str = ".3f") -> str:
@@ -110,70 +166,6 @@ def title(report: dict) -> str:
     """``detector + classifier`` as a run's name."""
     names = [p["name"] for p in (report["detector"], report["classifier"]) if p]
     return " + ".join(names)
-
-
-def summary_markdown(report: dict) -> str:
-    """The Markdown summary: headline figures, skipped inputs and the Table 5-2 breakdown."""
-    pf = report["per_frame"]
-    lines = [f"# {title(report)} on {report['dataset']['name']}", "",
-             f"{report['frames']} frames evaluated, {len(report['skipped'])} skipped; "
-             f"box convention: {report['dataset']['box_convention']}.", "",
-             markdown_table(["figure", "value", "95 % interval"],
-                            [[label, value, _interval(report, label)]
-                             for label, value in headline(report).items()]), "",
-             pf.get("note") or
-             f"Frames without ground truth: {pf['frames_without_gt']} "
-             f"({pf['false_positives_without_gt']} false positives on "
-             f"{pf['frames_without_gt_with_detections']} of them).", ""]
-    if report["categories"]:
-        lines += ["## Frame counts by lighting and max target radius (Zheng Table 5-2 layout)",
-                  "", category_markdown(report["categories"]), ""]
-    if report["state"]["pairs"] and "note" not in report["state"]:
-        lines += ["## States of matched detections", "", state_markdown(report["state"]), ""]
-    if report["skipped"]:
-        lines += ["## Skipped", ""] + [f"- `{s['source']}`: {s['reason']}"
-                                       for s in report["skipped"]] + [""]
-    return "\n".join(lines)
-
-
-def _interval(report: dict, label: str) -> str:
-    key = {"recall": "recall_mean", "prec.": "precision_mean",
-           "hit": "hit_frame_fraction"}.get(label)
-    interval = report.get("intervals", {}).get(key) if key else None
-    return f"{interval[0]:.3f} - {interval[1]:.3f}" if interval else ""
-
-
-def category_markdown(rows: list[dict]) -> str:
-    """Table 5-2: one row per lighting (total) and radius; recall labels then precision bounds."""
-    recall_cols = sorted({k for r in rows for k in r["recall_counts"]}, key=recall_sort_key)
-    precision_cols = sorted({k for r in rows for k in r["precision_counts"]},
-                            key=lambda k: int(k[:-1]))
-    header = (["lighting - max radius"] + [f"R {c}" for c in recall_cols]
-              + [f"P {c}" for c in precision_cols] + ["total"])
-    body = []
-    for r in rows:
-        name = r["lighting"] if r["max_radius"] is None else f"{r['max_radius']}"
-        body.append([name] + [str(r["recall_counts"].get(c, "")) for c in recall_cols]
-                    + [str(r["precision_counts"].get(c, "")) for c in precision_cols]
-                    + [str(r["frames"])])
-    return markdown_table(header, body) if rows else "(no frame with ground truth)"
-
-
-def state_markdown(state: dict) -> str:
-    """Confusion matrix (rows truth, columns predicted), per-class figures and R-Y errors."""
-    labels, matrix = state["confusion"]["labels"], state["confusion"]["matrix"]
-    confusion = markdown_table(["truth \\ predicted"] + labels,
-                               [[label] + [str(v) for v in row]
-                                for label, row in zip(labels, matrix)])
-    classes = markdown_table(["state", "precision", "recall", "support"],
-                             [[name, fmt(c["precision"]), fmt(c["recall"]), str(c["support"])]
-                              for name, c in state["per_class"].items()])
-    ry = state["red_yellow_errors"]
-    ratio = f"mean discriminative ratio (Zheng 5.3): {fmt(state['discriminative_ratio']['mean'])}."
-    if not ry:  # sign classes: no red/yellow pair
-        return f"{confusion}\n\n{classes}\n\n{ratio[0].upper()}{ratio[1:]}"
-    return (f"{confusion}\n\n{classes}\n\nR-Y errors (Mascetti 5.1): {ry['total']} "
-            f"({ry['red_as_yellow']} red as yellow, {ry['yellow_as_red']} yellow as red); {ratio}")
 
 
 def markdown_table(header: list[str], rows: list[list[str]]) -> str:
@@ -201,24 +193,3 @@ def report_table(reports: list[dict]) -> Table:
 def print_table(reports: list[dict], file=None) -> None:
     """Print the headline table to stdout (or ``file``)."""
     Console(file=file or sys.stdout).print(report_table(reports))
-
-
-def compare_markdown(comparison: dict) -> str:
-    """compare.md: the side-by-side headline table and the paired tests."""
-    reports = comparison["reports"]
-    lines = [f"# Comparison on {comparison['dataset']}", "",
-             markdown_table(["method"] + [label for _, _, label, _ in HEADLINE],
-                            [[title(r)] + list(headline(r).values()) for r in reports]), "",
-             "## Paired tests on the same frames (Wilcoxon signed-rank, per-frame recall)", ""]
-    lines.append(markdown_table(
-        ["A", "B", "frames", "mean A - B", "p", "verdict"],
-        [[t["a"], t["b"], str(t["frames"]), fmt(t["mean_difference"]), fmt(t["p_value"]),
-          t["verdict"]] for t in comparison["paired_tests"]]))
-    return "\n".join(lines) + "\n"
-
-
-def write_compare(out: Path, comparison: dict) -> None:
-    """compare.json and compare.md in ``out``."""
-    write_json(out / "compare.json", comparison)
-    with atomic_open(out / "compare.md") as fh:
-        fh.write(compare_markdown(comparison))

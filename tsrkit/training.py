@@ -1,4 +1,8 @@
-"""Fitting a trainable plugin on a dataset and saving its model (``tsrkit train``)."""
+"""Fitting a trainable plugin on a dataset and saving its model (``tsrkit train``).
+
+Every trainable plugin follows :class:`tsrkit.plugin.Trainable`: ``fit(samples, *, detector=None)``;
+a verifier receives the detector whose candidates it learns to verify.
+"""
 from __future__ import annotations
 
 import hashlib
@@ -8,16 +12,16 @@ from typing import Any
 
 from tsrkit.errors import TsrkitError
 from tsrkit.models import save_model
-from tsrkit.plugin import is_trainable
+from tsrkit.plugin import Detector, is_trainable
 from tsrkit.registry import PluginInfo, get_registry
 from tsrkit.types import Dataset
 
 
 def trainable_plugin(name: str) -> PluginInfo:
-    """The trainable detector or classifier called ``name``."""
+    """The trainable detector, verifier or classifier called ``name``."""
     registry = get_registry()
     candidates = [info for info in registry.plugins() if info.name == name
-                  and info.kind in ("detector", "classifier")]
+                  and info.kind in ("detector", "verifier", "classifier")]
     if not candidates:
         known = sorted(i.name for i in registry.plugins() if is_trainable(i.cls))
         raise TsrkitError(f"no trainable plugin called '{name}' (trainable: "
@@ -43,12 +47,22 @@ def dataset_checksum(dataset: Dataset) -> str:
     return digest.hexdigest()
 
 
-def train(name: str, dataset: Dataset, out: str | Path, params: Mapping[str, Any]) -> Path:
-    """Fit plugin ``name`` on ``dataset`` with ``params``; write the model; return its path."""
+def train(name: str, dataset: Dataset, out: str | Path, params: Mapping[str, Any],
+          detector: Detector | None = None) -> Path:
+    """Fit plugin ``name`` on ``dataset`` with ``params``; write the model; return its path.
+
+    ``detector`` is passed to ``fit`` (a verifier learns on that detector's candidates).
+    """
     info = trainable_plugin(name)
+    if info.kind == "verifier" and detector is None:
+        raise TsrkitError(f"verifier '{name}' learns on a detector's candidates: give one "
+                          "(tsrkit train NAME --detector X)")
     plugin = info.create(**params)
-    model = plugin.fit(dataset)
+    extra = {"detector": detector} if detector is not None else {}
+    model = plugin.fit(dataset, **extra)  # type: ignore[attr-defined]
     training = {"dataset": dataset.name, "samples": len(dataset),
                 "checksum": dataset_checksum(dataset)}
+    if detector is not None:
+        training["detector"] = {"name": detector.name, "params": detector.params}
     return save_model(out, model, plugin=info.name, plugin_version=info.version,
                       params=plugin.params, training=training)

@@ -11,12 +11,13 @@ from typing import Any
 
 import numpy as np
 
+from tsrkit.geometry import Box, box_centre, circle_box, inscribed_circle
+from tsrkit.images import read_image
+from tsrkit.records import DetectionRecord
+
 #: The signal states every classifier and dataset reader maps its labels onto. ``red_yellow``
 #: is the red+amber phase (Germany, UK...) where a dataset labels it.
 STATES = ("red", "yellow", "green", "red_yellow", "off", "unknown")
-
-Box = tuple[float, float, float, float]
-
 
 
 @dataclass(frozen=True)
@@ -65,16 +66,15 @@ class Candidate:
     def from_circle(cls, x: float, y: float, radius: float, score: float,
                     state: str | None = None) -> Candidate:
         """Build a candidate whose box circumscribes the circle ``(x, y, radius)``."""
-        return cls(float(x), float(y), float(radius),
-                   (float(x - radius), float(y - radius), float(x + radius), float(y + radius)),
-                   float(score), state)
+        return cls(float(x), float(y), float(radius), circle_box(x, y, radius), float(score),
+                   state)
 
     @classmethod
     def from_box(cls, bbox: Sequence[float], score: float, state: str | None = None) -> Candidate:
         """Build a candidate centred in ``bbox`` with the radius of its inscribed circle."""
+        x, y, radius = inscribed_circle(bbox)
         x0, y0, x1, y1 = (float(v) for v in bbox)
-        return cls((x0 + x1) / 2, (y0 + y1) / 2, min(x1 - x0, y1 - y0) / 2,
-                   (x0, y0, x1, y1), float(score), state)
+        return cls(x, y, radius, (x0, y0, x1, y1), float(score), state)
 
 
 @dataclass(frozen=True)
@@ -95,22 +95,9 @@ class Detection:
         """The JSON object ``tsrkit detect`` writes for this detection.
 
         ``bbox`` is the housing when a housing stage fitted one, else the lens box;
-        ``lens_bbox`` is always the lens box.
+        ``lens_bbox`` is always the lens box (:class:`tsrkit.records.DetectionRecord`).
         """
-        c = self.candidate
-        record = {
-            "x": round(c.x, 3), "y": round(c.y, 3), "radius": round(c.radius, 3),
-            "bbox": [round(v, 3) for v in c.object_bbox],
-            "lens_bbox": [round(v, 3) for v in c.bbox], "score": float(c.score),
-            "state": self.state,
-            "state_scores": {k: float(v) for k, v in self.state_scores.items()},
-            "origin": self.origin,
-        }
-        if c.housing_score is not None:
-            record["housing_score"] = round(float(c.housing_score), 4)
-        if self.track_id is not None:
-            record["track_id"] = self.track_id
-        return record
+        return DetectionRecord.from_detection(self).to_json()
 
 
 @dataclass(frozen=True)
@@ -124,8 +111,7 @@ class Annotation:
     @property
     def center(self) -> tuple[float, float]:
         """Centre of the box."""
-        x0, y0, x1, y1 = self.bbox
-        return (x0 + x1) / 2, (y0 + y1) / 2
+        return box_centre(self.bbox)
 
 
 @dataclass(frozen=True, eq=False)
@@ -183,11 +169,9 @@ class Sample:
 
         Raises
         ------
-        tsrkit.inputs.ImageReadError
+        tsrkit.images.ImageReadError
             When the file is missing or not a decodable image.
         """
-        from tsrkit.inputs import read_image
-
         image = self.image if self.image is not None else read_image(self.source)
         return Frame(image=image, source=self.source, metadata=self.metadata)
 

@@ -4,7 +4,7 @@ histogram per colour; the best match wins, and a low discriminative ratio gives 
 """
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from pathlib import Path
 
 import cv2
@@ -13,7 +13,7 @@ import numpy as np
 from tsrkit.hookspecs import hookimpl
 from tsrkit.models import Model, ModelError, load_model
 from tsrkit.params import Param
-from tsrkit.plugin import Classifier
+from tsrkit.plugin import Classifier, Detector
 from tsrkit.types import Candidate, Detection, Frame, Sample
 from tsrkit_plugins.classifiers.decision import UNKNOWN, best_state, discriminative_ratio
 from tsrkit_plugins.classifiers.priors import warm_red
@@ -165,7 +165,7 @@ class AbHist(Classifier):
             out.append(Detection(candidate, state, scores))
         return out
 
-    def fit(self, samples: Sequence[Sample]) -> Model:
+    def fit(self, samples: Iterable[Sample], *, detector: Detector | None = None) -> Model:
         """Mean histogram per colour over the labelled lenses of ``samples`` (deterministic)."""
         bins = self.params["bins"]
         sums = np.zeros((len(self.states), bins, bins), np.float64)

@@ -5,7 +5,7 @@ of the expected lens size, and the most probable state wins; below a threshold i
 """
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from pathlib import Path
 
 import cv2
@@ -15,7 +15,7 @@ from scipy.ndimage import gaussian_filter1d
 from tsrkit.hookspecs import hookimpl
 from tsrkit.models import Model, ModelError, load_model
 from tsrkit.params import Param
-from tsrkit.plugin import Classifier
+from tsrkit.plugin import Classifier, Detector
 from tsrkit.types import Candidate, Detection, Frame, Sample
 from tsrkit_plugins.classifiers.decision import UNKNOWN, best_state, fuse_lights
 from tsrkit_plugins.classifiers.priors import warm_red
@@ -223,7 +223,7 @@ class HsiBackprojection(Classifier):
             states = [fused] * len(states)
         return [Detection(c, st, s) for c, st, s in zip(candidates, states, scores)]
 
-    def fit(self, samples: Sequence[Sample]) -> Model:
+    def fit(self, samples: Iterable[Sample], *, detector: Detector | None = None) -> Model:
         """Hue histograms per state and shared S and I histograms from an equal number of lit
         pixels per labelled lens (Lee 5.3.3); deterministic."""
         taken = [(state, lit_pixels(frame.image, lens))

@@ -21,7 +21,7 @@ from tsrkit.errors import TsrkitError
 from tsrkit.hookspecs import hookimpl
 from tsrkit.models import Model, load_model
 from tsrkit.params import Param
-from tsrkit.plugin import Classifier
+from tsrkit.plugin import Classifier, Detector
 from tsrkit.types import Candidate, Detection, Frame, Sample
 
 #: Parameters that shape the feature vector; a model records them and they must match.
@@ -147,7 +147,7 @@ class LogPolarSVM(Classifier):
         rows = [sign_vector(image, bbox, settings) for image, bbox in pairs]
         return np.array(rows, np.float64).reshape(len(rows), -1)
 
-    def fit(self, samples: Iterable[Sample]) -> Model:
+    def fit(self, samples: Iterable[Sample], *, detector: Detector | None = None) -> Model:
         """PCA and SVM on every annotated box; its ``state`` is the class name.
 
         Raises

@@ -19,7 +19,7 @@ from sklearn.ensemble import AdaBoostClassifier
 from sklearn.tree import DecisionTreeClassifier
 
 from tsrkit.errors import TsrkitError
-from tsrkit.eval.matching import iou_matrix
+from tsrkit.geometry import iou_matrix
 from tsrkit.hookspecs import hookimpl
 from tsrkit.models import Model, load_model
 from tsrkit.params import Param
@@ -408,7 +408,7 @@ class AdaBoostHSV(Detector):
         """The colours this instance trains and detects (from ``target``)."""
         return TARGET_COLOURS[self.params["target"]]
 
-    def fit(self, samples: Iterable[Sample]) -> Model:
+    def fit(self, samples: Iterable[Sample], *, detector: Detector | None = None) -> Model:
         """Learn one booster per colour from annotated boxes; see :func:`pixel_labels`.
 
         When ``samples`` is a :class:`~tsrkit.types.Dataset`, its licence and citation are

@@ -13,6 +13,7 @@ from pathlib import Path
 
 from tsrkit.atomic import write_json
 from tsrkit.datasets import DatasetError, to_state
+from tsrkit.geometry import xywh_to_xyxy, xyxy_to_xywh
 from tsrkit.hookspecs import hookimpl
 from tsrkit.plugin import DatasetFormat
 from tsrkit.types import Dataset, Sample
@@ -24,11 +25,6 @@ from tsrkit_plugins.formats.common import (annotation, checked_box, class_names,
 
 def _is_coco(data) -> bool:
     return isinstance(data, dict) and {"images", "annotations", "categories"} <= set(data)
-
-
-def xywh_to_box(x: float, y: float, w: float, h: float) -> tuple[float, float, float, float]:
-    """COCO ``[x, y, width, height]`` to ``(x_min, y_min, x_max, y_max)``."""
-    return x, y, x + w, y + h
 
 
 class Coco(DatasetFormat):
@@ -92,17 +88,17 @@ def _annotation(path: Path, ann, where: str, categories: dict):
     if category not in categories:
         raise DatasetError(path, f"unknown category_id {category}", where)
     values = numbers(field(ann, "bbox", list, path, where), 4, path, where)
-    bbox = checked_box(xywh_to_box(*values), path, where)
+    bbox = checked_box(xywh_to_xyxy(*values), path, where)
     return annotation(bbox, categories[category], explicit_state(ann, path, where),
                       **(ann.get("attributes") or {}))
 
 
 def _coco_annotation(ann, ann_id: int, image_id: int, ids: dict) -> dict:
-    x0, y0, x1, y1 = (float(v) for v in ann.bbox)
+    x, y, w, h = xyxy_to_xywh(ann.bbox)
     label = raw_label(ann)
     record = {"id": ann_id, "image_id": image_id, "category_id": ids[label],
-              "bbox": [round(x0, 3), round(y0, 3), round(x1 - x0, 3), round(y1 - y0, 3)],
-              "area": round((x1 - x0) * (y1 - y0), 3), "iscrowd": 0}
+              "bbox": [round(x, 3), round(y, 3), round(w, 3), round(h, 3)],
+              "area": round(w * h, 3), "iscrowd": 0}
     if ann.state != to_state(label):
         record["state"] = ann.state
     extra = extra_attributes(ann)

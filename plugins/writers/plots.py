@@ -1,4 +1,4 @@
-"""PNG plots of a benchmark (matplotlib, Agg backend): Figure 5-1 bubbles, bars and the PR curve.
+"""Report writer ``plots``: PNG plots (matplotlib, Agg): Figure 5-1 bubbles, bars, PR curve, confusion.
 
 ``bubble_plot`` follows Zheng 2016 Figure 5-1: one panel per lighting x max-radius category,
 recall against FPR = 1 - precision, circle area proportional to the share of the category's
@@ -14,6 +14,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402  (the backend must be chosen first)
 
+from tsrkit import ReportWriter, RunResult, hookimpl  # noqa: E402
 from tsrkit.atomic import atomic_open  # noqa: E402
 
 
@@ -99,18 +100,40 @@ def confusion_plot(state: dict, path: Path) -> str:
     return _save(fig, path)
 
 
-def write_plots(folder: Path, report: dict, curve: dict | None) -> list[str]:
-    """Write the plots that apply into ``folder``; return their paths relative to the report.
-
-    Detection runs get the bubble plot, the category bars and the PR curve; runs with
-    predicted states get the confusion matrix.
-    """
-    folder.mkdir(parents=True, exist_ok=True)
+def plot_names(report: dict) -> list[str]:
+    """The plots that apply to a report: detection runs get the bubble plot, the category bars
+    and the PR curve; runs with predicted states get the confusion matrix."""
     names = []
     if "ap" in report["iou50"]:
-        names += [bubble_plot(report["categories"], folder / "recall_fpr_bubbles.png"),
-                  category_bars(report["categories"], folder / "categories.png"),
-                  pr_curve(curve, report["iou50"]["ap"], folder / "pr_curve.png")]
+        names += ["recall_fpr_bubbles.png", "categories.png", "pr_curve.png"]
     if report["state"]["pairs"] and "note" not in report["state"]:
-        names.append(confusion_plot(report["state"], folder / "confusion.png"))
-    return [f"{folder.name}/{name}" for name in names]
+        names.append("confusion.png")
+    return names
+
+
+def write_plots(folder: Path, report: dict) -> None:
+    """Write the plots of :func:`plot_names` into ``folder``."""
+    folder.mkdir(parents=True, exist_ok=True)
+    draw = {"recall_fpr_bubbles.png": lambda path: bubble_plot(report["categories"], path),
+            "categories.png": lambda path: category_bars(report["categories"], path),
+            "pr_curve.png": lambda path: pr_curve(report["iou50"].get("pr_curve"),
+                                                  report["iou50"]["ap"], path),
+            "confusion.png": lambda path: confusion_plot(report["state"], path)}
+    for name in plot_names(report):
+        draw[name](folder / name)
+
+
+class Plots(ReportWriter):
+    name = "plots"
+    summary = "plots/: Figure 5-1 bubbles, category bars, PR curve, state confusion (PNG)"
+
+    def files(self, run: RunResult) -> list[str]:
+        return [f"plots/{name}" for name in plot_names(run.report)]
+
+    def write(self, run: RunResult, folder: Path) -> None:
+        write_plots(folder / "plots", run.report)
+
+
+@hookimpl
+def register_report_writers(register):
+    register(Plots)

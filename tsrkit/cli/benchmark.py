@@ -1,7 +1,7 @@
 """``tsrkit benchmark`` and ``tsrkit compare``: evaluate methods on a dataset, side by side.
 
-Both stream the frames through the runner (:mod:`tsrkit.runner`), print a rich table on stdout
-and write report.json, summary.md, COCO files and plots to ``--out``. Bare ``tsrkit`` runs
+Both run :func:`tsrkit.benchmarking.benchmark` / :func:`tsrkit.comparison.compare`, print a rich
+table on stdout and let the report writers fill ``--out``. Bare ``tsrkit`` runs
 ``run_default``: the three built-in detectors compared on the bundled synthetic sample.
 """
 from __future__ import annotations
@@ -11,10 +11,10 @@ from collections.abc import Sequence
 
 import click
 
-from tsrkit.cli.common import UserError, plugin_options, route_params, selected_plugins
-from tsrkit.params import load_config, parse_assignments
-from tsrkit.registry import get_registry
+from tsrkit.cli.common import UserError, plugin_options
+from tsrkit.eval.settings import BOX_OPTIONS
 from tsrkit.report import print_table
+from tsrkit.selection import build, build_compare
 
 DEFAULT_OUT = "tsrkit-out"
 DEFAULT_COMPARE = ("conspicuity", "gray-tophat", "lab-frst")
@@ -37,7 +37,8 @@ def dataset_options(func):
 
 
 def run_options(func):
-    """``--workers``, ``--engine``, ``--scheduler``, ``--out``, ``--no-cache``, ``--iou``."""
+    """``--workers``, ``--engine``, ``--scheduler``, ``--out``, ``--no-cache``, ``--iou``,
+    ``--quiet``, ``--eval-box``, ``--writer``."""
     options = [
         click.option("--workers", "-w", type=click.IntRange(min=1), default=None,
                      help="Worker processes (default: all cores)."),
@@ -52,6 +53,12 @@ def run_options(func):
                      default=0.5, show_default=True,
                      help="IoU threshold of the report's 'iou' section (Lee 3.6.2)."),
         click.option("--quiet", "-q", is_flag=True, help="No progress bar."),
+        click.option("--eval-box", type=click.Choice(BOX_OPTIONS), default="auto",
+                     show_default=True,
+                     help="Box evaluated: the lens box, the housing (bbox), or auto (lens on "
+                          "lens-boxed datasets, else housing)."),
+        click.option("--writer", "writers", multiple=True, metavar="NAME",
+                     help="Report writer to run (repeatable; default: every default writer)."),
     ]
     for option in reversed(options):
         func = option(func)
@@ -70,25 +77,11 @@ def load_dataset(ref: str, format_name: str | None, images: str | None, split: s
     return dataset
 
 
-def build_plugins(detector: str | None, classifier: str | None, params: Sequence[str],
-                  config_path: str | None, verifier: str | None = None):
-    """The detector (None for a classifier-only run on crops), classifier and verifier."""
-    config = load_config(config_path) if config_path else None
-    chosen = selected_plugins(detector, classifier, None, config, verifier)
-    if classifier and not detector and not (config or {}).get("detector"):
-        del chosen["detector"]
-    registry = get_registry()
-    for kind, name in chosen.items():
-        registry.get(kind, name)
-    routed = route_params(chosen, params, config)
-    plugins = {kind: registry.create(kind, name, routed[kind]) for kind, name in chosen.items()}
-    return plugins.get("detector"), plugins.get("classifier"), plugins.get("verifier")
-
-
-def _run_kwargs(workers, engine, scheduler, no_cache, iou_threshold, quiet) -> dict:
+def _run_kwargs(workers, engine, scheduler, no_cache, iou_threshold, quiet, eval_box,
+                writers) -> dict:
     return {"workers": workers or os.cpu_count() or 1, "engine": engine,
             "scheduler": scheduler, "cache": not no_cache, "iou_threshold": iou_threshold,
-            "progress": not quiet}
+            "progress": not quiet, "box": eval_box, "writers": list(writers) or None}
 
 
 @click.command("benchmark")
@@ -96,22 +89,24 @@ def _run_kwargs(workers, engine, scheduler, no_cache, iou_threshold, quiet) -> d
 @plugin_options
 @run_options
 def benchmark_command(dataset_ref, format_name, images, split, detector, verifier, classifier,
-                      tracker, params, config, workers, engine, scheduler, out, no_cache, iou_threshold,
-                      quiet) -> None:
+                      tracker, params, config, workers, engine, scheduler, out, no_cache,
+                      iou_threshold, quiet, eval_box, writers) -> None:
     """Run a detector (and classifier) over a dataset and write an evaluated report.
 
     With --classifier alone, classifies the ground-truth boxes (crop datasets) and reports
-    accuracy, per-class figures and the confusion matrix. Writes OUT/report.json, summary.md,
-    detections.jsonl, detections.coco.json, ground_truth.coco.json and plots/.
+    accuracy, per-class figures and the confusion matrix. The report writers write
+    OUT/report.json, summary.md, detections.jsonl, the COCO files, CSV tables and plots/.
     """
-    from tsrkit.runner import benchmark
+    from tsrkit.benchmarking import benchmark
 
     if tracker:
         raise UserError("benchmark evaluates frames independently; --tracker is not supported")
-    det, cls, ver = build_plugins(detector, classifier, params, config, verifier)
+    chosen = build(detector, verifier, classifier, None, params, config, classifier_alone=True)
     dataset = load_dataset(dataset_ref, format_name, images, split)
-    report = benchmark(dataset, det, cls, out=out, verifier=ver,
-                       **_run_kwargs(workers, engine, scheduler, no_cache, iou_threshold, quiet))
+    report = benchmark(dataset, chosen.detector, chosen.classifier, out=out,
+                       verifier=chosen.verifier,
+                       **_run_kwargs(workers, engine, scheduler, no_cache, iou_threshold, quiet,
+                                     eval_box, writers))
     print_table([report])
     click.echo(f"report: {os.path.join(out, 'report.json')}", err=True)
 
@@ -120,35 +115,36 @@ def benchmark_command(dataset_ref, format_name, images, split, detector, verifie
 @dataset_options
 @click.option("--detectors", "detector_names", default=",".join(DEFAULT_COMPARE),
               show_default=True, help="Comma-separated detector plugins.")
+@click.option("--verifier", "-V", default=None, help="Verifier plugin for every run.")
 @click.option("--classifier", "-c", default=None, help="Classifier plugin for every run.")
 @click.option("--param", "-p", "params", multiple=True, metavar="NAME.KEY=VALUE",
-              help="Parameter for one detector (prefix with its name) or classifier.KEY=VALUE.")
+              help="Parameter for one detector (prefix with its name), for classifier. or "
+                   "verifier.; unprefixed, for every chosen plugin that declares the key.")
 @run_options
-def compare_command(dataset_ref, format_name, images, split, detector_names, classifier, params,
-                    workers, engine, scheduler, out, no_cache, iou_threshold, quiet) -> None:
+def compare_command(dataset_ref, format_name, images, split, detector_names, verifier,
+                    classifier, params, workers, engine, scheduler, out, no_cache, iou_threshold,
+                    quiet, eval_box, writers) -> None:
     """Benchmark several detectors on the same frames; one report side by side.
 
     Writes OUT/<detector>/ for each run plus OUT/compare.json and OUT/compare.md with a paired
     test (Wilcoxon signed-rank on per-frame recall) for every pair.
     """
     run_compare(dataset_ref, format_name, images, split, detector_names, classifier, params,
-                out, _run_kwargs(workers, engine, scheduler, no_cache, iou_threshold, quiet))
+                out, _run_kwargs(workers, engine, scheduler, no_cache, iou_threshold, quiet,
+                                 eval_box, writers), verifier)
 
 
 def run_compare(dataset_ref, format_name, images, split, detector_names: str,
-                classifier: str | None, params: Sequence[str], out: str, options: dict) -> None:
+                classifier: str | None, params: Sequence[str], out: str, options: dict,
+                verifier: str | None = None) -> None:
     """Build every detector, compare them, print the table and the paired verdicts."""
-    from tsrkit.runner import compare
+    from tsrkit.comparison import compare
 
-    registry = get_registry()
     names = [n.strip() for n in detector_names.split(",") if n.strip()]
-    detectors = [registry.create("detector", name, parse_assignments(_params_for(name, params)))
-                 for name in names]
-    cls = (registry.create("classifier", classifier,
-                           parse_assignments(_params_for("classifier", params)))
-           if classifier else None)
+    runs = build_compare(names, classifier, verifier, params)
     dataset = load_dataset(dataset_ref, format_name, images, split)
-    comparison = compare(dataset, detectors, cls, out=out, **options)
+    comparison = compare(dataset, [run.detector for run in runs], runs[0].classifier,
+                         out=out, verifier=runs[0].verifier, **options)
     print_table(comparison["reports"])
     for test in comparison["paired_tests"]:
         click.echo(f"{test['a']} vs {test['b']}: {test['verdict']} "
@@ -156,16 +152,8 @@ def run_compare(dataset_ref, format_name, images, split, detector_names: str,
     click.echo(f"report: {os.path.join(out, 'compare.md')}", err=True)
 
 
-def _params_for(prefix: str, params: Sequence[str]) -> list[str]:
-    """The ``prefix.key=value`` assignments with the prefix removed."""
-    return [p.split(".", 1)[1] for p in params if p.startswith(prefix + ".")]
-
-
 @click.command("default", hidden=True)
 def run_default() -> None:
     """Compare the built-in detectors on the bundled sample, writing to ./tsrkit-out."""
     run_compare("sample", None, None, None, ",".join(DEFAULT_COMPARE), None, (), DEFAULT_OUT,
                 {"workers": os.cpu_count() or 1, "progress": True})
-
-
-COMMANDS = [benchmark_command, compare_command]

@@ -115,5 +115,3 @@ def _present(entry) -> str:
 
 
 datasets_group.add_command(synth_command)
-
-COMMANDS = [datasets_group]

@@ -11,11 +11,12 @@ import cv2
 from rich.console import Console
 
 from tsrkit.atomic import atomic_open
-from tsrkit.cli.common import build_pipeline, plugin_options
+from tsrkit.cli.common import plugin_options
 from tsrkit.draw import draw_detections
 from tsrkit.errors import TsrkitError
 from tsrkit.inputs import iter_frames
 from tsrkit.pipeline import Pipeline
+from tsrkit.selection import build
 from tsrkit.types import Frame, Skipped
 
 
@@ -90,7 +91,7 @@ def detect_command(paths, detector, verifier, classifier, tracker, params, confi
     Writes one JSON record per frame: source, frame, width, height, ms and detections (x, y,
     radius, bbox, score, state, state_scores). With no PATHS, runs on the bundled sample.
     """
-    pipeline = build_pipeline(detector, classifier, tracker, params, config, verifier)
+    pipeline = build(detector, verifier, classifier, tracker, params, config).pipeline()
     inputs = list(paths) or default_inputs()
     draw_dir = Path(draw) if draw else None
     if draw_dir is not None:
@@ -105,5 +106,3 @@ def detect_command(paths, detector, verifier, classifier, tracker, params, confi
     for item in skipped:
         console.print(f"  skipped {item.source}: {item.reason}", markup=False)
 
-
-COMMANDS = [detect_command]

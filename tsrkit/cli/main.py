@@ -1,11 +1,11 @@
-"""The ``tsrkit`` click group: built-in verbs plus those plugins add via ``register_commands``."""
+"""The ``tsrkit`` click group; every verb, built-in or not, is added via ``register_commands``."""
 from __future__ import annotations
 
 import click
 
 from tsrkit.cli.common import UserError
 from tsrkit.errors import TsrkitError
-from tsrkit.registry import PluginFailure, get_registry
+from tsrkit.registry import INTERNAL, PluginFailure, get_registry
 
 
 class TsrkitGroup(click.Group):
@@ -33,15 +33,8 @@ def cli(ctx: click.Context) -> None:
         ctx.invoke(run_default)
 
 
-def _add_builtin_commands() -> None:
-    from tsrkit.cli import benchmark, datasets, detect, plugins_cmd, train
-
-    for module in (plugins_cmd, detect, train, datasets, benchmark):
-        for command in module.COMMANDS:
-            cli.add_command(command)
-
-
-def _add_plugin_commands() -> None:
+def _add_commands() -> None:
+    """Every verb: the built-in ones (:mod:`tsrkit.cli.commands`) and the plugins'."""
     registry = get_registry()
     for impl in registry.pm.hook.register_commands.get_hookimpls():
         try:
@@ -49,10 +42,11 @@ def _add_plugin_commands() -> None:
         except Exception as exc:  # one broken plugin must not break the command line
             registry.failures.append(PluginFailure(
                 impl.plugin_name, "?", f"register_commands: {type(exc).__name__}: {exc}"))
+            if impl.plugin_name in INTERNAL:  # the core's own verbs must not fail silently
+                raise
 
 
-_add_builtin_commands()
-_add_plugin_commands()
+_add_commands()
 
 
 def main() -> None:

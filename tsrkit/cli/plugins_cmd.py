@@ -31,6 +31,3 @@ def plugins_command(as_json: bool, kind: str | None) -> None:
             table.add_row(item["name"], item["kind"], item["package"], item["version"],
                           item["summary"])
     Console().print(table)
-
-
-COMMANDS = [plugins_command]

@@ -5,6 +5,7 @@ import click
 from rich.console import Console
 
 from tsrkit.params import parse_assignments
+from tsrkit.registry import get_registry
 from tsrkit.training import train
 
 
@@ -21,16 +22,23 @@ from tsrkit.training import train
               help="Plugin parameter; repeatable.")
 @click.option("--out", required=True, type=click.Path(dir_okay=False),
               help="Model path (writes MODEL.npz and MODEL.json).")
-def train_command(plugin, dataset_ref, format_name, images, split, params, out) -> None:
-    """Fit PLUGIN (a trainable detector or classifier) and save the model for --param model=."""
+@click.option("--detector", "-d", default=None,
+              help="Detector whose candidates a trainable verifier learns on (its parameters: "
+                   "-p detector.KEY=VALUE).")
+def train_command(plugin, dataset_ref, format_name, images, split, params, out,
+                  detector) -> None:
+    """Fit PLUGIN (a trainable detector, verifier or classifier) and save the model for
+    --param model=."""
     from tsrkit.datasets import open_dataset
 
+    assignments = parse_assignments(params)
+    detector_params = {k.removeprefix("detector."): v for k, v in assignments.items()
+                       if k.startswith("detector.")}
+    own = {k: v for k, v in assignments.items() if not k.startswith("detector.")}
+    det = get_registry().create("detector", detector, detector_params) if detector else None
     dataset = open_dataset(dataset_ref, format=format_name, images=images)
     if split:
         dataset = dataset.split(split)
-    path = train(plugin, dataset, out, parse_assignments(params))
+    path = train(plugin, dataset, out, own, det)
     Console(stderr=True).print(f"trained {plugin} on {len(dataset)} samples of "
                                f"{dataset.name} -> {path}")
-
-
-COMMANDS = [train_command]

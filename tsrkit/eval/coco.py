@@ -1,47 +1,59 @@
-"""COCO export of ground truth and detections, and AP computed by pycocotools.
+"""COCO ground truth and detections of a run, and AP computed by pycocotools.
 
 Detection AP is class-agnostic (every box is category 1, ``traffic_light``): detectors report
 where lit lenses are, not their state. ``coco_ap`` returns pycocotools' AP at IoU 0.5 and its AP
-averaged over IoU 0.5:0.05:0.95, computed on exactly the dictionaries tsrkit writes to disk.
+averaged over IoU 0.5:0.05:0.95, computed on exactly the dictionaries the COCO writer puts on
+disk (:func:`coco_frame` builds both). Image ids are the dataset positions plus one.
 """
 from __future__ import annotations
 
 import contextlib
 import io
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Iterable, Mapping
 from typing import Any
+
+from tsrkit.eval.settings import EvalSettings
+from tsrkit.geometry import xyxy_to_xywh
+from tsrkit.plugin import Metric
+from tsrkit.records import FrameRecord
+from tsrkit.types import Sample
 
 CATEGORY = {"id": 1, "name": "traffic_light", "supercategory": "traffic_signal"}
 
 
-def xywh(bbox: Sequence[float]) -> list[float]:
-    """``(x_min, y_min, x_max, y_max)`` to COCO's ``[x, y, width, height]``."""
-    x0, y0, x1, y1 = (float(v) for v in bbox)
-    return [x0, y0, x1 - x0, y1 - y0]
+def coco_frame(sample: Sample, record: FrameRecord, first_id: int,
+               box: str) -> tuple[dict, list[dict], list[dict]]:
+    """One frame's COCO ``images`` entry, ground-truth ``annotations`` and ``results``.
+
+    ``first_id`` numbers the annotations; ``box`` is the evaluated record box (``lens`` or
+    ``housing``).
+    """
+    image_id = record.index + 1
+    image = {"id": image_id, "file_name": record.source, "width": int(record.width),
+             "height": int(record.height)}
+    annotations = []
+    for offset, ann in enumerate(sample.annotations):
+        xywh = xyxy_to_xywh(ann.bbox)
+        annotations.append({"id": first_id + offset, "image_id": image_id, "category_id": 1,
+                            "bbox": xywh, "area": xywh[2] * xywh[3], "iscrowd": 0,
+                            "state": ann.state})
+    results = [{"image_id": image_id, "category_id": 1, "bbox": xyxy_to_xywh(d.box(box)),
+                "score": float(d.score), "state": d.state} for d in record.detections]
+    return image, annotations, results
 
 
-def coco_image(image_id: int, source: str, width: int, height: int) -> dict[str, Any]:
-    """One entry of the COCO ``images`` list."""
-    return {"id": int(image_id), "file_name": source, "width": int(width), "height": int(height)}
-
-
-def coco_annotations(image_id: int, annotations: Iterable[Mapping[str, Any]],
-                     first_id: int) -> list[dict[str, Any]]:
-    """COCO ``annotations`` entries for one image's ground-truth ``{"bbox", "state"}`` dicts."""
-    entries = []
-    for offset, ann in enumerate(annotations):
-        box = xywh(ann["bbox"])
-        entries.append({"id": first_id + offset, "image_id": int(image_id), "category_id": 1,
-                        "bbox": box, "area": box[2] * box[3], "iscrowd": 0,
-                        "state": ann["state"]})
-    return entries
-
-
-def coco_results(image_id: int, detections: Iterable[Mapping[str, Any]]) -> list[dict[str, Any]]:
-    """COCO results entries for one image's detection records (``bbox``, ``score``, ``state``)."""
-    return [{"image_id": int(image_id), "category_id": 1, "bbox": xywh(d["bbox"]),
-             "score": float(d["score"]), "state": d.get("state", "unknown")}
-            for d in detections]
+def coco_run(name: str, pairs: Iterable[tuple[Sample, FrameRecord]],
+             box: str) -> tuple[dict[str, Any], list[dict[str, Any]]]:
+    """The COCO ground-truth dictionary and the results list of evaluated frames."""
+    images: list[dict] = []
+    annotations: list[dict] = []
+    results: list[dict] = []
+    for sample, record in pairs:
+        image, anns, dets = coco_frame(sample, record, len(annotations) + 1, box)
+        images.append(image)
+        annotations += anns
+        results += dets
+    return coco_dataset(images, annotations, name), results
 
 
 def coco_dataset(images: list[dict], annotations: list[dict], name: str) -> dict[str, Any]:
@@ -76,3 +88,33 @@ def coco_ap(ground_truth: Mapping[str, Any], results: list[dict[str, Any]]) -> d
     curve = {"recall": evaluator.params.recThrs.tolist(),
              "precision": evaluator.eval["precision"][0, :, 0, 0, -1].tolist()}
     return {"ap50": float(evaluator.stats[1]), "ap": float(evaluator.stats[0]), "curve": curve}
+
+
+class CocoAP(Metric):
+    """``iou50.ap``, ``iou50.ap_50_95`` and ``iou50.pr_curve``: pycocotools on the evaluated box."""
+
+    name = "coco-ap"
+    summary = "class-agnostic COCO AP at IoU 0.5 and 0.5:0.95 (pycocotools)"
+    section = "COCO detection evaluation (cocodataset.org/#detection-eval)"
+
+    def reset(self, settings: EvalSettings) -> None:
+        self.settings = settings
+        self.images: list[dict] = []
+        self.annotations: list[dict] = []
+        self.results: list[dict] = []
+
+    def update(self, sample: Sample, record: FrameRecord) -> None:
+        image, anns, dets = coco_frame(sample, record, len(self.annotations) + 1,
+                                       self.settings.box)
+        self.images.append(image)
+        self.annotations += anns
+        self.results += dets
+
+    def compute(self) -> dict:
+        if not self.settings.detection:
+            return {}
+        ap = coco_ap(coco_dataset(self.images, self.annotations, self.settings.dataset),
+                     self.results)
+        if not self.settings.exhaustive:
+            ap = {"ap50": None, "ap": None, "curve": None}
+        return {"iou50": {"ap": ap["ap50"], "ap_50_95": ap["ap"], "pr_curve": ap["curve"]}}

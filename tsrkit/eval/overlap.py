@@ -12,7 +12,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tsrkit.eval.matching import box_areas, greedy_match, intersection_matrix, iou_matrix
+from tsrkit.eval.matching import greedy_match
+from tsrkit.eval.settings import NOT_DETECTION, EvalSettings
+from tsrkit.geometry import box_areas, intersection_matrix, iou_matrix
+from tsrkit.plugin import Metric
+from tsrkit.records import FrameRecord
+from tsrkit.types import Sample
 
 
 @dataclass(frozen=True)
@@ -58,3 +63,35 @@ def summarise_overlap(scores: Sequence[OverlapScore], threshold: float) -> dict:
         "area_precision": sum(s.area_precision_sum for s in scores) / matched if matched else None,
         "area_recall": sum(s.area_recall_sum for s in scores) / matched if matched else None,
     }
+
+
+class OverlapPR(Metric):
+    """``iou50`` and ``iou``: Lee 3.6.2's overlap precision and recall at IoU 0.5 and ``--iou``.
+
+    Reads the evaluated box of each detection (``lens_bbox`` or ``bbox``, ``--eval-box``).
+    """
+
+    name = "iou-overlap"
+    summary = "precision, recall and area precision / recall of IoU matching at 0.5 and --iou"
+    section = "Lee 2017, 3.6.2"
+
+    def reset(self, settings: EvalSettings) -> None:
+        self.settings = settings
+        self.at50: list[OverlapScore] = []
+        self.at_threshold: list[OverlapScore] = []
+
+    def update(self, sample: Sample, record: FrameRecord) -> None:
+        boxes = [d.box(self.settings.box) for d in record.detections]
+        scores = [d.score for d in record.detections]
+        truth = [a.bbox for a in sample.annotations]
+        self.at50.append(score_overlap(boxes, scores, truth, 0.5))
+        self.at_threshold.append(score_overlap(boxes, scores, truth, self.settings.iou_threshold))
+
+    def compute(self) -> dict:
+        if not self.settings.detection:
+            return {"iou50": NOT_DETECTION, "iou": NOT_DETECTION}
+        out = {"iou50": summarise_overlap(self.at50, 0.5),
+               "iou": summarise_overlap(self.at_threshold, self.settings.iou_threshold)}
+        for section in out.values():
+            section["precision"] = self.settings.false_positive_figure(section["precision"])
+        return out

@@ -1,4 +1,4 @@
-"""Zheng 2016, 5.2.1: per-frame recall and precision, grouped as in Table 5-2 and Figure 5-1.
+"""Zheng 2016, 5.2.1: per-frame recall and precision, and the metric of the ``per_frame`` section.
 
 A candidate is a true positive when its centre lies in the minimum enclosing circle of any
 ground-truth box of the same frame. Reading chosen for the per-frame figures (the prose: "how many
@@ -6,21 +6,22 @@ of the present traffic signals in a given frame can be correctly detected" and "
 objects are reported among all detections"): recall = boxes whose circle holds at least one
 candidate centre / boxes; precision = candidates inside some circle / candidates.
 Summary definitions follow DESIGN.md; false positives on frames without ground truth are counted
-separately and do not enter ``precision_mean``.
+separately and do not enter ``precision_mean``. The Table 5-2 grouping is :mod:`tsrkit.eval.categories`.
 """
 from __future__ import annotations
 
 import math
-from collections import Counter, defaultdict
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from tsrkit.eval.matching import centre_hits
-
-#: Lower bounds (percent) of the precision columns; Table 5-2 uses a subset of these 5 % steps.
-PRECISION_BOUNDS = tuple(range(0, 101, 5))
+from tsrkit.eval.settings import NOT_DETECTION, EvalSettings
+from tsrkit.eval.stats import bootstrap_interval
+from tsrkit.plugin import Metric
+from tsrkit.records import FrameRecord
+from tsrkit.types import Sample
 
 
 @dataclass(frozen=True)
@@ -73,21 +74,6 @@ def max_target_radius(boxes) -> int:
     return int(math.floor(radius + 0.5))
 
 
-def recall_label(score: FrameScore) -> str:
-    """Table 5-2 recall column: ``"0"``, ``"1"`` or the unreduced fraction such as ``"2/4"``."""
-    if score.gt_hit == 0:
-        return "0"
-    if score.gt_hit == score.n_gt:
-        return "1"
-    return f"{score.gt_hit}/{score.n_gt}"
-
-
-def precision_bound(score: FrameScore) -> int:
-    """Table 5-2 precision column: the 5 % lower bound (a frame with no candidates counts as 0)."""
-    precision = score.precision or 0.0
-    return int(math.floor(precision * 20 + 1e-9)) * 5
-
-
 def summarise(scores: Sequence[FrameScore]) -> dict:
     """``recall_mean``, ``precision_mean``, ``hit_frame_fraction`` and the no-ground-truth counts.
 
@@ -115,42 +101,45 @@ def _mean(values: Iterable[float]) -> float | None:
     return float(np.mean(values)) if values else None
 
 
-def category_table(scores: Sequence[FrameScore]) -> list[dict]:
-    """The Table 5-2 rows: ground-truth frames grouped by lighting, then by max target radius.
-
-    Each lighting condition gets a total row (``max_radius`` None) followed by one row per
-    radius. A row holds the frame count, the counts per recall label and per precision lower
-    bound, its summary means, and the Figure 5-1 bubbles (recall, FPR = 1 - precision, frames).
-    """
-    groups: dict[tuple[str, int], list[FrameScore]] = defaultdict(list)
-    for s in scores:
-        if s.n_gt:
-            groups[(s.lighting, s.max_radius)].append(s)
-    rows = []
-    for lighting in sorted({key[0] for key in groups}):
-        radii = sorted(r for (light, r) in groups if light == lighting)
-        members = [s for r in radii for s in groups[(lighting, r)]]
-        rows.append(_row(lighting, None, members))
-        rows.extend(_row(lighting, r, groups[(lighting, r)]) for r in radii)
-    return rows
+def frame_score(sample: Sample, record: FrameRecord) -> FrameScore:
+    """One evaluated frame's :class:`FrameScore`: detection centres against its ground truth."""
+    return score_frame([(d.x, d.y) for d in record.detections],
+                       [a.bbox for a in sample.annotations], record.lighting or "unknown")
 
 
-def _row(lighting: str, radius: int | None, members: Sequence[FrameScore]) -> dict:
-    summary = summarise(members)
-    recall_counts = Counter(recall_label(s) for s in members)
-    precision_counts = Counter(precision_bound(s) for s in members)
-    bubbles = Counter((round(s.recall, 6), round(1 - (s.precision or 0.0), 6)) for s in members)
+def headline_intervals(scores: Sequence[FrameScore]) -> dict[str, list[float] | None]:
+    """Bootstrap 95 % intervals (over frames) of the three per-frame headline figures."""
+    with_gt = [s for s in scores if s.n_gt]
     return {
-        "lighting": lighting, "max_radius": radius, "frames": len(members),
-        "recall_mean": summary["recall_mean"], "precision_mean": summary["precision_mean"],
-        "hit_frame_fraction": summary["hit_frame_fraction"],
-        "recall_counts": dict(sorted(recall_counts.items(), key=lambda kv: recall_sort_key(kv[0]))),
-        "precision_counts": {f"{b}%": precision_counts[b] for b in sorted(precision_counts)},
-        "bubbles": [{"recall": r, "fpr": f, "frames": n} for (r, f), n in sorted(bubbles.items())],
+        "recall_mean": bootstrap_interval([s.recall for s in with_gt]),
+        "precision_mean": bootstrap_interval([s.precision for s in with_gt if s.n_det]),
+        "hit_frame_fraction": bootstrap_interval([float(s.recall > 0) for s in with_gt]),
     }
 
 
-def recall_sort_key(label: str) -> tuple[float, str]:
-    """Order Table 5-2 recall labels by value (``"1/4"`` before ``"1/3"`` before ``"2/4"``)."""
-    top, _, bottom = label.partition("/")
-    return (int(top) / int(bottom) if bottom else float(top), label)
+class ZhengPerFrame(Metric):
+    """``per_frame`` and ``intervals``: Zheng 5.2.1's per-frame means with bootstrap intervals.
+
+    A detection's centre (the lens centre) is matched to the ground truth's minimum enclosing
+    circles whichever box is evaluated.
+    """
+
+    name = "per-frame"
+    summary = "per-frame recall, precision and hit-frame fraction (centre in enclosing circle)"
+    section = "Zheng 2016, 5.2.1"
+
+    def reset(self, settings: EvalSettings) -> None:
+        self.settings = settings
+        self.scores: list[FrameScore] = []
+
+    def update(self, sample: Sample, record: FrameRecord) -> None:
+        self.scores.append(frame_score(sample, record))
+
+    def compute(self) -> dict:
+        if not self.settings.detection:
+            return {"per_frame": NOT_DETECTION, "intervals": {}}
+        summary, intervals = summarise(self.scores), headline_intervals(self.scores)
+        for figures in (summary, intervals):
+            figures["precision_mean"] = self.settings.false_positive_figure(
+                figures["precision_mean"])
+        return {"per_frame": summary, "intervals": intervals}

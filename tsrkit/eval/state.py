@@ -6,12 +6,17 @@ the discriminative ratio is Zheng 2016, 5.3: ``1 - min confidence / max confiden
 """
 from __future__ import annotations
 
+from collections import Counter
 from collections.abc import Mapping, Sequence
 
 import numpy as np
-from sklearn.metrics import confusion_matrix
+from sklearn.metrics import confusion_matrix, precision_recall_fscore_support
 
-from tsrkit.types import STATES
+from tsrkit.eval.matching import centre_hits, greedy_match
+from tsrkit.eval.settings import EvalSettings
+from tsrkit.plugin import Metric
+from tsrkit.records import FrameRecord
+from tsrkit.types import STATES, Sample
 
 #: Discriminative-ratio bin edges for the misclassification-rate curve (Zheng Figure 5-15).
 RATIO_EDGES = (0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0)
@@ -51,7 +56,7 @@ def state_metrics(truth: Sequence[str], predicted: Sequence[str],
     return {
         "pairs": len(truth),
         "accuracy": float(np.trace(matrix) / matrix.sum()) if matrix.sum() else None,
-        "per_class": per_class(matrix, labels),
+        "per_class": per_class(truth, predicted, labels),
         "confusion": {"labels": labels, "matrix": matrix.tolist()},
         "red_yellow_errors": red_yellow_errors(matrix, labels),
         "discriminative_ratio": ratio_figures(truth, predicted, scores or []),
@@ -64,24 +69,32 @@ def label_order(seen: set[str]) -> list[str]:
     Examples
     --------
     >>> label_order({"green", "red"})
-    ['red', 'yellow', 'green', 'off', 'unknown']
+    ['red', 'yellow', 'green', 'red_yellow', 'off', 'unknown']
     >>> label_order({"stop", "yield", "unknown"})
     ['stop', 'unknown', 'yield']
     """
     return list(STATES) if seen <= set(STATES) else sorted(seen)
 
 
-def per_class(matrix: np.ndarray, labels: Sequence[str]) -> dict[str, dict]:
-    """Precision, recall and support of every state that occurs (rows truth, columns predicted)."""
-    out = {}
-    for k, label in enumerate(labels):
-        support, predicted = int(matrix[k].sum()), int(matrix[:, k].sum())
-        if support or predicted:
-            hits = float(matrix[k, k])
-            out[label] = {"precision": hits / predicted if predicted else None,
-                          "recall": hits / support if support else None,
-                          "support": support}
-    return out
+def per_class(truth: Sequence[str], predicted: Sequence[str],
+              labels: Sequence[str]) -> dict[str, dict]:
+    """Precision, recall and support of every state that occurs (``sklearn.metrics``).
+
+    Examples
+    --------
+    >>> per_class(["red", "red", "green"], ["red", "green", "green"], ["red", "green", "off"])
+    {'red': {'precision': 1.0, 'recall': 0.5, 'support': 2}, 'green': {'precision': 0.5, \
+'recall': 1.0, 'support': 1}}
+    """
+    if not len(truth):
+        return {}
+    precision, recall, _, support = precision_recall_fscore_support(
+        truth, predicted, labels=list(labels), zero_division=np.nan)
+    predicted_counts = Counter(predicted)
+    return {label: {"precision": None if np.isnan(p) else float(p),
+                    "recall": None if np.isnan(r) else float(r), "support": int(n)}
+            for label, p, r, n in zip(labels, precision, recall, support)
+            if n or predicted_counts[label]}
 
 
 def red_yellow_errors(matrix: np.ndarray, labels: Sequence[str]) -> dict[str, int]:
@@ -114,3 +127,35 @@ def ratio_figures(truth: Sequence[str], predicted: Sequence[str],
              "misclassification_rate": float(wrong_a[index == k].mean())}
             for k in range(len(RATIO_EDGES) - 1) if (index == k).any()]
     return {"mean": float(ratios_a.mean()), "bins": bins}
+
+
+class StateMetric(Metric):
+    """``state``: the states of detections matched to ground truth by Zheng's centre rule.
+
+    Each ground-truth box takes at most one detection (best score first) whose centre lies in
+    its minimum enclosing circle; the pair's true and predicted states enter the figures.
+    """
+
+    name = "state"
+    summary = "state accuracy, per-class figures, confusion, R-Y errors, discriminative ratio"
+    section = "Mascetti 2016, 5.1; Zheng 2016, 5.3"
+
+    def reset(self, settings: EvalSettings) -> None:
+        self.settings = settings
+        self.truth: list[str] = []
+        self.predicted: list[str] = []
+        self.scores: list[Mapping[str, float]] = []
+
+    def update(self, sample: Sample, record: FrameRecord) -> None:
+        dets = record.detections
+        hits = centre_hits([(d.x, d.y) for d in dets], [a.bbox for a in sample.annotations])
+        for i, j in greedy_match([d.score for d in dets], hits.astype(float), 0.5):
+            self.truth.append(sample.annotations[j].state)
+            self.predicted.append(dets[i].state)
+            self.scores.append(dets[i].state_scores)
+
+    def compute(self) -> dict:
+        if all(p == "unknown" for p in self.predicted):
+            return {"state": {**state_metrics([], []), "note": "the method predicts no state "
+                              "(every detection is 'unknown')"}}
+        return {"state": state_metrics(self.truth, self.predicted, self.scores)}

@@ -43,7 +43,7 @@ from tsrkit.hookspecs import hookimpl
 from tsrkit.params import Param, ParamError
 from tsrkit.plugin import Detector
 from tsrkit.types import Candidate, Frame
-from tsrkit_plugins.detectors.conspicuity_kernel import (LIGHT_PREFIX, SAT_PREFIX, best_products,
+from tsrkit_plugins.detectors.conspicuity.conspicuity_kernel import (LIGHT_PREFIX, SAT_PREFIX, best_products,
                                                            prefix_tables)
 from tsrkit_plugins.detectors.localization import (LOCALIZATION_PARAMS, ROI_PARAM, localize,
                                                      region_of_interest)

@@ -13,7 +13,7 @@ from tsrkit.hookspecs import hookimpl
 from tsrkit.params import Param
 from tsrkit.plugin import Detector
 from tsrkit.types import Candidate, Frame
-from tsrkit_plugins.detectors.frst import frst
+from tsrkit_plugins.detectors.frst.frst import frst
 
 
 def lab_feature_map(image: np.ndarray) -> np.ndarray:

@@ -8,6 +8,7 @@ default the patch covers the 3-lens housing the lens implies (``context=housing`
 """
 from __future__ import annotations
 
+from collections.abc import Iterable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
@@ -18,10 +19,10 @@ from tsrkit.hookspecs import hookimpl
 from tsrkit.models import Model, load_model
 from tsrkit.params import Param
 from tsrkit.plugin import Detector
-from tsrkit.types import Candidate, Frame
+from tsrkit.types import Candidate, Frame, Sample
 
-from tsrkit_plugins.detectors import tl_geometry as geo
-from tsrkit_plugins.detectors.tl_templates import (
+from tsrkit_plugins.detectors.tl_recognizer import tl_geometry as geo
+from tsrkit_plugins.detectors.tl_recognizer.tl_templates import (
     ORIENTATIONS, Layout, extract_patch, load_templates, ncc, patch_box, patch_size)
 
 #: Filters of the ranges array: rows of ``ranges[k] = [[h, s, v]_min, [h, s, v]_max]``.
@@ -300,9 +301,9 @@ class TlRecognizer(Detector):
         patch = extract_patch(image, box, roll, centre, patch_size(orientation, self.layout))
         return ncc(patch, self.templates[state, orientation])
 
-    def fit(self, samples) -> Model:
+    def fit(self, samples: Iterable[Sample], *, detector: Detector | None = None) -> Model:
         """Derive range bounds (Figure 16) and T (5.2) from annotated samples."""
-        from tsrkit_plugins.detectors.tl_tuning import fit_model
+        from tsrkit_plugins.detectors.tl_recognizer.tl_tuning import fit_model
 
         return fit_model(self, samples)
 

@@ -13,7 +13,7 @@ import numpy as np
 from tsrkit.eval.matching import centre_hits
 from tsrkit.models import Model
 
-from tsrkit_plugins.detectors.tl_recognizer import (
+from tsrkit_plugins.detectors.tl_recognizer.tl_recognizer import (
     PASSES, extract_contours, range_mask, reduced_hsv)
 
 #: The broad first ranges standing in for the paper's "few manually sampled pixels" (5.2):

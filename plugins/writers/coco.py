@@ -1,0 +1,30 @@
+"""Report writer ``coco``: the evaluated frames as COCO ground truth and COCO detection results.
+
+``ground_truth.coco.json`` and ``detections.coco.json`` are the dictionaries the ``coco-ap``
+metric gave pycocotools, with the evaluated box (``report.json``'s ``evaluated_box``).
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+from tsrkit import ReportWriter, RunResult, hookimpl
+from tsrkit.atomic import write_json
+from tsrkit.eval.coco import coco_run
+
+
+class CocoFiles(ReportWriter):
+    name = "coco"
+    summary = "ground_truth.coco.json and detections.coco.json (class-agnostic, pycocotools)"
+
+    def files(self, run: RunResult) -> list[str]:
+        return ["detections.coco.json", "ground_truth.coco.json"]
+
+    def write(self, run: RunResult, folder: Path) -> None:
+        truth, results = coco_run(run.settings.dataset, run.pairs(), run.settings.box)
+        write_json(folder / "ground_truth.coco.json", truth)
+        write_json(folder / "detections.coco.json", results)
+
+
+@hookimpl
+def register_report_writers(register):
+    register(CocoFiles)

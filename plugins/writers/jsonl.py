@@ -1,0 +1,27 @@
+"""Report writer ``jsonl``: ``detections.jsonl``, one ``tsrkit detect`` record per evaluated frame
+(plus its lighting), in dataset order."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from tsrkit import ReportWriter, RunResult, hookimpl
+from tsrkit.atomic import atomic_open
+
+
+class JsonLines(ReportWriter):
+    name = "jsonl"
+    summary = "detections.jsonl: the per-frame records (detect's JSON Lines form)"
+
+    def files(self, run: RunResult) -> list[str]:
+        return ["detections.jsonl"]
+
+    def write(self, run: RunResult, folder: Path) -> None:
+        with atomic_open(folder / "detections.jsonl") as fh:
+            for record in run.records:
+                fh.write(json.dumps(record.to_json()) + "\n")
+
+
+@hookimpl
+def register_report_writers(register):
+    register(JsonLines)

@@ -1,0 +1,223 @@
+"""The engine: per-frame records computed in this process, a process pool or on Dask, cached.
+
+Frames stream through a bounded window of tasks and come back in dataset order, so memory stays
+flat whatever the dataset size. Each frame's :class:`~tsrkit.records.FrameRecord` is cached under
+a key made of the image's hash and the plugins' names, versions and parameters, so a killed run
+resumes where it stopped.
+"""
+from __future__ import annotations
+
+import hashlib
+import inspect
+import json
+import multiprocessing
+import os
+import time
+from collections import deque
+from collections.abc import Callable, Iterable, Iterator
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any
+
+from tsrkit.atomic import atomic_open
+from tsrkit.errors import TsrkitError
+from tsrkit.images import ImageReadError
+from tsrkit.lighting import light_condition
+from tsrkit.pipeline import FrameResult, Pipeline
+from tsrkit.plugin import Classifier, Detector, Plugin, Verifier
+from tsrkit.records import FrameRecord
+from tsrkit.registry import PluginNotFound, get_registry
+from tsrkit.types import Candidate, Frame, Sample
+
+ENGINES = ("local", "dask")
+
+
+class BenchmarkError(TsrkitError):
+    """A benchmark that cannot start: no plugin, bad engine, unreachable scheduler..."""
+
+
+@dataclass(frozen=True)
+class Job:
+    """What every worker needs: the plugins, their cache identity and the cache folder."""
+
+    detector: Detector | None
+    classifier: Classifier | None
+    identity: str
+    cache_dir: str | None
+    verifier: Verifier | None = None
+
+
+def plugin_identity(plugin: Plugin | None) -> dict[str, Any] | None:
+    """Name, version, parameters and source hash of a plugin (report and cache key)."""
+    if plugin is None:
+        return None
+    try:
+        version = get_registry().get(plugin.kind, plugin.name).version
+    except PluginNotFound:
+        version = plugin.version or "0"
+    params = json.loads(json.dumps(plugin.params, default=str, sort_keys=True))
+    return {"name": plugin.name, "version": version, "params": params,
+            "source_sha256": source_hash(type(plugin))}
+
+
+def source_hash(cls: type) -> str | None:
+    """SHA-256 of the file defining ``cls``, so editing a plugin without a version bump does
+    not reuse stale cached frames (helpers in other files are not covered)."""
+    try:
+        path = inspect.getsourcefile(cls)
+    except TypeError:
+        return None
+    if path is None or not os.path.isfile(path):
+        return None
+    with open(path, "rb") as fh:
+        return hashlib.sha256(fh.read()).hexdigest()
+
+
+def image_hash(sample: Sample) -> str:
+    """SHA-256 of the image file's bytes, or of the in-memory pixels and their shape."""
+    digest = hashlib.sha256()
+    if sample.image is not None:
+        digest.update(repr(sample.image.shape).encode())
+        digest.update(sample.image.tobytes())
+    else:
+        with open(sample.source, "rb") as fh:
+            for block in iter(lambda: fh.read(1 << 20), b""):
+                digest.update(block)
+    return digest.hexdigest()
+
+
+def process_sample(index: int, sample: Sample, job: Job) -> FrameRecord:
+    """The record of one frame: from the cache, else computed (and cached)."""
+    try:
+        key = hashlib.sha256((image_hash(sample) + job.identity).encode()).hexdigest()
+    except OSError as exc:
+        return FrameRecord(sample.source, index, skipped=f"cannot read: {exc.strerror or exc}")
+    path = Path(job.cache_dir, key[:2], f"{key}.json") if job.cache_dir else None
+    if path is not None and path.is_file():
+        with open(path, encoding="utf-8") as fh:
+            return replace(FrameRecord.from_json(json.load(fh)), index=index, cached=True)
+    record = compute_record(index, sample, job)
+    if path is not None and record.skipped is None:
+        with atomic_open(path) as fh:
+            json.dump(record.to_json(), fh)
+    return record
+
+
+def compute_record(index: int, sample: Sample, job: Job) -> FrameRecord:
+    """Load the frame, run the plugins and time them; a failure becomes a skipped record."""
+    try:
+        frame = sample.load()
+    except ImageReadError as exc:
+        return FrameRecord(sample.source, index, skipped=str(exc))
+    lighting = sample.metadata.get("lighting") or light_condition(frame.image)
+    try:
+        if job.detector is not None:
+            result = Pipeline(job.detector, job.classifier, verifier=job.verifier).process(frame)
+        else:
+            result = classify_annotations(job.classifier, frame, sample)
+    except TsrkitError:  # a setup problem (missing model...) would recur on every frame
+        raise
+    except Exception as exc:  # a crashing plugin costs one frame, not the run
+        return FrameRecord(sample.source, index,
+                           skipped=f"plugin error: {type(exc).__name__}: {exc}")
+    return replace(FrameRecord.from_result(result, str(lighting)), index=index)
+
+
+def classify_annotations(classifier: Classifier, frame: Frame, sample: Sample) -> FrameResult:
+    """Classification benchmark: the classifier alone on the ground-truth boxes."""
+    candidates = [Candidate.from_box(a.bbox, 1.0) for a in sample.annotations]
+    start = time.perf_counter()
+    detections = classifier.classify(frame, candidates)
+    ms = (time.perf_counter() - start) * 1000.0
+    return FrameResult(frame.source, frame.index, frame.width, frame.height, ms,
+                       tuple(detections))
+
+
+_WORKER_JOB: Job | None = None
+
+
+def _init_worker(job: Job) -> None:
+    global _WORKER_JOB
+    _WORKER_JOB = job
+    _single_thread()
+
+
+def _single_thread() -> None:
+    import cv2
+
+    cv2.setNumThreads(1)
+
+
+def _pool_context():
+    """Workers from a fork server: forking a process whose OpenCV thread pool has started can
+    crash the child, so children fork from a clean server that preloads the runner."""
+    context = multiprocessing.get_context("forkserver")
+    context.set_forkserver_preload(["tsrkit.engine"])
+    return context
+
+
+def _run_in_worker(index: int, sample: Sample) -> FrameRecord:
+    return process_sample(index, sample, _WORKER_JOB)
+
+
+def ordered(submit: Callable[[int, Sample], Any], result: Callable[[Any], FrameRecord],
+            samples: Iterable[Sample], window: int) -> Iterator[FrameRecord]:
+    """Submit tasks with at most ``window`` in flight; yield their results in dataset order."""
+    pending: deque = deque()
+    for index, sample in enumerate(samples):
+        pending.append(submit(index, sample))
+        if len(pending) >= window:
+            yield result(pending.popleft())
+    while pending:
+        yield result(pending.popleft())
+
+
+def run_records(samples: Iterable[Sample], job: Job, workers: int = 1, engine: str = "local",
+                scheduler: Any = None) -> Iterator[FrameRecord]:
+    """Frame records in dataset order, computed in this process, a process pool or on Dask."""
+    if engine not in ENGINES:
+        raise BenchmarkError(f"unknown engine '{engine}' (choose {' or '.join(ENGINES)})")
+    if workers < 1:
+        raise BenchmarkError(f"workers must be at least 1; got {workers}")
+    if engine == "dask":
+        yield from _run_dask(samples, job, workers, scheduler)
+    elif workers == 1:
+        yield from (process_sample(i, s, job) for i, s in enumerate(samples))
+    else:
+        with ProcessPoolExecutor(workers, mp_context=_pool_context(), initializer=_init_worker,
+                                 initargs=(job,)) as pool:
+            yield from ordered(lambda i, s: pool.submit(_run_in_worker, i, s),
+                               lambda f: f.result(), samples, 4 * workers)
+
+
+def _run_dask(samples: Iterable[Sample], job: Job, workers: int,
+              scheduler: Any) -> Iterator[FrameRecord]:
+    from distributed import Client, LocalCluster
+
+    cluster = None
+    if scheduler is None:
+        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, dashboard_address=None)
+        scheduler = cluster
+    address = getattr(scheduler, "scheduler_address", scheduler)
+    try:
+        client = Client(address, timeout="20s", set_as_default=False)
+    except OSError as exc:
+        raise BenchmarkError(f"cannot reach Dask scheduler {address}: {exc}") from None
+    try:
+        shared = client.scatter(job, broadcast=True)
+        window = 4 * max(workers, len(client.scheduler_info()["workers"]))
+        yield from ordered(lambda i, s: client.submit(process_sample, i, s, shared, pure=False),
+                           lambda f: f.result(), samples, window)
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+def default_cache_dir(out: str | os.PathLike | None) -> Path:
+    """``OUT/cache``, else ``$TSRKIT_CACHE_DIR/frames`` or ``~/.cache/tsrkit/frames``."""
+    if out is not None:
+        return Path(out) / "cache"
+    base = os.environ.get("TSRKIT_CACHE_DIR") or Path.home() / ".cache" / "tsrkit"
+    return Path(base) / "frames"
