@@ -77,13 +77,7 @@ def source_hash(cls: type) -> str | None:
 def image_hash(sample: Sample) -> str:
     """SHA-256 of the image file's bytes, or of the in-memory pixels and their shape."""
     digest = hashlib.sha256()
-    if sample.image is not None:
-        digest.update(repr(sample.image.shape).encode())
-        digest.update(sample.image.tobytes())
-    else:
-        with open(sample.source, "rb") as fh:
-            for block in iter(lambda: fh.read(1 << 20), b""):
-                digest.update(block)
+    sample.hash_into(digest)
     return digest.hexdigest()
 
 

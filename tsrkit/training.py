@@ -36,12 +36,7 @@ def dataset_checksum(dataset: Dataset) -> str:
     """sha256 over every sample's image bytes and annotations, in dataset order."""
     digest = hashlib.sha256()
     for sample in dataset:
-        if sample.image is not None:
-            digest.update(sample.image.tobytes())
-        else:
-            with open(sample.source, "rb") as fh:
-                for block in iter(lambda: fh.read(1 << 20), b""):
-                    digest.update(block)
+        sample.hash_into(digest)
         for ann in sample.annotations:
             digest.update(repr((tuple(round(v, 3) for v in ann.bbox), ann.state)).encode())
     return digest.hexdigest()

@@ -175,6 +175,17 @@ class Sample:
         image = self.image if self.image is not None else read_image(self.source)
         return Frame(image=image, source=self.source, metadata=self.metadata)
 
+    def hash_into(self, digest) -> None:
+        """Feed the image to a ``hashlib`` digest: the file's bytes, or the in-memory pixels
+        and their shape (the cache key and the training-set checksum)."""
+        if self.image is not None:
+            digest.update(repr(self.image.shape).encode())
+            digest.update(self.image.tobytes())
+            return
+        with open(self.source, "rb") as fh:
+            for block in iter(lambda: fh.read(1 << 20), b""):
+                digest.update(block)
+
 
 @dataclass(frozen=True)
 class Dataset:

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 
+from tsrkit.eval.state import discriminative_ratio as ratio_or_none
+
 UNKNOWN = "unknown"
 
 
@@ -22,8 +24,7 @@ def discriminative_ratio(scores: Mapping[str, float]) -> float:
     >>> discriminative_ratio({"red": 0.8, "yellow": 0.2, "green": 0.4})
     0.75
     """
-    top = max(scores.values())
-    return 0.0 if top <= 0 else 1.0 - min(scores.values()) / top
+    return ratio_or_none(scores) or 0.0
 
 
 def fuse_lights(decisions: Sequence[tuple[str, float]], threshold: float) -> str:

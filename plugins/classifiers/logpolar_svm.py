@@ -23,6 +23,7 @@ from tsrkit.models import Model, load_model
 from tsrkit.params import Param
 from tsrkit.plugin import Classifier, Detector
 from tsrkit.types import Candidate, Detection, Frame, Sample
+from tsrkit_plugins.classifiers.regions import clip_box
 
 #: Parameters that shape the feature vector; a model records them and they must match.
 FEATURE_KEYS = ("transform", "crop_size", "n_rho", "n_theta")
@@ -36,12 +37,7 @@ def crop_gray(image: np.ndarray, bbox: Sequence[float], size: int) -> np.ndarray
     ValueError
         When the box does not overlap the image.
     """
-    x0, y0, x1, y1 = bbox
-    h, w = image.shape[:2]
-    xa, ya = max(int(np.floor(x0)), 0), max(int(np.floor(y0)), 0)
-    xb, yb = min(int(np.ceil(x1)), w), min(int(np.ceil(y1)), h)
-    if xb <= xa or yb <= ya:
-        raise ValueError(f"box {tuple(bbox)} lies outside the {w}x{h} image")
+    xa, ya, xb, yb = clip_box(bbox, image.shape[1], image.shape[0])
     gray = cv2.cvtColor(image[ya:yb, xa:xb], cv2.COLOR_BGR2GRAY)
     return cv2.resize(gray, (size, size), interpolation=cv2.INTER_AREA).astype(np.float32)
 

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from tsrkit.geometry import clip_box as image_box
 from tsrkit.params import Param
 from tsrkit.types import Candidate, Frame, Sample
 
@@ -55,9 +56,7 @@ def clip_box(bbox, width: int, height: int) -> tuple[int, int, int, int]:
     ValueError
         When the box does not overlap the image.
     """
-    x0, y0, x1, y1 = bbox
-    box = (max(int(np.floor(x0)), 0), max(int(np.floor(y0)), 0),
-           min(int(np.ceil(x1)), width), min(int(np.ceil(y1)), height))
+    box = image_box(bbox, width, height)
     if box[2] <= box[0] or box[3] <= box[1]:
         raise ValueError(f"box {tuple(bbox)} lies outside the {width}x{height} image")
     return box

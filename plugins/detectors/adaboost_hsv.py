@@ -19,7 +19,7 @@ from sklearn.ensemble import AdaBoostClassifier
 from sklearn.tree import DecisionTreeClassifier
 
 from tsrkit.errors import TsrkitError
-from tsrkit.geometry import iou_matrix
+from tsrkit.geometry import clip_box, iou_matrix
 from tsrkit.hookspecs import hookimpl
 from tsrkit.models import Model, load_model
 from tsrkit.params import Param
@@ -180,10 +180,8 @@ def pixel_histograms(samples: Iterable[Sample], targets: Sequence[str], min_valu
 
 
 def _box_slice(bbox: Sequence[float], shape: tuple[int, int]) -> tuple[slice, slice]:
-    x0, y0, x1, y1 = bbox
-    rows = slice(max(int(np.floor(y0)), 0), min(int(np.ceil(y1)), shape[0]))
-    cols = slice(max(int(np.floor(x0)), 0), min(int(np.ceil(x1)), shape[1]))
-    return rows, cols
+    x0, y0, x1, y1 = clip_box(bbox, shape[1], shape[0])
+    return slice(y0, y1), slice(x0, x1)
 
 
 def fit_stumps(positive: np.ndarray, negative: np.ndarray, n_estimators: int,

@@ -8,11 +8,12 @@ from rich.console import Console
 from rich.table import Table
 
 import tsrkit
+from tsrkit.registry import KINDS
 
 
 @click.command("plugins")
 @click.option("--json", "as_json", is_flag=True, help="Print JSON (with parameter schemas).")
-@click.option("--kind", type=click.Choice(["detector", "classifier", "tracker", "format"]),
+@click.option("--kind", type=click.Choice(list(KINDS)),
               default=None, help="Only plugins of this kind.")
 def plugins_command(as_json: bool, kind: str | None) -> None:
     """List installed plugins: name, kind, package, version and summary."""

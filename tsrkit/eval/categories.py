@@ -9,11 +9,7 @@ import math
 from collections import Counter, defaultdict
 from collections.abc import Sequence
 
-from tsrkit.eval.perframe import FrameScore, frame_score, summarise
-from tsrkit.eval.settings import EvalSettings
-from tsrkit.plugin import Metric
-from tsrkit.records import FrameRecord
-from tsrkit.types import Sample
+from tsrkit.eval.perframe import FrameScore, FrameScoreMetric, summarise
 
 #: Lower bounds (percent) of the precision columns; Table 5-2 uses a subset of these 5 % steps.
 PRECISION_BOUNDS = tuple(range(0, 101, 5))
@@ -75,19 +71,12 @@ def precision_bound(score: FrameScore) -> int:
     return int(math.floor(precision * 20 + 1e-9)) * 5
 
 
-class LightingBySize(Metric):
+class LightingBySize(FrameScoreMetric):
     """``categories``: the Table 5-2 rows (lighting x max target radius) with Figure 5-1 bubbles."""
 
     name = "categories"
     summary = "frame counts by lighting and max target radius, recall and precision columns"
     section = "Zheng 2016, 5.2.1, Table 5-2, Figure 5-1"
-
-    def reset(self, settings: EvalSettings) -> None:
-        self.settings = settings
-        self.scores: list[FrameScore] = []
-
-    def update(self, sample: Sample, record: FrameRecord) -> None:
-        self.scores.append(frame_score(sample, record))
 
     def compute(self) -> dict:
         return {"categories": category_table(self.scores) if self.settings.detection else []}

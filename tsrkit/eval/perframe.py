@@ -117,7 +117,18 @@ def headline_intervals(scores: Sequence[FrameScore]) -> dict[str, list[float] | 
     }
 
 
-class ZhengPerFrame(Metric):
+class FrameScoreMetric(Metric):
+    """A metric computed from every frame's :class:`FrameScore` (kept in ``self.scores``)."""
+
+    def reset(self, settings: EvalSettings) -> None:
+        self.settings = settings
+        self.scores: list[FrameScore] = []
+
+    def update(self, sample: Sample, record: FrameRecord) -> None:
+        self.scores.append(frame_score(sample, record))
+
+
+class ZhengPerFrame(FrameScoreMetric):
     """``per_frame`` and ``intervals``: Zheng 5.2.1's per-frame means with bootstrap intervals.
 
     A detection's centre (the lens centre) is matched to the ground truth's minimum enclosing
@@ -127,13 +138,6 @@ class ZhengPerFrame(Metric):
     name = "per-frame"
     summary = "per-frame recall, precision and hit-frame fraction (centre in enclosing circle)"
     section = "Zheng 2016, 5.2.1"
-
-    def reset(self, settings: EvalSettings) -> None:
-        self.settings = settings
-        self.scores: list[FrameScore] = []
-
-    def update(self, sample: Sample, record: FrameRecord) -> None:
-        self.scores.append(frame_score(sample, record))
 
     def compute(self) -> dict:
         if not self.settings.detection:
