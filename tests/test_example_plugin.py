@@ -32,9 +32,11 @@ def tsrkit(env, *args):
 def test_installed_plugin_is_listed(installed):
     done = tsrkit(installed, "plugins", "--json")
     assert done.returncode == 0, done.stderr
-    (entry,) = [p for p in json.loads(done.stdout) if p["name"] == "brightest-blobs"]
-    assert entry == {**entry, "kind": "detector", "package": "tsrkit-brightest-blobs",
-                     "version": "0.1.0"}
+    found = {p["name"]: p for p in json.loads(done.stdout)}
+    for name, kind in (("brightest-blobs", "detector"), ("centre-error", "metric"),
+                       ("missed-boxes", "writer")):
+        assert found[name] == {**found[name], "kind": kind, "package": "tsrkit-brightest-blobs",
+                               "version": "0.1.0"}
 
 
 def test_installed_plugin_detects(installed, tmp_path):
@@ -85,6 +87,13 @@ def test_installed_plugin_benchmarks_real_coco_and_sample(installed, tmp_path, d
         assert (out / name).is_file(), name
     report = json.loads((out / "report.json").read_text())
     assert report["detector"]["name"] == "brightest-blobs"
+    # The package's own metric and report writer: one file each, no change to tsrkit.
+    error = report["centre_error"]
+    assert (error["pairs"] > 0) == (report["per_frame"]["hit_frame_fraction"] > 0)
+    assert error["pairs"] == 0 or min(error["mean_px"], error["median_px"]) >= 0
+    missed = (out / "missed.csv").read_text().splitlines()
+    assert "missed.csv" in report["files"] and missed[0].startswith("frame,source,state")
+    assert len(missed) > 1
     assert report["frames"] > 0 and report["per_frame"]["frames_with_gt"] > 0
     assert 0 <= report["per_frame"]["recall_mean"] <= 1
     assert abs(report["iou50"]["ap"] - coco_ap50(out)) <= 1e-6

@@ -6,8 +6,7 @@ Threshold the HSV value channel at a top percentile, label 8-connected blobs, an
 import cv2
 import numpy as np
 
-from tsrkit import Candidate, Detector, Param
-from tsrkit.hookspecs import hookimpl
+from tsrkit import Candidate, Detector, Param, hookimpl
 
 
 class BrightestBlobs(Detector):
