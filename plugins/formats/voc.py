@@ -13,6 +13,9 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+import defusedxml.ElementTree as SafeET
+from defusedxml import DefusedXmlException
+
 from tsrkit.atomic import atomic_open
 from tsrkit.datasets import DatasetError, to_state
 from tsrkit.hookspecs import hookimpl
@@ -37,9 +40,9 @@ def _xml_files(path: Path) -> list[Path]:
 
 def _is_voc(file: Path) -> bool:
     try:
-        for _, element in ET.iterparse(file, events=("start",)):
+        for _, element in SafeET.iterparse(file, events=("start",)):
             return element.tag == "annotation"
-    except ET.ParseError:
+    except (ET.ParseError, DefusedXmlException):
         return False
     return False
 
@@ -97,7 +100,10 @@ def _splits(root: Path) -> dict[str, str]:
 
 def _parse(file: Path) -> ET.Element:
     try:
-        root = ET.parse(file).getroot()
+        root = SafeET.parse(file).getroot()
+    except DefusedXmlException as exc:  # entities and DTDs are refused (billion laughs...)
+        raise DatasetError(file, f"XML with a forbidden construct ({type(exc).__name__})",
+                           "document") from None
     except ET.ParseError as exc:
         line, column = exc.position
         reason = str(exc).split(":")[0]

@@ -1,7 +1,8 @@
 """The dataset registry: named datasets in ``datasets.yaml`` and where their files are.
 
-The file is ``$TSRKIT_DATASETS_YAML`` when set, else ``datasets.yaml`` at the repository root
-(next to the ``tsrkit`` package source). A relative ``root`` resolves against
+The file is ``$TSRKIT_DATASETS_YAML`` when set, else the ``datasets.yaml`` installed inside the
+``tsrkit`` package (in a checkout, ``tsrkit/datasets.yaml`` links to the one at the repository
+root, so a wheel or ``pip install .`` carries a copy). A relative ``root`` resolves against
 ``$TSRKIT_DATA_DIR``; when that is unset, against ``<repo>/../shared/datasets``.
 """
 from __future__ import annotations
@@ -19,6 +20,7 @@ from tsrkit.datasets.states import check_mapping
 REGISTRY_ENV = "TSRKIT_DATASETS_YAML"
 DATA_DIR_ENV = "TSRKIT_DATA_DIR"
 REPO_ROOT = Path(__file__).resolve().parents[2]
+PACKAGED_REGISTRY = Path(__file__).parents[1] / "datasets.yaml"
 BOXES = ("lens", "housing", "crop", "roi")
 GENERATED_SAMPLE = "generated:sample"
 REQUIRED = ("format", "root", "licence", "citation", "task", "box")
@@ -91,7 +93,7 @@ def data_dir() -> Path:
 def registry_path() -> Path:
     """The ``datasets.yaml`` in use: ``$TSRKIT_DATASETS_YAML`` or the repository's own."""
     given = os.environ.get(REGISTRY_ENV)
-    return Path(given).expanduser() if given else REPO_ROOT / "datasets.yaml"
+    return Path(given).expanduser() if given else PACKAGED_REGISTRY
 
 
 def load_registry(path: str | os.PathLike | None = None) -> dict[str, DatasetEntry]:
