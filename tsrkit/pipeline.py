@@ -9,6 +9,7 @@ from dataclasses import dataclass, replace
 from typing import Any
 
 from tsrkit.plugin import Classifier, Detector, Tracker, Verifier
+from tsrkit.records import FrameRecord
 from tsrkit.types import Candidate, Detection, Frame
 
 
@@ -24,10 +25,8 @@ class FrameResult:
     detections: tuple[Detection, ...]
 
     def to_record(self) -> dict[str, Any]:
-        """The JSON Lines record of ``tsrkit detect``."""
-        return {"source": self.source, "frame": self.index, "width": self.width,
-                "height": self.height, "ms": round(self.ms, 3),
-                "detections": [d.to_record() for d in self.detections]}
+        """The JSON Lines record of ``tsrkit detect`` (:meth:`tsrkit.records.FrameRecord.to_json`)."""
+        return FrameRecord.from_result(self).to_json()
 
 
 def as_detections(candidates: list[Candidate]) -> list[Detection]:

@@ -4,6 +4,9 @@ The crop of each candidate is intensity-normalised and resampled on a log-polar 
 centre (rotation becomes a circular shift along theta), projected on a few principal
 components and classified by an SVM whose classes are the sign classes of its training data.
 Lee 2017, section 3.4.
+
+Not ``skops.io``: the model stays plain arrays + JSON (``tsrkit.models``), readable whatever the
+scikit-learn version; the one-vs-one decision is a few lines, tested equal to ``SVC.predict``.
 """
 from __future__ import annotations
 

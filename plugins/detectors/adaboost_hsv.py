@@ -5,6 +5,9 @@ probability, the probability map is thresholded, and connected blobs become cand
 Lee 2017, section 3.2 (Eq. 3.1 and the two unnumbered equations after it). One model file holds
 one booster per colour; ``target=lights`` runs red, yellow and green together and gives each
 blob the colour whose posterior wins. Shipped default: ``models/adaboost_hsv_default``.
+
+Not ``skops.io``: the booster is evaluated once over the whole (hue, saturation) plane into Lee's
+lookup table; its stumps as arrays are that table's inputs, so the fitted object is not needed.
 """
 from __future__ import annotations
 

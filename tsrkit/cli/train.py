@@ -35,6 +35,8 @@ def train_command(plugin, dataset_ref, format_name, images, split, params, out,
     detector_params = {k.removeprefix("detector."): v for k, v in assignments.items()
                        if k.startswith("detector.")}
     own = {k: v for k, v in assignments.items() if not k.startswith("detector.")}
+    if detector_params and not detector:
+        raise click.UsageError("detector.KEY=VALUE parameters need --detector")
     det = get_registry().create("detector", detector, detector_params) if detector else None
     dataset = open_dataset(dataset_ref, format=format_name, images=images)
     if split:
