@@ -11,6 +11,11 @@ conspicuous) iteration is dropped; among new ones the larger is kept. Without a 
 (GRAY-TOPHAT) each component keeps the fixed radius of the disk of its own area (the plain mean
 shift that Algorithm 3-1 extends). Candidate centres are reported in pixel coordinates with pixel
 ``(i, j)`` centred at ``(j + 0.5, i + 0.5)``.
+
+Building block for plugin authors: a detector with its own saliency map gets Zheng's
+localization with ``from tsrkit_plugins.detectors.localization import LOCALIZATION_PARAMS,
+localize`` (add the params to its schema, call ``localize(saliency, self.params)``), as
+conspicuity and gray-tophat do.
 """
 from __future__ import annotations
 
