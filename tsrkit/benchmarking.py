@@ -4,6 +4,10 @@ The data path is one line: the engine yields :class:`~tsrkit.records.FrameRecord
 registered :class:`~tsrkit.plugin.Metric` folds them in, :func:`tsrkit.report.build_report` turns
 the metrics' sections into ``report.json`` once, and each :class:`~tsrkit.plugin.ReportWriter`
 writes its files from the finished :class:`~tsrkit.report.RunResult`.
+
+Memory: the engine streams frames, and images are never kept; the evaluated records are (a few
+hundred bytes per detection), because the writers (JSON Lines, COCO, CSV, the HTML gallery) need
+them after the metrics are computed.
 """
 from __future__ import annotations
 
