@@ -42,22 +42,22 @@ except _metadata.PackageNotFoundError:  # running from a source tree that is not
 
 def detector(name: str, **params: Any) -> Detector:
     """An installed detector, its parameters validated against its schema."""
-    return get_registry().create("detector", name, params)  # type: ignore[return-value]
+    return get_registry().create("detector", name, params)
 
 
 def classifier(name: str, **params: Any) -> Classifier:
     """An installed classifier, its parameters validated against its schema."""
-    return get_registry().create("classifier", name, params)  # type: ignore[return-value]
+    return get_registry().create("classifier", name, params)
 
 
 def verifier(name: str, **params: Any) -> Verifier:
     """An installed verifier, its parameters validated against its schema."""
-    return get_registry().create("verifier", name, params)  # type: ignore[return-value]
+    return get_registry().create("verifier", name, params)
 
 
 def tracker(name: str, **params: Any) -> Tracker:
     """An installed tracker, its parameters validated against its schema."""
-    return get_registry().create("tracker", name, params)  # type: ignore[return-value]
+    return get_registry().create("tracker", name, params)
 
 
 def plugins(kind: str | None = None) -> list[dict[str, Any]]:

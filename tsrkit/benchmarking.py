@@ -40,19 +40,20 @@ def eval_settings(dataset: Dataset, detection: bool = True, iou_threshold: float
 
 def metrics_for(settings: EvalSettings) -> list[Metric]:
     """Every registered metric, reset for a new evaluation."""
-    metrics = [info.create() for info in get_registry().plugins("metric")]
+    registry = get_registry()
+    metrics = [registry.create("metric", info.name) for info in registry.plugins("metric")]
     for metric in metrics:
-        metric.reset(settings)  # type: ignore[attr-defined]
-    return metrics  # type: ignore[return-value]
+        metric.reset(settings)
+    return metrics
 
 
 def writers_for(names: Sequence[str] | None) -> list[ReportWriter]:
     """The named report writers, or every registered writer that runs by default."""
     registry = get_registry()
     if names is None:
-        return [info.create() for info in registry.plugins("writer")
-                if info.cls.default]  # type: ignore[attr-defined,misc]
-    return [registry.create("writer", name) for name in names]  # type: ignore[misc]
+        names = [info.name for info in registry.plugins("writer")
+                 if getattr(info.cls, "default", False)]
+    return [registry.create("writer", name) for name in names]
 
 
 def evaluate(dataset: Dataset, records: Iterable[FrameRecord], settings: EvalSettings,

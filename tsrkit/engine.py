@@ -108,8 +108,10 @@ def compute_record(index: int, sample: Sample, job: Job) -> FrameRecord:
     try:
         if job.detector is not None:
             result = Pipeline(job.detector, job.classifier, verifier=job.verifier).process(frame)
-        else:
+        elif job.classifier is not None:
             result = classify_annotations(job.classifier, frame, sample)
+        else:
+            raise TsrkitError("a run needs a detector or a classifier")
     except TsrkitError:  # a setup problem (missing model...) would recur on every frame
         raise
     except Exception as exc:  # a crashing plugin costs one frame, not the run
@@ -152,6 +154,7 @@ def _pool_context():
 
 
 def _run_in_worker(index: int, sample: Sample) -> FrameRecord:
+    assert _WORKER_JOB is not None, "the pool initializer sets the job"
     return process_sample(index, sample, _WORKER_JOB)
 
 

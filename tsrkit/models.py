@@ -66,7 +66,9 @@ def save_model(path: str | os.PathLike, model: Model, *, plugin: str, plugin_ver
         if np.asarray(array).dtype.kind not in "biufc":
             raise ModelError(f"model array '{name}' is not numeric; cannot save without pickle")
     buffer = io.BytesIO()
-    np.savez_compressed(buffer, **{k: np.asarray(v) for k, v in model.arrays.items()})
+    arrays = {k: np.asarray(v) for k, v in model.arrays.items()}
+    # numpy's stub reads **arrays as its allow_pickle keyword; the arrays are numeric (above)
+    np.savez_compressed(buffer, **arrays)  # type: ignore[arg-type]
     with atomic_open(npz_path, "wb") as fh:
         fh.write(buffer.getvalue())
     from tsrkit import __version__

@@ -6,6 +6,7 @@ A plugin lists :class:`Param` objects; values arrive as Python objects (API, YAM
 """
 from __future__ import annotations
 
+import os
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -205,7 +206,7 @@ def parse_assignments(items: Iterable[str]) -> dict[str, str]:
     return out
 
 
-def load_config(path: str) -> dict[str, Any]:
+def load_config(path: str | os.PathLike) -> dict[str, Any]:
     """Read a YAML run configuration.
 
     The file is a mapping whose optional keys ``detector``, ``classifier`` and ``tracker`` are

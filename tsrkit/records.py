@@ -76,8 +76,8 @@ class DetectionRecord:
     def from_json(cls, data: Mapping[str, Any]) -> DetectionRecord:
         """Read :meth:`to_json`'s form back (older records without ``lens_bbox`` too)."""
         bbox = tuple(data["bbox"])
-        return cls(data["x"], data["y"], data["radius"], bbox,  # type: ignore[arg-type]
-                   tuple(data.get("lens_bbox", bbox)), data["score"],  # type: ignore[arg-type]
+        return cls(data["x"], data["y"], data["radius"], bbox,
+                   tuple(data.get("lens_bbox", bbox)), data["score"],
                    data.get("state", "unknown"), dict(data.get("state_scores", {})),
                    data.get("origin", "detected"), data.get("housing_score"),
                    data.get("track_id"))

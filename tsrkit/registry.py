@@ -15,14 +15,15 @@ import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from importlib import metadata
-from typing import Any
+from typing import Any, Literal, overload
 
 import pluggy
 
 from tsrkit import hookspecs
 from tsrkit.errors import TsrkitError
 from tsrkit.params import ParamError, validate
-from tsrkit.plugin import Plugin, is_trainable
+from tsrkit.plugin import (Classifier, DatasetFormat, Detector, Metric, Plugin, ReportWriter,
+                           Tracker, Verifier, is_trainable)
 
 ENTRY_POINT_GROUP = "tsrkit"
 LOAD_ENV = "TSRKIT_LOAD_PLUGINS"
@@ -146,8 +147,33 @@ class Registry:
             known = ", ".join(sorted(table.get(kind, {}))) or "none installed"
             raise PluginNotFound(f"no {kind} called '{name}' (available: {known})") from None
 
+    @overload
+    def create(self, kind: Literal["detector"], name: str,
+               params: Mapping[str, Any] | None = None) -> Detector: ...
+    @overload
+    def create(self, kind: Literal["verifier"], name: str,
+               params: Mapping[str, Any] | None = None) -> Verifier: ...
+    @overload
+    def create(self, kind: Literal["classifier"], name: str,
+               params: Mapping[str, Any] | None = None) -> Classifier: ...
+    @overload
+    def create(self, kind: Literal["tracker"], name: str,
+               params: Mapping[str, Any] | None = None) -> Tracker: ...
+    @overload
+    def create(self, kind: Literal["format"], name: str,
+               params: Mapping[str, Any] | None = None) -> DatasetFormat: ...
+    @overload
+    def create(self, kind: Literal["metric"], name: str,
+               params: Mapping[str, Any] | None = None) -> Metric: ...
+    @overload
+    def create(self, kind: Literal["writer"], name: str,
+               params: Mapping[str, Any] | None = None) -> ReportWriter: ...
+    @overload
+    def create(self, kind: str, name: str,
+               params: Mapping[str, Any] | None = None) -> Plugin: ...
+
     def create(self, kind: str, name: str, params: Mapping[str, Any] | None = None) -> Plugin:
-        """Instantiate a plugin with validated parameters."""
+        """Instantiate a plugin with validated parameters (typed by ``kind`` for the checker)."""
         return self.get(kind, name).create(**(params or {}))
 
     def _collect(self) -> dict[str, dict[str, PluginInfo]]:

@@ -60,4 +60,5 @@ def train(name: str, dataset: Dataset, out: str | Path, params: Mapping[str, Any
     if detector is not None:
         training["detector"] = {"name": detector.name, "params": detector.params}
     return save_model(out, model, plugin=info.name, plugin_version=info.version,
-                      params=plugin.params, training=training)
+                      params=plugin.params,  # type: ignore[arg-type]  # the instance's values
+                      training=training)

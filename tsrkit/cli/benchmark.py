@@ -143,7 +143,8 @@ def run_compare(dataset_ref, format_name, images, split, detector_names: str,
     names = [n.strip() for n in detector_names.split(",") if n.strip()]
     runs = build_compare(names, classifier, verifier, params)
     dataset = load_dataset(dataset_ref, format_name, images, split)
-    comparison = compare(dataset, [run.detector for run in runs], runs[0].classifier,
+    detectors = [run.detector for run in runs if run.detector is not None]
+    comparison = compare(dataset, detectors, runs[0].classifier,
                          out=out, verifier=runs[0].verifier, **options)
     print_table(comparison["reports"])
     for test in comparison["paired_tests"]:

@@ -80,7 +80,7 @@ def detect_format(path: Path) -> str:
         When none or several match, naming them and asking for ``--format``.
     """
     matched = [info.name for info in get_registry().plugins("format")
-               if info.create().sniff(Path(path))]
+               if get_registry().create("format", info.name).sniff(Path(path))]
     if len(matched) == 1:
         return matched[0]
     every = ", ".join(info.name for info in get_registry().plugins("format"))
@@ -108,7 +108,7 @@ def write_dataset(dataset: Dataset, format: str, out: str | os.PathLike) -> Path
     """Write ``dataset`` with the format plugin ``format`` at ``out`` (file or folder)."""
     writer = get_registry().create("format", format)
     if not writer.writable:
-        writable = ", ".join(i.name for i in get_registry().plugins("format") if i.cls.writable)
+        writable = ", ".join(i.name for i in get_registry().plugins("format") if getattr(i.cls, "writable", False))
         raise TsrkitError(f"format '{format}' has no writer (writable: {writable})")
     writer.write(dataset, Path(out))
     return Path(out)

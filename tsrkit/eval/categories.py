@@ -39,7 +39,8 @@ def _row(lighting: str, radius: int | None, members: Sequence[FrameScore]) -> di
     summary = summarise(members)
     recall_counts = Counter(recall_label(s) for s in members)
     precision_counts = Counter(precision_bound(s) for s in members)
-    bubbles = Counter((round(s.recall, 6), round(1 - (s.precision or 0.0), 6)) for s in members)
+    bubbles = Counter((round(s.recall or 0.0, 6), round(1 - (s.precision or 0.0), 6))
+                      for s in members)
     return {
         "lighting": lighting, "max_radius": radius, "frames": len(members),
         "recall_mean": summary["recall_mean"], "precision_mean": summary["precision_mean"],

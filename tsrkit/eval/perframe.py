@@ -11,6 +11,7 @@ separately and do not enter ``precision_mean``. The Table 5-2 grouping is :mod:`
 from __future__ import annotations
 
 import math
+from typing import Any
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
@@ -82,8 +83,8 @@ def summarise(scores: Sequence[FrameScore]) -> dict:
     ground-truth frames with recall > 0. Means over no frames are None.
     """
     with_gt = [s for s in scores if s.n_gt]
-    recalls = [s.recall for s in with_gt]
-    precisions = [s.precision for s in with_gt if s.n_det]
+    recalls = [s.gt_hit / s.n_gt for s in with_gt]
+    precisions = [s.det_tp / s.n_det for s in with_gt if s.n_det]
     without_gt = [s for s in scores if not s.n_gt]
     return {
         "frames_with_gt": len(with_gt),
@@ -111,9 +112,9 @@ def headline_intervals(scores: Sequence[FrameScore]) -> dict[str, list[float] | 
     """Bootstrap 95 % intervals (over frames) of the three per-frame headline figures."""
     with_gt = [s for s in scores if s.n_gt]
     return {
-        "recall_mean": bootstrap_interval([s.recall for s in with_gt]),
-        "precision_mean": bootstrap_interval([s.precision for s in with_gt if s.n_det]),
-        "hit_frame_fraction": bootstrap_interval([float(s.recall > 0) for s in with_gt]),
+        "recall_mean": bootstrap_interval([s.gt_hit / s.n_gt for s in with_gt]),
+        "precision_mean": bootstrap_interval([s.det_tp / s.n_det for s in with_gt if s.n_det]),
+        "hit_frame_fraction": bootstrap_interval([float(s.gt_hit > 0) for s in with_gt]),
     }
 
 
@@ -142,7 +143,8 @@ class ZhengPerFrame(FrameScoreMetric):
     def compute(self) -> dict:
         if not self.settings.detection:
             return {"per_frame": NOT_DETECTION, "intervals": {}}
-        summary, intervals = summarise(self.scores), headline_intervals(self.scores)
+        summary: dict[str, Any] = summarise(self.scores)
+        intervals: dict[str, Any] = headline_intervals(self.scores)
         for figures in (summary, intervals):
             figures["precision_mean"] = self.settings.false_positive_figure(
                 figures["precision_mean"])

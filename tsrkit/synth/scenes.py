@@ -453,6 +453,8 @@ class Housing:
 
     def annotation(self) -> Annotation:
         """The lens box of the lit lens, with its exact radius."""
+        if self.state is None:
+            raise ValueError("a dark head has no lit lens to annotate")
         x, y = self.centres[LENS_ORDER.index(self.state)]
         r = self.radius
         return Annotation(
@@ -609,7 +611,10 @@ def encode_jpeg(image: np.ndarray, quality: int) -> np.ndarray:
 
 def compress(image: np.ndarray, quality: int) -> np.ndarray:
     """One JPEG round trip: the block and chroma artefacts of a low-quality video."""
-    return cv2.imdecode(encode_jpeg(image, quality), cv2.IMREAD_COLOR)
+    decoded = cv2.imdecode(encode_jpeg(image, quality), cv2.IMREAD_COLOR)
+    if decoded is None:
+        raise TsrkitError("JPEG decoding failed")
+    return decoded
 
 
 # --------------------------------------------------------------------------- frames
