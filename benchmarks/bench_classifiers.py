@@ -3,6 +3,7 @@
 
 Run: /work/venv/bin/python benchmarks/bench_classifiers.py [--repeats 5]
 """
+
 from __future__ import annotations
 
 import os
@@ -25,16 +26,17 @@ from tsrkit.types import Candidate, Dataset  # noqa: E402
 
 CLASSIFIERS = ("ab-hist", "hsi-backprojection")
 #: The papers' methods as printed (Zheng 3.3, Lee 5.3.3), run beside the defaults.
-PAPER_EXACT = {"ab-hist": {"smooth": "0", "min_chroma": "0", "red_prior": "false"},
-               "hsi-backprojection": {"hue_smooth": "0", "red_prior": "false", "clip": "256"}}
+PAPER_EXACT = {
+    "ab-hist": {"smooth": "0", "min_chroma": "0", "red_prior": "false"},
+    "hsi-backprojection": {"hue_smooth": "0", "red_prior": "false", "clip": "256"},
+}
 STATES = ("red", "yellow", "green")
 
 
 def by_lighting(dataset: Dataset, lighting: str) -> Dataset:
     """The samples of ``dataset`` whose metadata ``lighting`` is ``lighting`` (day, night)."""
     chosen = tuple(s for s in dataset if s.metadata.get("lighting") == lighting)
-    return Dataset(f"{dataset.name}:{lighting}", chosen, dataset.format, dataset.root,
-                   dataset.info)
+    return Dataset(f"{dataset.name}:{lighting}", chosen, dataset.format, dataset.root, dataset.info)
 
 
 def benchmark_sets() -> tuple[Dataset, dict[str, Dataset]]:
@@ -43,9 +45,11 @@ def benchmark_sets() -> tuple[Dataset, dict[str, Dataset]]:
     vgis = open_dataset("lisa_vgis_bulb_crops", format="crops")
     return mit.split("train"), {
         "mit test": mit.split("test"),
-        "vgis day": by_lighting(vgis, "day"), "vgis night": by_lighting(vgis, "night"),
+        "vgis day": by_lighting(vgis, "day"),
+        "vgis night": by_lighting(vgis, "night"),
         "kr boxes": open_dataset("roboflow_traffic_light_kr"),
-        "cinta boxes": open_dataset("roboflow_cinta_v2_id")}
+        "cinta boxes": open_dataset("roboflow_cinta_v2_id"),
+    }
 
 
 def evaluate(classifier, dataset: Dataset) -> dict:
@@ -62,10 +66,13 @@ def evaluate(classifier, dataset: Dataset) -> dict:
             row[det.state] = row.get(det.state, 0) + 1
     totals = {s: sum(confusion[s].values()) for s in STATES}
     correct = sum(confusion[s].get(s, 0) for s in STATES)
-    return {"n": sum(totals.values()), "accuracy": correct / max(sum(totals.values()), 1),
-            "recall": {s: (confusion[s].get(s, 0) / totals[s] if totals[s] else None)
-                       for s in STATES},
-            "counts": totals, "confusion": confusion}
+    return {
+        "n": sum(totals.values()),
+        "accuracy": correct / max(sum(totals.values()), 1),
+        "recall": {s: (confusion[s].get(s, 0) / totals[s] if totals[s] else None) for s in STATES},
+        "counts": totals,
+        "confusion": confusion,
+    }
 
 
 def crops_per_second(classifier, dataset: Dataset, repeats: int) -> float:
@@ -81,8 +88,9 @@ def crops_per_second(classifier, dataset: Dataset, repeats: int) -> float:
 
 
 def show(name: str, result: dict) -> None:
-    recall = " ".join(f"{s}={'-' if r is None else f'{r:.3f}'}"
-                      for s, r in result["recall"].items())
+    recall = " ".join(
+        f"{s}={'-' if r is None else f'{r:.3f}'}" for s, r in result["recall"].items()
+    )
     print(f"  {name:<22} n={result['n']:<4} acc={result['accuracy']:.3f}  recall {recall}")
     for state, row in result["confusion"].items():
         print(f"      {state:<7} -> {dict(sorted(row.items()))}")
@@ -91,17 +99,31 @@ def show(name: str, result: dict) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--repeats", type=int, default=5)
-    parser.add_argument("--param", action="append", default=[],
-                        help="CLASSIFIER:KEY=VALUE passed to that classifier")
-    parser.add_argument("--paper-exact", action="store_true",
-                        help="also run each classifier with the paper's exact settings")
+    parser.add_argument(
+        "--param",
+        action="append",
+        default=[],
+        help="CLASSIFIER:KEY=VALUE passed to that classifier",
+    )
+    parser.add_argument(
+        "--paper-exact",
+        action="store_true",
+        help="also run each classifier with the paper's exact settings",
+    )
     args = parser.parse_args()
     cv2.setNumThreads(1)
     registry = get_registry()
     train, sets = benchmark_sets()
     tmp = tempfile.mkdtemp(prefix="bench_classifiers_")
-    runs = [(name, dict(p.split(":", 1)[1].split("=", 1) for p in args.param
-                        if p.split(":", 1)[0] == name)) for name in CLASSIFIERS]
+    runs = [
+        (
+            name,
+            dict(
+                p.split(":", 1)[1].split("=", 1) for p in args.param if p.split(":", 1)[0] == name
+            ),
+        )
+        for name in CLASSIFIERS
+    ]
     if args.paper_exact:
         runs += list(PAPER_EXACT.items())
     for name, given in runs:

@@ -8,6 +8,7 @@ first-call cost (numba compile or cache load), medians of wall and CPU time per 
 ratios measured in this run.
 Usage: python benchmarks/bench_conspicuity.py [--frames 8] [--reps 5] [--baseline e57479b]
 """
+
 import os
 
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
@@ -41,8 +42,10 @@ DATA = Path(os.environ.get("TSRKIT_DATA_DIR", REPO.parent / "shared" / "datasets
 def frames(count, size):
     root = DATA / "roboflow_traffic_light_kr"
     entries = json.loads((root / "annotations.json").read_text())[:count]
-    return [cv2.resize(cv2.imread(str(root / e["file"])), size, interpolation=cv2.INTER_AREA)
-            for e in entries]
+    return [
+        cv2.resize(cv2.imread(str(root / e["file"])), size, interpolation=cv2.INTER_AREA)
+        for e in entries
+    ]
 
 
 def first_call_seconds():
@@ -54,9 +57,12 @@ def first_call_seconds():
 
 def baseline_map(commit):
     """``conspicuity_map`` of ``plugins/detectors/conspicuity.py`` at ``commit`` (git show)."""
-    source = subprocess.run(["git", "-C", str(REPO), "show",
-                             f"{commit}:plugins/detectors/conspicuity.py"],
-                            check=True, capture_output=True, text=True).stdout
+    source = subprocess.run(
+        ["git", "-C", str(REPO), "show", f"{commit}:plugins/detectors/conspicuity.py"],
+        check=True,
+        capture_output=True,
+        text=True,
+    ).stdout
     path = Path(tempfile.mkdtemp()) / "conspicuity_baseline.py"
     path.write_text(source)
     spec = importlib.util.spec_from_file_location("conspicuity_baseline", path)
@@ -77,8 +83,10 @@ def interleaved(calls, reps):
                 call(item)
                 wall[name].append(time.perf_counter() - w0)
                 cpu[name].append(time.process_time() - c0)
-    return {name: (1e3 * float(np.median(wall[name])), 1e3 * float(np.median(cpu[name])))
-            for name in calls}
+    return {
+        name: (1e3 * float(np.median(wall[name])), 1e3 * float(np.median(cpu[name])))
+        for name in calls
+    }
 
 
 def main():
@@ -86,8 +94,11 @@ def main():
     parser.add_argument("--frames", type=int, default=8)
     parser.add_argument("--reps", type=int, default=5)
     parser.add_argument("--oracle-frames", type=int, default=2)
-    parser.add_argument("--baseline", default="e57479b",
-                        help="commit whose conspicuity map is timed alongside ('' to skip)")
+    parser.add_argument(
+        "--baseline",
+        default="e57479b",
+        help="commit whose conspicuity map is timed alongside ('' to skip)",
+    )
     args = parser.parse_args()
     print(f"first conspicuity_map call: {first_call_seconds():.2f} s")
     conspicuity = tsrkit.detector("conspicuity")
@@ -104,7 +115,8 @@ def main():
         "  map only": (conspicuity_map, small),
         "  localization only": (
             lambda i: localize(maps[i].values, conspicuity.params, maps[i].radius),
-            range(len(maps))),
+            range(len(maps)),
+        ),
         "conspicuity 1280x720": (detect(conspicuity), large),
         "  map only 1280x720": (conspicuity_map, large),
         "gray-tophat 480x356": (detect(tophat), small),
@@ -116,25 +128,32 @@ def main():
         differ = sum(not np.array_equal(old_map(im).values, m.values) for im, m in zip(small, maps))
         print(f"frames whose map differs from {args.baseline}'s: {differ} of {len(small)}")
     results = interleaved(calls, args.reps)
-    oracle_images = small[:args.oracle_frames]
+    oracle_images = small[: args.oracle_frames]
     results["oracle map 480x356"] = interleaved(
-        {"oracle": (conspicuity_reference, oracle_images)}, 1)["oracle"]
-    worst = max(float(np.abs(conspicuity_map(im).values - conspicuity_reference(im)[0]).max())
-                for im in oracle_images)
+        {"oracle": (conspicuity_reference, oracle_images)}, 1
+    )["oracle"]
+    worst = max(
+        float(np.abs(conspicuity_map(im).values - conspicuity_reference(im)[0]).max())
+        for im in oracle_images
+    )
 
     print(f"{'what':28s} {'wall ms':>10s} {'cpu ms':>10s}")
     for name, (wall, cpu) in results.items():
         print(f"{name:28s} {wall:10.2f} {cpu:10.2f}")
     print(f"max |fast - oracle| on {len(oracle_images)} frames: {worst:.2e}")
     for k, kind in enumerate(("wall", "cpu")):
-        def ratio(a, b):
+
+        def ratio(a, b, k=k):
             return results[a][k] / results[b][k]
-        line = (f"[{kind}] oracle map / fast map: {ratio('oracle map 480x356', '  map only'):.1f}x;"
-                f" oracle map / fast detect: "
-                f"{ratio('oracle map 480x356', 'conspicuity 480x356'):.1f}x; conspicuity "
-                f"1280x720 / 480x356: {ratio('conspicuity 1280x720', 'conspicuity 480x356'):.2f}x"
-                f" (map only {ratio('  map only 1280x720', '  map only'):.2f}x); gray-tophat "
-                f"1280x720 / 480x356: {ratio('gray-tophat 1280x720', 'gray-tophat 480x356'):.2f}x")
+
+        line = (
+            f"[{kind}] oracle map / fast map: {ratio('oracle map 480x356', '  map only'):.1f}x;"
+            f" oracle map / fast detect: "
+            f"{ratio('oracle map 480x356', 'conspicuity 480x356'):.1f}x; conspicuity "
+            f"1280x720 / 480x356: {ratio('conspicuity 1280x720', 'conspicuity 480x356'):.2f}x"
+            f" (map only {ratio('  map only 1280x720', '  map only'):.2f}x); gray-tophat "
+            f"1280x720 / 480x356: {ratio('gray-tophat 1280x720', 'gray-tophat 480x356'):.2f}x"
+        )
         if args.baseline:
             baseline = ratio(f"baseline {args.baseline} map", "  map only")
             line += f"; baseline map / map: {baseline:.2f}x"

@@ -4,6 +4,7 @@ Frames are the Korean Roboflow scenes resized to each size. Also times the fast 
 loop oracle of tests/oracles on the same feature maps (one frame) and checks they agree.
 Run: /work/venv/bin/python benchmarks/bench_lab_frst.py [--frames N] [--repeats R]
 """
+
 from __future__ import annotations
 
 import os
@@ -38,12 +39,12 @@ def scenes(count: int) -> list[np.ndarray]:
     """The first ``count`` images of roboflow_traffic_light_kr, as BGR uint8."""
     root = Path(os.environ.get("TSRKIT_DATA_DIR", REPO.parent / "shared" / "datasets"))
     entries = json.loads((root / "roboflow_traffic_light_kr" / "annotations.json").read_text())
-    return [cv2.imread(str(root / "roboflow_traffic_light_kr" / e["file"]))
-            for e in entries[:count]]
+    return [
+        cv2.imread(str(root / "roboflow_traffic_light_kr" / e["file"])) for e in entries[:count]
+    ]
 
 
-def timings_ms(detector: tsrkit.Detector, frames: list[Frame],
-               repeats: int) -> dict[str, float]:
+def timings_ms(detector: tsrkit.Detector, frames: list[Frame], repeats: int) -> dict[str, float]:
     """Median and minimum wall time, and median CPU time, of one ``detect`` call (ms).
 
     CPU time (``time.process_time``) is less sensitive than wall time to other processes on a
@@ -57,8 +58,11 @@ def timings_ms(detector: tsrkit.Detector, frames: list[Frame],
             detector.detect(frame)
             wall.append((time.perf_counter() - start) * 1000)
             cpu.append((time.process_time() - start_cpu) * 1000)
-    return {"median": statistics.median(wall), "min": min(wall),
-            "cpu_median": statistics.median(cpu)}
+    return {
+        "median": statistics.median(wall),
+        "min": min(wall),
+        "cpu_median": statistics.median(cpu),
+    }
 
 
 def oracle_comparison(image: np.ndarray) -> dict[str, float]:
@@ -76,8 +80,13 @@ def oracle_comparison(image: np.ndarray) -> dict[str, float]:
     fast_s = statistics.median(fast_times)
     diff = max(float(np.abs(f - s).max()) for f, s in zip(fast, slow))
     peak = max(float(np.abs(s).max()) for s in slow)
-    return {"oracle_ms": oracle_s * 1000, "fast_ms": fast_s * 1000,
-            "speedup": oracle_s / fast_s, "max_abs_diff": diff, "max_abs_value": peak}
+    return {
+        "oracle_ms": oracle_s * 1000,
+        "fast_ms": fast_s * 1000,
+        "speedup": oracle_s / fast_s,
+        "max_abs_diff": diff,
+        "max_abs_value": peak,
+    }
 
 
 def main() -> None:
@@ -92,22 +101,30 @@ def main() -> None:
     print(f"lab-frst params: {detector.params}")
     results = {}
     for width, height in SIZES:
-        frames = [Frame(cv2.resize(im, (width, height), interpolation=cv2.INTER_AREA), "bench")
-                  for im in images]
+        frames = [
+            Frame(cv2.resize(im, (width, height), interpolation=cv2.INTER_AREA), "bench")
+            for im in images
+        ]
         results[width, height] = timings_ms(detector, frames, args.repeats)
         t = results[width, height]
-        print(f"{width}x{height}: median {t['median']:.1f} ms/frame, min {t['min']:.1f}, "
-              f"CPU median {t['cpu_median']:.1f} ({len(frames)} frames x {args.repeats} repeats)")
+        print(
+            f"{width}x{height}: median {t['median']:.1f} ms/frame, min {t['min']:.1f}, "
+            f"CPU median {t['cpu_median']:.1f} ({len(frames)} frames x {args.repeats} repeats)"
+        )
     small, large = results[SIZES[0]], results[SIZES[1]]
-    print(f"1280x720 / 480x356 ratio: median {large['median'] / small['median']:.2f}, "
-          f"CPU {large['cpu_median'] / small['cpu_median']:.2f} "
-          f"(pixel ratio {1280 * 720 / (480 * 356):.2f})")
+    print(
+        f"1280x720 / 480x356 ratio: median {large['median'] / small['median']:.2f}, "
+        f"CPU {large['cpu_median'] / small['cpu_median']:.2f} "
+        f"(pixel ratio {1280 * 720 / (480 * 356):.2f})"
+    )
     small_frame = cv2.resize(images[0], SIZES[0], interpolation=cv2.INTER_AREA)
     check = oracle_comparison(small_frame)
-    print(f"FRST of both feature-map parts, 480x356, alpha 3, radii 1..10, beta 0: "
-          f"oracle {check['oracle_ms']:.0f} ms, fast {check['fast_ms']:.1f} ms, "
-          f"speed-up {check['speedup']:.0f}x, max abs diff {check['max_abs_diff']:.2e} "
-          f"(max |S| {check['max_abs_value']:.3g})")
+    print(
+        f"FRST of both feature-map parts, 480x356, alpha 3, radii 1..10, beta 0: "
+        f"oracle {check['oracle_ms']:.0f} ms, fast {check['fast_ms']:.1f} ms, "
+        f"speed-up {check['speedup']:.0f}x, max abs diff {check['max_abs_diff']:.2e} "
+        f"(max |S| {check['max_abs_value']:.3g})"
+    )
 
 
 if __name__ == "__main__":

@@ -9,6 +9,7 @@
 
     /work/venv/bin/python benchmarks/bench_lee_adaboost.py
 """
+
 from __future__ import annotations
 
 import os
@@ -22,8 +23,8 @@ import time  # noqa: E402
 import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
-from tsrkit.datasets import open_dataset  # noqa: E402
 from tsrkit.benchmarking import benchmark  # noqa: E402
+from tsrkit.datasets import open_dataset  # noqa: E402
 from tsrkit.types import Frame  # noqa: E402
 from tsrkit_plugins.detectors import adaboost_hsv as ab  # noqa: E402
 
@@ -40,8 +41,9 @@ def detector(**params) -> ab.AdaBoostHSV:
     return ab.AdaBoostHSV(**values)
 
 
-def balanced_accuracy(model, colour: str, positive: np.ndarray,
-                      negative: np.ndarray) -> tuple[float, float, float]:
+def balanced_accuracy(
+    model, colour: str, positive: np.ndarray, negative: np.ndarray
+) -> tuple[float, float, float]:
     """Balanced accuracy, TPR and TNR of the booster's decision f > 0 over pixel histograms."""
     stumps = {k: model.arrays[f"{colour}_{k}"] for k in ab.STUMP_KEYS}
     says = ab.boosted_margin(ab.plane_features(), stumps) > 0
@@ -77,9 +79,11 @@ def f1(report: dict) -> float:
 
 def report_row(settings: dict, report: dict) -> str:
     pf, state = report["per_frame"], report["state"]
-    return (f"| {settings['threshold']} | {settings['min_size']} | {settings['max_boxes']} | "
-            f"{_f(pf['recall_mean'])} | {_f(pf['precision_mean'])} | {f1(report):.3f} | "
-            f"{_f(report['iou50']['ap'])} | {_f(state.get('accuracy'))} |")
+    return (
+        f"| {settings['threshold']} | {settings['min_size']} | {settings['max_boxes']} | "
+        f"{_f(pf['recall_mean'])} | {_f(pf['precision_mean'])} | {f1(report):.3f} | "
+        f"{_f(report['iou50']['ap'])} | {_f(state.get('accuracy'))} |"
+    )
 
 
 def defaults_grid(train) -> None:
@@ -92,8 +96,10 @@ def defaults_grid(train) -> None:
         det.use_model(model)
         report = benchmark(train, det, cache=False)
         rows.append((f1(report), report_row(settings, report), settings == THESIS))
-    print("| threshold | min_size | max_boxes | recall_mean | precision_mean | F1 | AP50 | "
-          "state acc |")
+    print(
+        "| threshold | min_size | max_boxes | recall_mean | precision_mean | F1 | AP50 | "
+        "state acc |"
+    )
     print("|---|---|---|---|---|---|---|---|")
     for _, row, thesis in sorted(rows, reverse=True):
         print(row + (" (Lee's values)" if thesis else ""))
@@ -118,19 +124,24 @@ def speed(train) -> None:
     hue, sat, _ = ab.hsv_planes(image)
     start = time.perf_counter()
     for colour in COLOURS:
-        ab.boosted_margin(ab.color_features(hue, sat),
-                          {k: model.arrays[f"{colour}_{k}"] for k in ab.STUMP_KEYS})
+        ab.boosted_margin(
+            ab.color_features(hue, sat), {k: model.arrays[f"{colour}_{k}"] for k in ab.STUMP_KEYS}
+        )
     direct = (time.perf_counter() - start) * 1000
-    print(f"\n## Speed (1280x720, one thread, 60 runs, target=lights): detect median "
-          f"{np.median(times):.1f} ms (p90 {np.percentile(times, 90):.1f} ms); evaluating the "
-          f"3 x {det.params['n_estimators']} stumps per pixel without the table: {direct:.0f} ms "
-          f"(x{direct / np.median(times):.0f})")
+    print(
+        f"\n## Speed (1280x720, one thread, 60 runs, target=lights): detect median "
+        f"{np.median(times):.1f} ms (p90 {np.percentile(times, 90):.1f} ms); evaluating the "
+        f"3 x {det.params['n_estimators']} stumps per pixel without the table: {direct:.0f} ms "
+        f"(x{direct / np.median(times):.0f})"
+    )
 
 
 def main() -> None:
     kr, cinta = open_dataset(KR), open_dataset(CINTA)
-    print("## Held-out pixel accuracy: balanced accuracy (TPR / TNR) of f > 0; test pixels: "
-          "lit lens of the colour vs. outside every box and other colours' lenses")
+    print(
+        "## Held-out pixel accuracy: balanced accuracy (TPR / TNR) of f > 0; test pixels: "
+        "lit lens of the colour vs. outside every box and other colours' lenses"
+    )
     print("| train -> test | training labels | " + " | ".join(COLOURS) + " |")
     print("|---|---|---|---|---|")
     pixel_accuracy(kr, cinta, "KR -> cinTA")

@@ -7,6 +7,7 @@ rotated by +-10 deg about the ROI centre, and measures classified crops per seco
 
     /work/venv/bin/python benchmarks/bench_lee_classify.py
 """
+
 from __future__ import annotations
 
 import os
@@ -43,8 +44,9 @@ def rotated(sample, angle: float):
         return image
     centre = sample.annotations[0].center
     matrix = cv2.getRotationMatrix2D(centre, angle, 1.0)
-    return cv2.warpAffine(image, matrix, image.shape[1::-1], flags=cv2.INTER_LINEAR,
-                          borderMode=cv2.BORDER_REPLICATE)
+    return cv2.warpAffine(
+        image, matrix, image.shape[1::-1], flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE
+    )
 
 
 def predict(clf: LogPolarSVM, samples, angle: float) -> tuple[list[str], float]:
@@ -63,13 +65,18 @@ def main() -> None:
     cv2.setNumThreads(1)
     data = open_dataset("gtsrb_test_35px_subset")
     labels = [s.annotations[0].state for s in data.samples]
-    train, test = train_test_split(list(data.samples), test_size=0.5, stratify=labels,
-                                   random_state=0)
+    train, test = train_test_split(
+        list(data.samples), test_size=0.5, stratify=labels, random_state=0
+    )
     truth = [s.annotations[0].state for s in test]
-    print(f"GTSRB 35 px subset: {len(train)} train / {len(test)} test crops, "
-          f"{len(set(labels))} classes; SVM rbf C=10, gamma 1/(n_components var)")
-    print("\n| features | PCA comps | explained var | fit s | acc 0 deg | acc +10 deg | "
-          "acc -10 deg | mean per-class recall 0 deg | crops/s |")
+    print(
+        f"GTSRB 35 px subset: {len(train)} train / {len(test)} test crops, "
+        f"{len(set(labels))} classes; SVM rbf C=10, gamma 1/(n_components var)"
+    )
+    print(
+        "\n| features | PCA comps | explained var | fit s | acc 0 deg | acc +10 deg | "
+        "acc -10 deg | mean per-class recall 0 deg | crops/s |"
+    )
     print("|---|---|---|---|---|---|---|---|---|")
     per_class = {}
     for transform, comps in CONFIGS:
@@ -85,10 +92,13 @@ def main() -> None:
                 rate = speed
                 balanced = recall_score(truth, predicted, average="macro", zero_division=0)
                 per_class[(transform, comps)] = recall_score(
-                    truth, predicted, labels=sorted(set(labels)), average=None, zero_division=0)
-        print(f"| {transform} | {comps} | {clf.model().info['explained_variance']:.3f} | "
-              f"{fit_s:.1f} | {accs[0]:.3f} | {accs[1]:.3f} | {accs[2]:.3f} | "
-              f"{balanced:.3f} | {rate:.0f} |")
+                    truth, predicted, labels=sorted(set(labels)), average=None, zero_division=0
+                )
+        print(
+            f"| {transform} | {comps} | {clf.model().info['explained_variance']:.3f} | "
+            f"{fit_s:.1f} | {accs[0]:.3f} | {accs[1]:.3f} | {accs[2]:.3f} | "
+            f"{balanced:.3f} | {rate:.0f} |"
+        )
     names = sorted(set(labels))
     lp, px = per_class[("log-polar", 10)], per_class[("none", 10)]
     print("\nPer-class recall, 10 components (log-polar / pixels), worst log-polar first:")

@@ -8,6 +8,7 @@ overlap, and Lee's summary: frames localised at overlap > 0.65, area precision /
 
     /work/venv/bin/python benchmarks/bench_lee_track.py
 """
+
 from __future__ import annotations
 
 import os
@@ -21,8 +22,8 @@ from pathlib import Path  # noqa: E402
 import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
-from tsrkit.geometry import iou_matrix  # noqa: E402
 from tsrkit.eval.overlap import score_overlap, summarise_overlap  # noqa: E402
+from tsrkit.geometry import iou_matrix  # noqa: E402
 from tsrkit.inputs import iter_frames  # noqa: E402
 from tsrkit.pipeline import Pipeline  # noqa: E402
 from tsrkit.types import Annotation, Sample  # noqa: E402
@@ -32,9 +33,9 @@ from tsrkit_plugins.trackers.meanshift import MeanShift  # noqa: E402
 SIZE = (480, 640)
 FRAMES = 60
 ORANGE = (0, 140, 255)
-POLE = range(18, 27)      # frames where a pole crosses the sign
-SHADE = range(38, 46)     # frames where the sign is in shade
-LEE_TAU = 0.65            # Lee 3.6.2: a sign is missed below this overlap
+POLE = range(18, 27)  # frames where a pole crosses the sign
+SHADE = range(38, 46)  # frames where the sign is in shade
+LEE_TAU = 0.65  # Lee 3.6.2: a sign is missed below this overlap
 
 
 def background(rng: np.random.Generator) -> np.ndarray:
@@ -42,7 +43,7 @@ def background(rng: np.random.Generator) -> np.ndarray:
     h, w = SIZE
     image = np.empty((h, w, 3), np.float32)
     image[: h // 2] = np.linspace((235, 200, 150), (210, 190, 170), h // 2)[:, None, :]
-    image[h // 2:] = (110, 110, 112)
+    image[h // 2 :] = (110, 110, 112)
     for x in (60, 140, 560):
         cv2.circle(image, (x, h // 2 - 30), 45, (40, 120, 50), -1)
     cv2.rectangle(image, (20, 300), (130, 360), (30, 30, 170), -1)
@@ -65,8 +66,13 @@ def render(index: int, seed: int, pole: bool, shade: bool) -> tuple[np.ndarray, 
     diamond = np.array([[cx, y0], [x1, cy], [cx, y1], [x0, cy]], np.int32)
     colour = tuple(int(c * 0.55) for c in ORANGE) if shade else ORANGE
     cv2.fillPoly(image, [diamond], colour)
-    cv2.rectangle(image, (int(cx - r / 3), int(cy - r / 8)), (int(cx + r / 3), int(cy + r / 8)),
-                  (20, 20, 20), -1)
+    cv2.rectangle(
+        image,
+        (int(cx - r / 3), int(cy - r / 8)),
+        (int(cx + r / 3), int(cy + r / 8)),
+        (20, 20, 20),
+        -1,
+    )
     if pole:
         px = int(x0 + (x1 - x0) * 0.35 + 3 * (index - POLE.start))
         cv2.rectangle(image, (px, 0), (px + 7, SIZE[0]), (60, 60, 60), -1)
@@ -104,20 +110,27 @@ def run(pipeline: Pipeline, video: Path, boxes: list[tuple]) -> dict:
         result = pipeline.process(frame)
         ms.append(result.ms)
         found = [d.candidate.bbox for d in result.detections]
-        overlaps.append(score_overlap(found, [d.candidate.score for d in result.detections],
-                                      [truth], LEE_TAU))
+        overlaps.append(
+            score_overlap(found, [d.candidate.score for d in result.detections], [truth], LEE_TAU)
+        )
         if found:
             c = result.detections[0].candidate
-            errors.append(float(np.hypot(c.x - (truth[0] + truth[2]) / 2,
-                                         c.y - (truth[1] + truth[3]) / 2)))
+            errors.append(
+                float(np.hypot(c.x - (truth[0] + truth[2]) / 2, c.y - (truth[1] + truth[3]) / 2))
+            )
             ious.append(float(iou_matrix([found[0]], [truth])[0, 0]))
             origins.append(result.detections[0].origin[0])
         else:
             errors.append(np.nan)
             ious.append(0.0)
             origins.append("-")
-    return {"errors": np.array(errors), "ious": np.array(ious), "ms": np.array(ms),
-            "origins": origins, "lee": summarise_overlap(overlaps, LEE_TAU)}
+    return {
+        "errors": np.array(errors),
+        "ious": np.array(ious),
+        "ms": np.array(ms),
+        "origins": origins,
+        "lee": summarise_overlap(overlaps, LEE_TAU),
+    }
 
 
 def main() -> None:
@@ -129,25 +142,35 @@ def main() -> None:
         only = run(Pipeline(det), video, boxes)
         tracker = MeanShift(**{p.name: p.default for p in MeanShift.params} | {"min_size": 20})
         tracked = run(Pipeline(det, tracker=tracker), video, boxes)
-    print(f"{FRAMES} frames 640x480 MJPG @15 fps; pole frames {POLE.start}-{POLE.stop - 1}, "
-          f"shade frames {SHADE.start}-{SHADE.stop - 1}; sign half-size 14 -> 34 px")
+    print(
+        f"{FRAMES} frames 640x480 MJPG @15 fps; pole frames {POLE.start}-{POLE.stop - 1}, "
+        f"shade frames {SHADE.start}-{SHADE.stop - 1}; sign half-size 14 -> 34 px"
+    )
     print("\n| frame | err det (px) | IoU det | err det+trk (px) | IoU det+trk | origin |")
     print("|---|---|---|---|---|---|")
     for i in range(FRAMES):
-        print(f"| {i} | {only['errors'][i]:.1f} | {only['ious'][i]:.2f} | "
-              f"{tracked['errors'][i]:.1f} | {tracked['ious'][i]:.2f} | {tracked['origins'][i]} |")
-    print("\n| run | frames with output | median centre err (px) | mean IoU (miss = 0) | "
-          f"frames IoU > {LEE_TAU} | Lee area precision / recall | median ms/frame |")
+        print(
+            f"| {i} | {only['errors'][i]:.1f} | {only['ious'][i]:.2f} | "
+            f"{tracked['errors'][i]:.1f} | {tracked['ious'][i]:.2f} | {tracked['origins'][i]} |"
+        )
+    print(
+        "\n| run | frames with output | median centre err (px) | mean IoU (miss = 0) | "
+        f"frames IoU > {LEE_TAU} | Lee area precision / recall | median ms/frame |"
+    )
     print("|---|---|---|---|---|---|---|")
     for name, r in (("detection only", only), ("detection + tracking", tracked)):
         lee = r["lee"]
-        print(f"| {name} | {np.isfinite(r['errors']).sum()}/{FRAMES} | "
-              f"{np.nanmedian(r['errors']):.2f} | {r['ious'].mean():.3f} | "
-              f"{lee['true_positives']}/{FRAMES} | {_f(lee['area_precision'])} / "
-              f"{_f(lee['area_recall'])} | {np.median(r['ms']):.2f} |")
+        print(
+            f"| {name} | {np.isfinite(r['errors']).sum()}/{FRAMES} | "
+            f"{np.nanmedian(r['errors']):.2f} | {r['ious'].mean():.3f} | "
+            f"{lee['true_positives']}/{FRAMES} | {_f(lee['area_precision'])} / "
+            f"{_f(lee['area_recall'])} | {np.median(r['ms']):.2f} |"
+        )
     tracked_ms = [m for m, o in zip(tracked["ms"], tracked["origins"]) if o == "t"]
-    print(f"\nTracked frames: {len(tracked_ms)}; median pipeline ms on tracked frames "
-          f"(tracker only, no detection): {np.median(tracked_ms):.2f}")
+    print(
+        f"\nTracked frames: {len(tracked_ms)}; median pipeline ms on tracked frames "
+        f"(tracker only, no detection): {np.median(tracked_ms):.2f}"
+    )
 
 
 def _f(value) -> str:

@@ -10,6 +10,7 @@ Run::
     python benchmarks/cv_classifier_defaults.py hsi-backprojection \\
         --grid min_saturation=0,40,80 --grid clip=250,256
 """
+
 from __future__ import annotations
 
 import os
@@ -36,12 +37,14 @@ STATES = ("red", "yellow", "green")
 def grid_points(grid: list[str]) -> list[dict[str, str]]:
     """Every combination of ``KEY=V1,V2,...`` values, as parameter dicts."""
     axes = [(key, values.split(",")) for key, values in (g.split("=", 1) for g in grid)]
-    return [dict(zip([k for k, _ in axes], combo))
-            for combo in itertools.product(*[v for _, v in axes])]
+    return [
+        dict(zip([k for k, _ in axes], combo)) for combo in itertools.product(*[v for _, v in axes])
+    ]
 
 
-def cross_validate(name: str, params: dict[str, str], samples: list, frames: dict,
-                   folds: list, workdir: Path) -> dict[str, int]:
+def cross_validate(
+    name: str, params: dict[str, str], samples: list, frames: dict, folds: list, workdir: Path
+) -> dict[str, int]:
     """Pooled ``(state, predicted) -> count`` over the folds for one parameter setting."""
     registry = get_registry()
     counts: dict[str, int] = {}
@@ -64,18 +67,25 @@ def summary(counts: dict[str, int]) -> tuple[float, str]:
     recalls = []
     for state in STATES:
         n = sum(v for k, v in counts.items() if k.startswith(f"{state}>"))
-        recalls.append(f"{state}={counts.get(f'{state}>{state}', 0) / n:.3f}" if n else
-                       f"{state}=-")
+        recalls.append(
+            f"{state}={counts.get(f'{state}>{state}', 0) / n:.3f}" if n else f"{state}=-"
+        )
     return correct / total, " ".join(recalls)
 
 
 def grid_parser(description: str) -> argparse.ArgumentParser:
     """Command line of a grid search: a classifier name and repeatable ``--grid`` options."""
-    parser = argparse.ArgumentParser(description=description,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(
+        description=description, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("classifier")
-    parser.add_argument("--grid", action="append", default=[], metavar="KEY=V1,V2",
-                        help="values to try for one parameter (repeat for more)")
+    parser.add_argument(
+        "--grid",
+        action="append",
+        default=[],
+        metavar="KEY=V1,V2",
+        help="values to try for one parameter (repeat for more)",
+    )
     return parser
 
 
@@ -88,13 +98,13 @@ def main() -> None:
     samples = [s for s in train if s.annotations and s.annotations[0].state in STATES]
     labels = [s.annotations[0].state for s in samples]
     frames = {i: s.load() for i, s in enumerate(samples)}
-    folds = list(StratifiedKFold(args.folds, shuffle=True, random_state=0)
-                 .split(samples, labels))
+    folds = list(StratifiedKFold(args.folds, shuffle=True, random_state=0).split(samples, labels))
     results = []
     with tempfile.TemporaryDirectory(prefix="cv_classifier_") as tmp:
         for params in grid_points(args.grid) or [{}]:
-            accuracy, recalls = summary(cross_validate(args.classifier, params, samples,
-                                                       frames, folds, Path(tmp)))
+            accuracy, recalls = summary(
+                cross_validate(args.classifier, params, samples, frames, folds, Path(tmp))
+            )
             results.append((accuracy, params, recalls))
             print(f"{params} cv_acc={accuracy:.4f} recall {recalls}", flush=True)
     best = max(results, key=lambda r: r[0])

@@ -6,6 +6,7 @@ of the child and all its descendants (the pool workers) every 20 ms and keeps th
 
     /work/venv/bin/python benchmarks/memory_benchmark.py [--repeats 3] [--data DIR]
 """
+
 from __future__ import annotations
 
 import argparse
@@ -33,8 +34,9 @@ def child(frames: int, data: Path, detector: str, workers: int) -> None:
     full = open_dataset(str(data / "annotations.json"))
     subset = Dataset(f"synth-{frames}", full.samples[:frames], full.format, full.root)
     with tempfile.TemporaryDirectory() as out:
-        report = tsrkit.benchmark(subset, tsrkit.detector(detector), workers=workers,
-                                  out=out, cache=False)
+        report = tsrkit.benchmark(
+            subset, tsrkit.detector(detector), workers=workers, out=out, cache=False
+        )
     print(report["frames"], report["timing"]["frames_per_second"])
 
 
@@ -56,8 +58,18 @@ def measure(frames: int, data: Path, detector: str, workers: int) -> tuple[float
     import psutil
 
     env = {**os.environ, **SINGLE_THREAD}
-    cmd = [sys.executable, __file__, "--child", str(frames), "--data", str(data),
-           "--detector", detector, "--workers", str(workers)]
+    cmd = [
+        sys.executable,
+        __file__,
+        "--child",
+        str(frames),
+        "--data",
+        str(data),
+        "--detector",
+        detector,
+        "--workers",
+        str(workers),
+    ]
     start = time.perf_counter()
     popen = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, text=True)
     proc = psutil.Process(popen.pid)
@@ -84,8 +96,9 @@ def ensure_data(folder: Path) -> Path:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--child", type=int, default=None, help=argparse.SUPPRESS)
-    parser.add_argument("--data", type=Path,
-                        default=Path(tempfile.gettempdir()) / "tsrkit-memory-bench-2000")
+    parser.add_argument(
+        "--data", type=Path, default=Path(tempfile.gettempdir()) / "tsrkit-memory-bench-2000"
+    )
     parser.add_argument("--detector", default="gray-tophat")
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--repeats", type=int, default=3)
@@ -99,11 +112,15 @@ def main() -> None:
         runs = [measure(frames, data, args.detector, args.workers) for _ in range(args.repeats)]
         peaks[frames] = statistics.median(r[0] for r in runs)
         for peak, wall, output in runs:
-            print(f"{frames:5d} frames: peak RSS {peak:7.1f} MiB, wall {wall:6.1f} s "
-                  f"(frames, frames/s: {output})")
+            print(
+                f"{frames:5d} frames: peak RSS {peak:7.1f} MiB, wall {wall:6.1f} s "
+                f"(frames, frames/s: {output})"
+            )
     small, large = peaks[SIZES[0]], peaks[SIZES[1]]
-    print(f"median peak RSS: {SIZES[0]} frames {small:.1f} MiB, {SIZES[1]} frames "
-          f"{large:.1f} MiB, ratio {large / small:.2f} (target <= 1.5)")
+    print(
+        f"median peak RSS: {SIZES[0]} frames {small:.1f} MiB, {SIZES[1]} frames "
+        f"{large:.1f} MiB, ratio {large / small:.2f} (target <= 1.5)"
+    )
 
 
 if __name__ == "__main__":

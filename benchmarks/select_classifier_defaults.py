@@ -15,6 +15,7 @@ Run::
     python benchmarks/select_classifier_defaults.py hsi-backprojection \\
         --grid min_saturation=0,20,40 --grid clip=250,256
 """
+
 from __future__ import annotations
 
 import os
@@ -27,9 +28,9 @@ from pathlib import Path  # noqa: E402
 
 import cv2  # noqa: E402
 import numpy as np  # noqa: E402
-
 from bench_classifiers import STATES, benchmark_sets, evaluate  # noqa: E402
 from cv_classifier_defaults import grid_parser, grid_points  # noqa: E402
+
 from tsrkit.registry import get_registry  # noqa: E402
 from tsrkit.training import train as train_model  # noqa: E402
 
@@ -41,8 +42,9 @@ def balanced_accuracy(result: dict) -> float:
 
 def describe(result: dict) -> str:
     """``acc (red/yellow/green recall)`` of one result."""
-    recalls = "/".join("-" if result["recall"][s] is None else f"{result['recall'][s]:.2f}"
-                       for s in STATES)
+    recalls = "/".join(
+        "-" if result["recall"][s] is None else f"{result['recall'][s]:.2f}" for s in STATES
+    )
     return f"{result['accuracy']:.3f} ({recalls})"
 
 
@@ -56,11 +58,14 @@ def main() -> None:
     with tempfile.TemporaryDirectory(prefix="select_classifier_") as tmp:
         for k, params in enumerate(points):
             path = train_model(args.classifier, train, Path(tmp) / f"m{k}", params)
-            classifier = registry.create("classifier", args.classifier,
-                                         {**params, "model": str(path)})
+            classifier = registry.create(
+                "classifier", args.classifier, {**params, "model": str(path)}
+            )
             scores.append({name: evaluate(classifier, data) for name, data in sets.items()})
-            print(f"{params} " + "  ".join(f"{n}={describe(r)}" for n, r in scores[-1].items()),
-                  flush=True)
+            print(
+                f"{params} " + "  ".join(f"{n}={describe(r)}" for n, r in scores[-1].items()),
+                flush=True,
+            )
     balanced = np.array([[balanced_accuracy(s[name]) for name in sets] for s in scores])
     print("\nleave-one-set-out selection (chosen on the other sets; acc and r/y/g recall):")
     for j, name in enumerate(sets):
@@ -68,8 +73,7 @@ def main() -> None:
         best = int(np.argmax(others))
         print(f"  {name:<12} {describe(scores[best][name])}  chosen {points[best]}")
     best = int(np.argmax(balanced.mean(axis=1)))
-    print(f"best over all sets: {points[best]} mean balanced accuracy "
-          f"{balanced[best].mean():.3f}")
+    print(f"best over all sets: {points[best]} mean balanced accuracy {balanced[best].mean():.3f}")
 
 
 if __name__ == "__main__":

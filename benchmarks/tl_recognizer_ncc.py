@@ -6,6 +6,7 @@ annotations, and prints their NCC quantiles, the ROC AUC, the T that 5.2 would c
 score of a non-light) and the share of annotated lights a pruned patch reaches (the recall
 ceiling) and keeps at that T. Usage: ``python benchmarks/tl_recognizer_ncc.py``.
 """
+
 from __future__ import annotations
 
 import os
@@ -50,10 +51,19 @@ def separation(detector, samples) -> dict:
     parts = [frame_scores(detector, s.load(), [a.bbox for a in s.annotations]) for s in samples]
     lights, others, best = (np.concatenate([p[i] for p in parts]) for i in range(3))
     threshold = others.max() if len(others) else -1.0
-    auc = (roc_auc_score(np.r_[np.ones(len(lights)), np.zeros(len(others))], np.r_[lights, others])
-           if len(lights) and len(others) else float("nan"))
-    return {"lights": lights, "others": others, "auc": auc, "T": threshold,
-            "reached": float(np.mean(np.isfinite(best))), "kept": float(np.mean(best > threshold))}
+    auc = (
+        roc_auc_score(np.r_[np.ones(len(lights)), np.zeros(len(others))], np.r_[lights, others])
+        if len(lights) and len(others)
+        else float("nan")
+    )
+    return {
+        "lights": lights,
+        "others": others,
+        "auc": auc,
+        "T": threshold,
+        "reached": float(np.mean(np.isfinite(best))),
+        "kept": float(np.mean(best > threshold)),
+    }
 
 
 def quantiles(values: np.ndarray) -> str:
@@ -69,17 +79,21 @@ def main() -> None:
     args = parser.parse_args()
     cv2.setNumThreads(1)
     print(f"resize factor {args.resize_factor}; quantiles are median/p90/p99/max")
-    print(f"{'set':<28} {'setting':<14} {'lights':>6} {'others':>7} {'lights NCC':>22} "
-          f"{'others NCC':>22} {'AUC':>5} {'T':>5} {'reached':>7} {'kept@T':>6}")
+    print(
+        f"{'set':<28} {'setting':<14} {'lights':>6} {'others':>7} {'lights NCC':>22} "
+        f"{'others NCC':>22} {'AUC':>5} {'T':>5} {'reached':>7} {'kept@T':>6}"
+    )
     for name, split in TUNING.items():
         samples = list(tsrkit.dataset(name).split(split))
         for setting, params in SETTINGS.items():
             det = tsrkit.detector("tl-recognizer", resize_factor=args.resize_factor, **params)
             r = separation(det, samples)
-            print(f"{name + ':' + split:<28} {setting:<14} {len(r['lights']):>6} "
-                  f"{len(r['others']):>7} {quantiles(r['lights']):>22} "
-                  f"{quantiles(r['others']):>22} {r['auc']:>5.3f} {r['T']:>5.3f} "
-                  f"{r['reached']:>7.3f} {r['kept']:>6.3f}")
+            print(
+                f"{name + ':' + split:<28} {setting:<14} {len(r['lights']):>6} "
+                f"{len(r['others']):>7} {quantiles(r['lights']):>22} "
+                f"{quantiles(r['others']):>22} {r['auc']:>5.3f} {r['T']:>5.3f} "
+                f"{r['reached']:>7.3f} {r['kept']:>6.3f}"
+            )
 
 
 if __name__ == "__main__":

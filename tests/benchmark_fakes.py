@@ -3,6 +3,7 @@
 ``OracleDetector`` returns the candidates stored in each frame's metadata (``"dets"``: a list of
 ``(x, y, score)``), so a test decides exactly which hits, misses and false positives occur.
 """
+
 from __future__ import annotations
 
 import time
@@ -19,8 +20,10 @@ from tsrkit.types import Annotation, Candidate, Dataset, Detection, Sample
 class OracleDetector(Detector):
     name = "oracle"
     summary = "returns the candidates written in the frame's metadata"
-    params = (Param("delay", "float", 0.0, min=0, help="seconds to sleep per frame"),
-              Param("crash_on", "str", "", help="raise on the frame with this source"))
+    params = (
+        Param("delay", "float", 0.0, min=0, help="seconds to sleep per frame"),
+        Param("crash_on", "str", "", help="raise on the frame with this source"),
+    )
 
     def detect(self, frame):
         if self.params["delay"]:
@@ -35,8 +38,9 @@ class ShiftedDetector(OracleDetector):
     summary = "the oracle's candidates moved 20 px right (mostly misses)"
 
     def detect(self, frame):
-        return [Candidate.from_circle(c.x + 20, c.y, c.radius, c.score)
-                for c in super().detect(frame)]
+        return [
+            Candidate.from_circle(c.x + 20, c.y, c.radius, c.score) for c in super().detect(frame)
+        ]
 
 
 class RedClassifier(Classifier):
@@ -79,8 +83,7 @@ def hand_dataset(frames: int = 6, name: str = "hand") -> Dataset:
         image = np.full((40, 40, 3), (i * 37) % 256, np.uint8)
         boxes = (Annotation((10, 10, 16, 16), "red"), Annotation((20, 20, 26, 26), "green"))
         dets = [(13, 13, 0.9), (35, 35, 0.5)] if i % 2 else [(13, 13, 0.9), (23, 23, 0.8)]
-        samples.append(Sample(f"frame{i:03d}", boxes, 40, 40, metadata={"dets": dets},
-                              image=image))
+        samples.append(Sample(f"frame{i:03d}", boxes, 40, 40, metadata={"dets": dets}, image=image))
     return Dataset(name, tuple(samples))
 
 

@@ -1,4 +1,5 @@
 """Shared fixtures: where the real datasets live, and a clean plugin registry per test."""
+
 from __future__ import annotations
 
 import os

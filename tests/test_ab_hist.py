@@ -1,10 +1,11 @@
 """ab-hist (Zheng 3.3): histograms, Eq. 3.20 similarity, training, decisions, model files."""
+
 from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from oracles.lamps import COLOURS, lamp, training_set
+
 from tsrkit.models import ModelError, load_model, save_model
 from tsrkit.registry import get_registry
 from tsrkit.types import Candidate, Frame
@@ -20,8 +21,14 @@ def make(**params):
 def model_path(tmp_path_factory):
     classifier = make(smooth=0, min_chroma=0)
     path = tmp_path_factory.mktemp("ab") / "model"
-    save_model(path, classifier.fit(training_set()), plugin="ab-hist", plugin_version="t",
-               params=classifier.params, training={})
+    save_model(
+        path,
+        classifier.fit(training_set()),
+        plugin="ab-hist",
+        plugin_version="t",
+        params=classifier.params,
+        training={},
+    )
     return path
 
 
@@ -29,8 +36,9 @@ def test_histogram_matches_numpy_histogram2d():
     rng = np.random.default_rng(3)
     lab = rng.integers(0, 256, (12, 15, 3), dtype=np.uint8)
     mask = rng.random((12, 15)) < 0.6
-    expected, _, _ = np.histogram2d(lab[..., 1][mask], lab[..., 2][mask], bins=8,
-                                    range=[[0, 256], [0, 256]])
+    expected, _, _ = np.histogram2d(
+        lab[..., 1][mask], lab[..., 2][mask], bins=8, range=[[0, 256], [0, 256]]
+    )
     got = ab_histogram(lab, mask, 8)
     assert np.allclose(got, expected / mask.sum())
     assert got.sum() == pytest.approx(1.0)
@@ -64,15 +72,21 @@ def test_night_halo_is_classified_by_its_annulus(model_path):
     det = classifier.classify(Frame(image, "t"), [Candidate.from_circle(24, 24, 6, 1.0)])[0]
     assert det.state == "red"
     plain = lamp(white, size=48, radius=6, seed=5)
-    assert classifier.classify(Frame(plain, "t"), [Candidate.from_circle(24, 24, 6, 1.0)])[0] \
-        .state_scores["red"] < det.state_scores["red"]
+    assert (
+        classifier.classify(Frame(plain, "t"), [Candidate.from_circle(24, 24, 6, 1.0)])[
+            0
+        ].state_scores["red"]
+        < det.state_scores["red"]
+    )
 
 
 def test_low_discriminative_ratio_gives_unknown(model_path):
     grey = lamp((128, 128, 128), size=24, radius=8)
     classifier = make(model=str(model_path), smooth=0, min_chroma=0, min_ratio=0.99)
-    assert classifier.classify(Frame(grey, "t"), [Candidate.from_box((4, 4, 20, 20), 1)])[0] \
-        .state == "unknown"
+    assert (
+        classifier.classify(Frame(grey, "t"), [Candidate.from_box((4, 4, 20, 20), 1)])[0].state
+        == "unknown"
+    )
 
 
 def test_training_is_deterministic_and_averages_histograms():
@@ -92,13 +106,17 @@ def test_model_round_trip_and_wrong_models(tmp_path, model_path):
     model = load_model(model_path, plugin="ab-hist")
     image = lamp(COLOURS["green"], size=30, radius=9)
     frame, cands = Frame(image, "t"), [Candidate.from_box((6, 6, 24, 24), 1.0)]
-    assert make(model=str(model_path), smooth=0, min_chroma=0).classify(frame, cands)[0] \
-        .state_scores == make(model=str(model_path), smooth=0, min_chroma=0).classify(
-            frame, cands)[0].state_scores
+    assert (
+        make(model=str(model_path), smooth=0, min_chroma=0).classify(frame, cands)[0].state_scores
+        == make(model=str(model_path), smooth=0, min_chroma=0)
+        .classify(frame, cands)[0]
+        .state_scores
+    )
     assert model.arrays["histograms"].shape == (3, 32, 32)
     other = tmp_path / "other"
-    save_model(other, model, plugin="hsi-backprojection", plugin_version="t", params={},
-               training={})
+    save_model(
+        other, model, plugin="hsi-backprojection", plugin_version="t", params={}, training={}
+    )
     with pytest.raises(ModelError, match="hsi-backprojection"):
         make(model=str(other)).classify(frame, cands)
     (tmp_path / "bad.npz").write_bytes(b"not a zip")
@@ -107,14 +125,23 @@ def test_model_round_trip_and_wrong_models(tmp_path, model_path):
         make(model=str(tmp_path / "bad")).classify(frame, cands)
 
 
-
 def test_warm_red_prior_reads_orange_red_as_red(tmp_path):
     classifier = make(smooth=4)
     path = tmp_path / "smooth"
-    save_model(path, classifier.fit(training_set()), plugin="ab-hist", plugin_version="t",
-               params=classifier.params, training={})
+    save_model(
+        path,
+        classifier.fit(training_set()),
+        plugin="ab-hist",
+        plugin_version="t",
+        params=classifier.params,
+        training={},
+    )
     orange_red = lamp((10, 150, 240), size=40, radius=8, seed=4)  # a-b angle 70, red 34, yellow 90
     cand = [Candidate.from_circle(20, 20, 8, 1.0)]
-    states = {prior: make(model=str(path), smooth=4, red_prior=prior)
-              .classify(Frame(orange_red, "t"), cand)[0].state for prior in (True, False)}
+    states = {
+        prior: make(model=str(path), smooth=4, red_prior=prior)
+        .classify(Frame(orange_red, "t"), cand)[0]
+        .state
+        for prior in (True, False)
+    }
     assert states == {True: "red", False: "yellow"}

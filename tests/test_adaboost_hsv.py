@@ -1,4 +1,5 @@
 """adaboost-hsv: learning a colour on synthetic scenes, the lookup table, blobs, model I/O."""
+
 from __future__ import annotations
 
 import cv2
@@ -32,8 +33,9 @@ def samples(seed, n=6, colour=RED):
     for _ in range(n):
         x0, y0 = rng.integers(5, 40), rng.integers(5, 30)
         box = (int(x0), int(y0), int(x0 + 15), int(y0 + 20))
-        out.append(Sample(f"synthetic-{seed}", (Annotation(box, "red"),), image=scene(rng, box,
-                                                                                    colour)))
+        out.append(
+            Sample(f"synthetic-{seed}", (Annotation(box, "red"),), image=scene(rng, box, colour))
+        )
     return out
 
 
@@ -58,7 +60,7 @@ def trained():
 
 
 def test_learns_patch_to_near_perfect_pixel_accuracy(trained):
-    det, model = trained
+    _det, model = trained
     counts = ab.pixel_histograms(samples(2), ("red",), 50, "box")
     positive, negative = counts.positive[0], counts.negative[0]
     assert counts.images == counts.target_images[0] == 6 and model.info["priors"]["red"] == 0.5
@@ -71,10 +73,11 @@ def test_learns_patch_to_near_perfect_pixel_accuracy(trained):
 
 def test_margin_matches_scikit_learn_decision():
     rng = np.random.default_rng(0)
-    pos = rng.integers(0, 50, ab.LEVELS ** 2) * (rng.random(ab.LEVELS ** 2) < 0.01)
-    neg = rng.integers(0, 50, ab.LEVELS ** 2) * (rng.random(ab.LEVELS ** 2) < 0.05)
-    booster = ab.AdaBoostClassifier(ab.DecisionTreeClassifier(max_depth=1), n_estimators=7,
-                                    random_state=0)
+    pos = rng.integers(0, 50, ab.LEVELS**2) * (rng.random(ab.LEVELS**2) < 0.01)
+    neg = rng.integers(0, 50, ab.LEVELS**2) * (rng.random(ab.LEVELS**2) < 0.05)
+    booster = ab.AdaBoostClassifier(
+        ab.DecisionTreeClassifier(max_depth=1), n_estimators=7, random_state=0
+    )
     x = ab.plane_features()
     cells = np.flatnonzero(pos + neg)
     booster.fit(x[cells], (pos[cells] > neg[cells]).astype(int))
@@ -88,8 +91,9 @@ def test_probability_is_monotone_in_margin():
     margin = np.linspace(-8, 8, 401)
     for prior in (0.01, 0.5, 0.9):
         prob = ab.posterior(ab.margin_probability(margin), prior)
-        assert np.all(np.diff(prob) > 0) or np.all(np.diff(prob[(prob > 1e-12)
-                                                                 & (prob < 1 - 1e-12)]) > 0)
+        assert np.all(np.diff(prob) > 0) or np.all(
+            np.diff(prob[(prob > 1e-12) & (prob < 1 - 1e-12)]) > 0
+        )
     assert ab.margin_probability(0.0) == pytest.approx(0.5)
     assert ab.margin_probability(1.0) == pytest.approx(np.e / (np.e + 1 / np.e))
 
@@ -99,8 +103,10 @@ def test_table_lookup_equals_direct_evaluation(trained):
     image = samples(3, n=1)[0].image
     stumps = {k: model.arrays[f"red_{k}"] for k in ab.STUMP_KEYS}
     hue, sat, val = ab.hsv_planes(image)
-    direct = ab.posterior(ab.margin_probability(
-        ab.boosted_margin(ab.color_features(hue, sat), stumps)), model.info["priors"]["red"])
+    direct = ab.posterior(
+        ab.margin_probability(ab.boosted_margin(ab.color_features(hue, sat), stumps)),
+        model.info["priors"]["red"],
+    )
     direct[val.ravel() < 50] = 0
     fast, colour = ab.probability_map(image, det.table(), det._colour, 50)
     assert not colour.any()
@@ -137,8 +143,14 @@ def test_two_colour_expansion():
 
 def test_model_round_trip(tmp_path, trained):
     det, model = trained
-    path = save_model(tmp_path / "m", model, plugin="adaboost-hsv", plugin_version="0",
-                      params=det.params, training={})
+    path = save_model(
+        tmp_path / "m",
+        model,
+        plugin="adaboost-hsv",
+        plugin_version="0",
+        params=det.params,
+        training={},
+    )
     loaded = make(model=str(path), target="red", min_size=5, max_boxes=3)
     image = samples(5, n=1)[0].image
     np.testing.assert_array_equal(loaded.table(), det.table())
@@ -148,7 +160,7 @@ def test_model_round_trip(tmp_path, trained):
 
 def test_errors():
     with pytest.raises(ValueError, match="target and background"):
-        ab.fit_stumps(np.zeros(ab.LEVELS ** 2), np.ones(ab.LEVELS ** 2), 3, 0)
+        ab.fit_stumps(np.zeros(ab.LEVELS**2), np.ones(ab.LEVELS**2), 3, 0)
     det, model = make(target="green"), make(target="red", labels="box").fit(samples(1, n=2))
     with pytest.raises(TsrkitError, match="needs \\['green'\\]"):
         det.use_model(model)
@@ -186,13 +198,14 @@ def test_pixel_labels_lens_other_colours_and_hard_negatives():
     anns = (Annotation((2, 2, 14, 32), "red"), Annotation((20, 2, 32, 32), "green"))
     _, sat, val = ab.hsv_planes(image)
     (red_pos, red_neg), (green_pos, green_neg) = ab.pixel_labels(
-        sat, val, anns, ("red", "green"), "lens", False, 10)
+        sat, val, anns, ("red", "green"), "lens", False, 10
+    )
     assert red_pos[2:12, 2:14].sum() > 20 and not red_pos[12:].any() and not red_pos[:, 14:].any()
     assert red_neg[green_pos].all() and green_neg[red_pos].all()
     assert not red_neg[12:32, 2:14].any()
     _, (_, hard) = ab.pixel_labels(sat, val, anns, ("red", "green"), "lens", True, 10)
     assert hard[12:32, 2:14].sum() > 100 and not (hard & green_pos).any()
-    (box_pos, box_neg), = ab.pixel_labels(sat, val, anns, ("red",), "box", False, 10)
+    ((box_pos, box_neg),) = ab.pixel_labels(sat, val, anns, ("red",), "box", False, 10)
     assert box_pos[2:32, 2:14].all() and not box_neg[2:32, 20:32].any()
 
 
@@ -202,16 +215,22 @@ def test_lights_mode_gives_each_blob_its_colour():
     for i in range(6):
         lit = i % 3
         image = np.full((60, 60, 3), 110, np.uint8) + rng.integers(0, 20, (60, 60, 3)).astype(
-            np.uint8)
+            np.uint8
+        )
         x, y = int(rng.integers(2, 44)), int(rng.integers(2, 26))
-        image[y:y + 30, x:x + 12] = lit_housing(rng, lit)
-        train.append(Sample(f"l{i}", (Annotation((x, y, x + 12, y + 30),
-                                                 ("red", "yellow", "green")[lit]),), image=image))
+        image[y : y + 30, x : x + 12] = lit_housing(rng, lit)
+        train.append(
+            Sample(
+                f"l{i}",
+                (Annotation((x, y, x + 12, y + 30), ("red", "yellow", "green")[lit]),),
+                image=image,
+            )
+        )
     det = make(n_estimators=30, min_size=3, max_boxes=5, threshold=0.5)
     det.use_model(det.fit(train))
     scene_image = np.full((60, 90, 3), 110, np.uint8)
     for k, lit in enumerate((2, 0, 1)):
-        scene_image[10:40, 5 + 30 * k:17 + 30 * k] = lit_housing(rng, lit)
+        scene_image[10:40, 5 + 30 * k : 17 + 30 * k] = lit_housing(rng, lit)
     found = sorted(det.detect(Frame(scene_image, "x")), key=lambda c: c.x)
     assert [c.state for c in found] == ["green", "red", "yellow"]
     assert [c.y for c in found] == [35.5, 15.5, 25.5]

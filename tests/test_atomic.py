@@ -1,4 +1,5 @@
 """Atomic output: all or nothing, with ordinary permissions."""
+
 import os
 import stat
 
@@ -19,9 +20,8 @@ def test_success_replaces_and_uses_umask_permissions(tmp_path):
 def test_failure_leaves_the_old_file_and_no_temporary(tmp_path):
     target = tmp_path / "out.txt"
     target.write_text("old")
-    with pytest.raises(RuntimeError):
-        with atomic_open(target) as fh:
-            fh.write("new, half written")
-            raise RuntimeError("interrupted")
+    with pytest.raises(RuntimeError), atomic_open(target) as fh:
+        fh.write("new, half written")
+        raise RuntimeError("interrupted")
     assert target.read_text() == "old"
     assert [p.name for p in tmp_path.iterdir()] == ["out.txt"]

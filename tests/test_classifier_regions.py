@@ -1,16 +1,24 @@
 """Lens/annulus regions, the lit-lens search in a housing box, and the shared decisions."""
+
 from __future__ import annotations
 
 import cv2
 import numpy as np
 import pytest
-
 from oracles.lamps import COLOURS, crop_sample, housing, lamp
+
 from tsrkit.registry import get_registry
 from tsrkit.types import Annotation, Candidate, Frame, Sample
 from tsrkit_plugins.classifiers.decision import best_state, discriminative_ratio, fuse_lights
-from tsrkit_plugins.classifiers.regions import (clip_box, disk_kernel, find_lens, is_housing,
-                                                labelled_lenses, lens_of, rings)
+from tsrkit_plugins.classifiers.regions import (
+    clip_box,
+    disk_kernel,
+    find_lens,
+    is_housing,
+    labelled_lenses,
+    lens_of,
+    rings,
+)
 
 PARAMS = {"region": "auto", "elongation": 1.5, "lens_fraction": 0.4}
 
@@ -83,8 +91,10 @@ def test_lens_of_keeps_a_lens_candidate_and_searches_a_housing():
 
 def test_labelled_lenses_passes_over_other_labels():
     image = lamp(COLOURS["red"])
-    samples = [crop_sample(image, "red"),
-               Sample("arrow", (Annotation((0, 0, 24, 24), "left-arrow"),), image=image)]
+    samples = [
+        crop_sample(image, "red"),
+        Sample("arrow", (Annotation((0, 0, 24, 24), "left-arrow"),), image=image),
+    ]
     got = list(labelled_lenses(samples, ("red", "yellow", "green"), PARAMS))
     assert [state for state, _, _ in got] == ["red"]
 

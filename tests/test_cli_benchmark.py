@@ -1,4 +1,5 @@
 """``tsrkit benchmark`` / ``compare`` on the command line, with in-process fake plugins."""
+
 import json
 
 import benchmark_fakes
@@ -13,15 +14,31 @@ from tsrkit.cli.main import cli
 def fakes(registry, monkeypatch):
     """The fake plugins registered, and ``open_dataset`` serving the hand-built frames."""
     registry.add(benchmark_fakes, "benchmark-fakes")
-    monkeypatch.setattr("tsrkit.datasets.open_dataset",
-                        lambda ref, format=None, images=None: hand_dataset(6, name=ref))
+    monkeypatch.setattr(
+        "tsrkit.datasets.open_dataset",
+        lambda ref, format=None, images=None: hand_dataset(6, name=ref),
+    )
     return registry
 
 
 def test_benchmark_prints_table_and_writes_report(fakes, tmp_path):
-    result = CliRunner().invoke(cli, ["benchmark", "--dataset", "hand", "--detector", "oracle",
-                                      "--classifier", "always-red", "--out", str(tmp_path),
-                                      "--workers", "1", "--quiet"])
+    result = CliRunner().invoke(
+        cli,
+        [
+            "benchmark",
+            "--dataset",
+            "hand",
+            "--detector",
+            "oracle",
+            "--classifier",
+            "always-red",
+            "--out",
+            str(tmp_path),
+            "--workers",
+            "1",
+            "--quiet",
+        ],
+    )
     assert result.exit_code == 0, result.output
     assert "always-red" in result.stdout and "0.750" in result.stdout
     report = json.loads((tmp_path / "report.json").read_text())
@@ -30,8 +47,21 @@ def test_benchmark_prints_table_and_writes_report(fakes, tmp_path):
 
 
 def test_benchmark_param_reaches_the_plugin(fakes, tmp_path):
-    result = CliRunner().invoke(cli, ["benchmark", "-d", "oracle", "-p", "crash_on=frame001",
-                                      "-o", str(tmp_path), "-w", "1", "-q"])
+    result = CliRunner().invoke(
+        cli,
+        [
+            "benchmark",
+            "-d",
+            "oracle",
+            "-p",
+            "crash_on=frame001",
+            "-o",
+            str(tmp_path),
+            "-w",
+            "1",
+            "-q",
+        ],
+    )
     assert result.exit_code == 0, result.output
     report = json.loads((tmp_path / "report.json").read_text())
     assert [s["source"] for s in report["skipped"]] == ["frame001"]
@@ -39,8 +69,9 @@ def test_benchmark_param_reaches_the_plugin(fakes, tmp_path):
 
 
 def test_compare_runs_each_detector(fakes, tmp_path):
-    result = CliRunner().invoke(cli, ["compare", "--detectors", "oracle,shifted",
-                                      "-o", str(tmp_path), "-w", "1", "-q"])
+    result = CliRunner().invoke(
+        cli, ["compare", "--detectors", "oracle,shifted", "-o", str(tmp_path), "-w", "1", "-q"]
+    )
     assert result.exit_code == 0, result.output
     assert "oracle vs shifted" in result.stdout
     comparison = json.loads((tmp_path / "compare.json").read_text())
@@ -68,8 +99,10 @@ def test_bare_tsrkit_compares_the_defaults_into_tsrkit_out(fakes, tmp_path, monk
 @pytest.mark.parametrize("workers", ["1", "2"])
 def test_setup_error_from_a_plugin_stops_the_run(fakes, tmp_path, workers):
     """A TsrkitError from a plugin (e.g. no model) ends the run with one line, in workers too."""
-    result = CliRunner().invoke(cli, ["benchmark", "-d", "untrained", "--workers", workers,
-                                      "--quiet", "--out", str(tmp_path)])
+    result = CliRunner().invoke(
+        cli,
+        ["benchmark", "-d", "untrained", "--workers", workers, "--quiet", "--out", str(tmp_path)],
+    )
     assert result.exit_code == 2
     assert result.stderr.strip() == "Error: untrained needs a model: pass --param model=M"
     assert not (tmp_path / "report.json").exists()

@@ -1,4 +1,5 @@
 """``tsrkit datasets list | info | verify | convert``."""
+
 from __future__ import annotations
 
 import json
@@ -66,14 +67,23 @@ def test_verify_reports_missing_and_altered(shared_datasets, tmp_path, monkeypat
 
 def test_convert_and_errors(shared_datasets, tmp_path):
     out = tmp_path / "coco.json"
-    result = _run("convert", str(shared_datasets / "roboflow_cinta_v2_id"), "--format", "yolo",
-                  "--to", "coco", "--out", str(out))
+    result = _run(
+        "convert",
+        str(shared_datasets / "roboflow_cinta_v2_id"),
+        "--format",
+        "yolo",
+        "--to",
+        "coco",
+        "--out",
+        str(out),
+    )
     assert result.exit_code == 0, result.output
     assert "300 images, 403 boxes" in result.output
     coco = json.loads(out.read_text())
     assert len(coco["images"]) == 300 and len(coco["annotations"]) == 403
-    result = _run("convert", str(shared_datasets / "roboflow_cinta_v2_id"), "--to", "coco",
-                  "--out", str(out))
+    result = _run(
+        "convert", str(shared_datasets / "roboflow_cinta_v2_id"), "--to", "coco", "--out", str(out)
+    )
     assert result.exit_code == 2 and "--format" in result.output
     assert "Traceback" not in result.output
     result = _run("convert", "udacity_mit_tl_crops", "--to", "lisa", "--out", str(out))

@@ -1,4 +1,5 @@
 """``tsrkit detect`` and ``tsrkit plugins`` end to end, with the example plugin registered."""
+
 import json
 import sys
 from pathlib import Path
@@ -12,7 +13,17 @@ from tsrkit.cli.main import cli
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "tsrkit-brightest-blobs"
 RECORD_KEYS = {"source", "frame", "width", "height", "ms", "detections"}
-DETECTION_KEYS = {"x", "y", "radius", "bbox", "lens_bbox", "score", "state", "state_scores", "origin"}
+DETECTION_KEYS = {
+    "x",
+    "y",
+    "radius",
+    "bbox",
+    "lens_bbox",
+    "score",
+    "state",
+    "state_scores",
+    "origin",
+}
 
 
 @pytest.fixture
@@ -42,9 +53,21 @@ def mixed_folder(tmp_path):
 
 def test_detect_writes_records_and_reports_skips(example_plugin, mixed_folder, tmp_path):
     out = tmp_path / "dets.jsonl"
-    result = CliRunner().invoke(cli, ["detect", str(mixed_folder), "--detector", "brightest-blobs",
-                                      "--param", "top=1", "--out", str(out),
-                                      "--draw", str(tmp_path / "draw")])
+    result = CliRunner().invoke(
+        cli,
+        [
+            "detect",
+            str(mixed_folder),
+            "--detector",
+            "brightest-blobs",
+            "--param",
+            "top=1",
+            "--out",
+            str(out),
+            "--draw",
+            str(tmp_path / "draw"),
+        ],
+    )
     assert result.exit_code == 0, result.output
     records = [json.loads(line) for line in out.read_text().splitlines()]
     assert [Path(r["source"]).name for r in records] == ["good0.png", "good1.png"]
@@ -61,12 +84,15 @@ def test_detect_writes_records_and_reports_skips(example_plugin, mixed_folder, t
     assert len(list((tmp_path / "draw").glob("*.png"))) == 2
 
 
-@pytest.mark.parametrize("args, message", [
-    (["--param", "top=zero"], "parameter 'top' must be an integer"),
-    (["--param", "colour=red"], "unknown parameter 'colour'"),
-    (["--param", "noequals"], "--param expects key=value"),
-    (["--classifier", "nope"], "no classifier called 'nope'"),
-])
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--param", "top=zero"], "parameter 'top' must be an integer"),
+        (["--param", "colour=red"], "unknown parameter 'colour'"),
+        (["--param", "noequals"], "--param expects key=value"),
+        (["--classifier", "nope"], "no classifier called 'nope'"),
+    ],
+)
 def test_bad_input_is_one_line_exit_2(example_plugin, mixed_folder, args, message):
     result = CliRunner().invoke(cli, ["detect", str(mixed_folder), "-d", "brightest-blobs", *args])
     assert result.exit_code == 2
@@ -133,4 +159,3 @@ def test_setup_error_from_a_plugin_stops_detect_with_one_line(needs_model, mixed
     assert result.exit_code == 2
     assert result.stderr.strip() == "Error: needs-model needs a model: pass --param model=M"
     assert result.stdout == ""
-

@@ -1,16 +1,17 @@
 """Zheng's conspicuity map (3.2.1): fast maps against the direct-correlation oracle, and
 hand-computed micro images."""
+
 import json
 
 import cv2
 import numpy as np
 import pytest
+from oracles.conspicuity_oracle import conspicuity_reference
 
 import tsrkit
 from tsrkit.types import Frame
 from tsrkit_plugins.detectors.conspicuity import conspicuity as cs
 from tsrkit_plugins.detectors.conspicuity import conspicuity_kernel as ck
-from oracles.conspicuity_oracle import conspicuity_reference
 
 
 def random_image(seed, shape=(44, 57)):
@@ -34,13 +35,16 @@ def assert_matches_oracle(image, **settings):
     assert np.all((fast.radius == radius) | (np.abs(at_fast - values) <= 1e-4))
 
 
-@pytest.mark.parametrize("seed, settings", [
-    (0, {}),
-    (1, {"quadrant_rule": "min"}),
-    (2, {"margin": 2, "weights": (1.0, 2.0, 0.5)}),
-    (3, {"radii": (2, 3, 5), "weights": (2.0, 1.0, 4.0)}),
-    (4, {"radii": (3, 12), "margin": 6}),
-])
+@pytest.mark.parametrize(
+    "seed, settings",
+    [
+        (0, {}),
+        (1, {"quadrant_rule": "min"}),
+        (2, {"margin": 2, "weights": (1.0, 2.0, 0.5)}),
+        (3, {"radii": (2, 3, 5), "weights": (2.0, 1.0, 4.0)}),
+        (4, {"radii": (3, 12), "margin": 6}),
+    ],
+)
 def test_fast_map_matches_oracle_on_random_images(seed, settings):
     assert_matches_oracle(random_image(seed), **settings)
 
@@ -52,7 +56,7 @@ def test_fast_map_matches_oracle_on_a_real_frame(shared_datasets):
     image = cv2.imread(str(root / entry["file"]))
     cx, cy = int((box["x_min"] + box["x_max"]) / 2), int((box["y_min"] + box["y_max"]) / 2)
     y0, x0 = max(0, cy - 30), max(0, cx - 35)
-    assert_matches_oracle(np.ascontiguousarray(image[y0:y0 + 60, x0:x0 + 70]))
+    assert_matches_oracle(np.ascontiguousarray(image[y0 : y0 + 60, x0 : x0 + 70]))
 
 
 def window_sums(channel, pad, windows, row, prefix=ck.LIGHT_PREFIX):
@@ -71,16 +75,21 @@ def test_window_sums_are_exact_integer_sums():
     padded = cs.mirror(light, 20).astype(np.int64)
     for r in (1, 4, 10):
         windows = [cs.quarter_plan(r, q) for q in cs.QUADRANTS] + [
-            cs.box_plan(r, (1, 1)), cs.box_plan(r, (1, 1)), cs.box_plan(r, (1, 1)),
-            cs.box_plan(r, (1, 1)), cs.axes_plan(r), cs.disk_plan(r)]
+            cs.box_plan(r, (1, 1)),
+            cs.box_plan(r, (1, 1)),
+            cs.box_plan(r, (1, 1)),
+            cs.box_plan(r, (1, 1)),
+            cs.axes_plan(r),
+            cs.disk_plan(r),
+        ]
         sums = window_sums(light, 20, windows, 7)
         rebuilt = np.zeros(light.shape[1], np.int32)
         ck.disk_from_quarters(sums, light.shape[1], rebuilt)
         assert np.array_equal(rebuilt, sums[9])
-        disk = np.hypot(*np.mgrid[-r:r + 1, -r:r + 1]) <= r
-        assert int(sums[9, 9]) == int(np.sum(padded[27 - r:28 + r, 29 - r:30 + r] * disk))
-        assert int(sums[3, 9]) == int(np.sum((padded[27:28 + r, 29:30 + r] * disk[r:, r:])))
-        assert int(sums[4, 6]) == int(padded[27:28 + r, 26:27 + r].sum())
+        disk = np.hypot(*np.mgrid[-r : r + 1, -r : r + 1]) <= r
+        assert int(sums[9, 9]) == int(np.sum(padded[27 - r : 28 + r, 29 - r : 30 + r] * disk))
+        assert int(sums[3, 9]) == int(np.sum(padded[27 : 28 + r, 29 : 30 + r] * disk[r:, r:]))
+        assert int(sums[4, 6]) == int(padded[27 : 28 + r, 26 : 27 + r].sum())
 
 
 def test_window_sums_survive_wrapping_integrals():
@@ -111,11 +120,18 @@ def test_quadrant_contrast_is_zero_on_a_flat_image():
     light = cs.lightness(flat)
     for r in (1, 3, 6):
         windows = [cs.quarter_plan(r, q) for q in cs.QUADRANTS] + [
-            cs.box_plan(r, q) for q in cs.QUADRANTS]
+            cs.box_plan(r, q) for q in cs.QUADRANTS
+        ]
         contrast = np.ones(40, np.int64)
         for use_min in (False, True):
-            ck.lightness_contrast(window_sums(light, 12, windows, 5), cs.quarter_disk_size(r),
-                                  (r + 1) ** 2, use_min, 40, contrast)
+            ck.lightness_contrast(
+                window_sums(light, 12, windows, 5),
+                cs.quarter_disk_size(r),
+                (r + 1) ** 2,
+                use_min,
+                40,
+                contrast,
+            )
             assert not contrast.any()
     assert cs.conspicuity_map(flat, radii=(1, 3, 6)).values.max() < 1e-2
 
@@ -127,8 +143,9 @@ def test_geometric_mean_ratio_is_invariant_to_feature_scales():
 
     def geometric_mean(scales):
         product = np.zeros(50, np.float32)
-        ck.weighted_product(*(f * np.float32(s) for f, s in zip(features, scales)), weights, 50,
-                            product)
+        ck.weighted_product(
+            *(f * np.float32(s) for f, s in zip(features, scales)), weights, 50, product
+        )
         return cs.weighted_root(product, weights)
 
     base, scaled = geometric_mean((1, 1, 1)), geometric_mean((0.3, 7.0, 0.01))
@@ -143,14 +160,14 @@ def test_disk_and_annulus_sizes():
     sat[10, 10] = 255
     sums = window_sums(sat, 8, [cs.disk_plan(2), cs.disk_plan(4)], 10, ck.SAT_PREFIX)
     feature = np.zeros(20, np.float32)
-    ck.saturation_feature(sums[0], sums[1], cs.mean_scale(13), cs.mean_scale(49 - 13), 20,
-                          feature)
+    ck.saturation_feature(sums[0], sums[1], cs.mean_scale(13), cs.mean_scale(49 - 13), 20, feature)
     # At the lit pixel the disk mean wins (1/13); three columns away only the annulus sees it.
     assert feature[10] == pytest.approx(1 / 13) and feature[13] == pytest.approx(1 / 36)
 
 
-@pytest.mark.parametrize("kwargs", [{"weights": (0, 0, 0)}, {"weights": (1, 1)},
-                                    {"radii": (0, 2)}, {"margin": -1}])
+@pytest.mark.parametrize(
+    "kwargs", [{"weights": (0, 0, 0)}, {"weights": (1, 1)}, {"radii": (0, 2)}, {"margin": -1}]
+)
 def test_bad_settings_raise_value_error(kwargs):
     with pytest.raises(ValueError):
         cs.conspicuity_map(lit_disk(3), **kwargs)
@@ -181,16 +198,30 @@ def test_region_of_interest_hides_the_lower_frame():
 #: roboflow_traffic_light_kr frames: (x, y, radius, score). The compiled kernel must keep them.
 ROUND_ONE_CANDIDATES = {
     0: [(228.531, 164.473, 2, 0.656477)],
-    5: [(303.466, 98.541, 2, 0.558103), (309.465, 77.661, 7, 0.531864),
-        (373.47, 9.464, 6, 0.523986), (302.432, 88.479, 3, 0.520394),
-        (363.456, 18.528, 6, 0.512656), (384.419, 3.8, 5, 0.507688),
-        (209.58, 58.611, 7, 0.488395), (224.146, 73.623, 9, 0.480928),
-        (371.499, 41.511, 4, 0.475431), (326.35, 98.294, 9, 0.472935)],
-    11: [(227.406, 294.412, 5, 0.498181), (123.45, 298.521, 6, 0.488416),
-         (293.029, 136.568, 7, 0.480127), (211.576, 295.528, 4, 0.47258),
-         (456.198, 26.839, 8, 0.46342), (107.498, 298.416, 6, 0.463031),
-         (431.853, 44.701, 8, 0.461131), (95.437, 298.548, 5, 0.438441),
-         (208.432, 182.492, 6, 0.431261), (292.383, 113.416, 7, 0.430705)],
+    5: [
+        (303.466, 98.541, 2, 0.558103),
+        (309.465, 77.661, 7, 0.531864),
+        (373.47, 9.464, 6, 0.523986),
+        (302.432, 88.479, 3, 0.520394),
+        (363.456, 18.528, 6, 0.512656),
+        (384.419, 3.8, 5, 0.507688),
+        (209.58, 58.611, 7, 0.488395),
+        (224.146, 73.623, 9, 0.480928),
+        (371.499, 41.511, 4, 0.475431),
+        (326.35, 98.294, 9, 0.472935),
+    ],
+    11: [
+        (227.406, 294.412, 5, 0.498181),
+        (123.45, 298.521, 6, 0.488416),
+        (293.029, 136.568, 7, 0.480127),
+        (211.576, 295.528, 4, 0.47258),
+        (456.198, 26.839, 8, 0.46342),
+        (107.498, 298.416, 6, 0.463031),
+        (431.853, 44.701, 8, 0.461131),
+        (95.437, 298.548, 5, 0.438441),
+        (208.432, 182.492, 6, 0.431261),
+        (292.383, 113.416, 7, 0.430705),
+    ],
 }
 
 
@@ -199,28 +230,32 @@ def test_candidates_on_real_frames_match_the_round_one_implementation(shared_dat
     entries = json.loads((root / "annotations.json").read_text())
     detector = tsrkit.detector("conspicuity")
     for index, expected in ROUND_ONE_CANDIDATES.items():
-        image = cv2.resize(cv2.imread(str(root / entries[index]["file"])), (480, 356),
-                           interpolation=cv2.INTER_AREA)
+        image = cv2.resize(
+            cv2.imread(str(root / entries[index]["file"])), (480, 356), interpolation=cv2.INTER_AREA
+        )
         found = detector.detect(Frame(image, entries[index]["file"]))
         assert [c.radius for c in found] == [e[2] for e in expected]
         for candidate, (x, y, _, score) in zip(found, expected):
-            assert (candidate.x, candidate.y) == (pytest.approx(x, abs=2e-3),
-                                                  pytest.approx(y, abs=2e-3))
+            assert (candidate.x, candidate.y) == (
+                pytest.approx(x, abs=2e-3),
+                pytest.approx(y, abs=2e-3),
+            )
             assert candidate.score == pytest.approx(score, abs=2e-6)
 
 
 def test_map_does_not_depend_on_how_the_rows_are_split_into_runs():
     image = random_image(6, (30, 41))
     tables, pad = cs.channel_tables(image, list(range(1, 11)), 0)
-    whole = cs.products_on_runs(tables, pad, cs.full_runs(30, 41), list(range(1, 11)),
-                                (1.0, 1.0, 1.0), 0, "max")
+    whole = cs.products_on_runs(
+        tables, pad, cs.full_runs(30, 41), list(range(1, 11)), (1.0, 1.0, 1.0), 0, "max"
+    )
     pieces = np.array([(i, a, b) for i in range(30) for a, b in ((0, 7), (7, 8), (8, 41))])
-    split = cs.products_on_runs(tables, pad, pieces, list(range(1, 11)), (1.0, 1.0, 1.0), 0,
-                                "max")
+    split = cs.products_on_runs(tables, pad, pieces, list(range(1, 11)), (1.0, 1.0, 1.0), 0, "max")
     assert np.array_equal(whole[0], split[0]) and np.array_equal(whole[1], split[1])
     assert whole[0].max() > 0
-    partial = cs.products_on_runs(tables, pad, pieces[pieces[:, 1] == 7], list(range(1, 11)),
-                                  (1.0, 1.0, 1.0), 0, "max")
+    partial = cs.products_on_runs(
+        tables, pad, pieces[pieces[:, 1] == 7], list(range(1, 11)), (1.0, 1.0, 1.0), 0, "max"
+    )
     assert np.array_equal(partial[0][:, 7], whole[0][:, 7]) and not partial[0][:, 8:].any()
 
 

@@ -1,4 +1,5 @@
 """datasets.yaml, open_dataset by name / path / "sample", and format auto-detection."""
+
 from __future__ import annotations
 
 import json
@@ -8,8 +9,14 @@ import pytest
 from tsrkit.datasets import DatasetError, load_registry, open_dataset
 from tsrkit.errors import TsrkitError
 
-REAL = ["roboflow_traffic_light_kr", "roboflow_cinta_v2_id", "udacity_mit_tl_crops",
-        "lisa_vgis_bulb_crops", "gtsrb_test_35px_subset", "dtld_fridtjofs"]
+REAL = [
+    "roboflow_traffic_light_kr",
+    "roboflow_cinta_v2_id",
+    "udacity_mit_tl_crops",
+    "lisa_vgis_bulb_crops",
+    "gtsrb_test_35px_subset",
+    "dtld_fridtjofs",
+]
 
 
 def _write_registry(tmp_path, monkeypatch, text):
@@ -33,10 +40,23 @@ def test_repository_registry_lists_the_real_sets_and_sample(shared_datasets):
 def test_relative_root_resolves_against_data_dir(tmp_path, monkeypatch):
     data = tmp_path / "data" / "mine"
     data.mkdir(parents=True)
-    (data / "annotations.json").write_text(json.dumps(
-        [{"file": "a.jpg", "split": "test", "width": 8, "height": 6,
-          "boxes": [{"label": "Stop", "x_min": 1, "y_min": 1, "x_max": 3, "y_max": 4}]}]))
-    _write_registry(tmp_path, monkeypatch, """
+    (data / "annotations.json").write_text(
+        json.dumps(
+            [
+                {
+                    "file": "a.jpg",
+                    "split": "test",
+                    "width": 8,
+                    "height": 6,
+                    "boxes": [{"label": "Stop", "x_min": 1, "y_min": 1, "x_max": 3, "y_max": 4}],
+                }
+            ]
+        )
+    )
+    _write_registry(
+        tmp_path,
+        monkeypatch,
+        """
 datasets:
   mine:
     format: normalized
@@ -47,7 +67,8 @@ datasets:
     licence: CC0
     citation: me
     states: {Stop: off}
-""")
+""",
+    )
     monkeypatch.setenv("TSRKIT_DATA_DIR", str(tmp_path / "data"))
     ds = open_dataset("mine")
     assert ds.name == "mine" and ds.info["licence"] == "CC0" and ds.info["box"] == "lens"
@@ -60,14 +81,18 @@ datasets:
 
 
 def test_malformed_registry_entry_is_named(tmp_path, monkeypatch):
-    file = _write_registry(tmp_path, monkeypatch, """
+    file = _write_registry(
+        tmp_path,
+        monkeypatch,
+        """
 datasets:
   broken:
     format: coco
     root: x
     task: detection
     box: lens
-""")
+""",
+    )
     with pytest.raises(DatasetError, match=rf"{file}: datasets.broken: missing licence, citation"):
         load_registry()
     file.write_text("datasets:\n  a: [1,\n")
@@ -87,8 +112,9 @@ def test_ambiguous_and_unknown_formats_ask_for_format(shared_datasets, tmp_path)
 
 def test_sample_resolves_through_synth(tmp_path, monkeypatch):
     file = tmp_path / "annotations.json"
-    file.write_text(json.dumps([{"file": "f.jpg", "split": "train", "width": 4, "height": 4,
-                                 "boxes": []}]))
+    file.write_text(
+        json.dumps([{"file": "f.jpg", "split": "train", "width": 4, "height": 4, "boxes": []}])
+    )
     monkeypatch.setattr("tsrkit.synth.scenes.sample_path", lambda: file)
     ds = open_dataset("sample")
     assert ds.name == "sample" and ds.format == "normalized" and len(ds) == 1

@@ -1,10 +1,11 @@
 """Zheng's centre-in-enclosing-circle rule and IoU matching on hand-worked boxes."""
+
 import numpy as np
 import pytest
 
 from tsrkit.eval.matching import centre_hits, greedy_match
-from tsrkit.geometry import enclosing_circles, iou_matrix
 from tsrkit.eval.overlap import score_overlap, summarise_overlap
+from tsrkit.geometry import enclosing_circles, iou_matrix
 
 
 def test_enclosing_circle_of_a_3_4_5_box():
@@ -55,5 +56,7 @@ def test_overlap_precision_recall_and_area_ratios():
     assert summary["precision"] == 0.5 and summary["recall"] == 1.0
     assert summary["area_precision"] == pytest.approx(0.5)
     assert summary["area_recall"] == pytest.approx(1.0)
-    assert summarise_overlap([score_overlap([(0, 0, 4, 2)], [1], [(0, 0, 2, 2)], 0.5)],
-                             0.5)["recall"] == 0.0
+    assert (
+        summarise_overlap([score_overlap([(0, 0, 4, 2)], [1], [(0, 0, 2, 2)], 0.5)], 0.5)["recall"]
+        == 0.0
+    )

@@ -1,4 +1,5 @@
 """Zheng 5.2.1 per-frame recall/precision and the Table 5-2 breakdown on hand-built frames."""
+
 import pytest
 
 from tsrkit.eval.categories import category_table, precision_bound, recall_label
@@ -30,17 +31,17 @@ def test_precision_lower_bound_of_one_third_is_30_percent():
 
 
 def test_max_target_radius_uses_half_the_shorter_side_rounded():
-    assert max_target_radius([(0, 0, 5, 9), (0, 0, 3, 3)]) == 3   # 2.5 rounds half up
+    assert max_target_radius([(0, 0, 5, 9), (0, 0, 3, 3)]) == 3  # 2.5 rounds half up
     assert max_target_radius([]) == 0
 
 
 def test_summary_follows_design_definitions():
     frames = [
-        score_frame([(5, 5)], BOXES[:2]),                 # recall 1/2, precision 1
-        score_frame([(5, 5), (200, 200)], BOXES[:1]),     # recall 1, precision 1/2
-        score_frame([], BOXES[:1]),                       # recall 0, no candidates
-        score_frame([(1, 1), (2, 2)], []),                # no ground truth: 2 false positives
-        score_frame([], []),                              # empty frame
+        score_frame([(5, 5)], BOXES[:2]),  # recall 1/2, precision 1
+        score_frame([(5, 5), (200, 200)], BOXES[:1]),  # recall 1, precision 1/2
+        score_frame([], BOXES[:1]),  # recall 0, no candidates
+        score_frame([(1, 1), (2, 2)], []),  # no ground truth: 2 false positives
+        score_frame([], []),  # empty frame
     ]
     summary = summarise(frames)
     assert summary["recall_mean"] == pytest.approx((0.5 + 1 + 0) / 3)
@@ -52,17 +53,26 @@ def test_summary_follows_design_definitions():
 
 
 def test_category_table_groups_by_lighting_then_radius():
-    frames = [score_frame([(5, 5)], [(0, 0, 10, 10)], "low"),             # radius 5, recall 1
-              score_frame([], [(0, 0, 4, 4)], "low"),                      # radius 2, recall 0
-              score_frame([(5, 5), (90, 90)], [(0, 0, 10, 10)], "high"),   # radius 5, prec 1/2
-              score_frame([(1, 1)], [], "high")]                           # no GT: not a row
+    frames = [
+        score_frame([(5, 5)], [(0, 0, 10, 10)], "low"),  # radius 5, recall 1
+        score_frame([], [(0, 0, 4, 4)], "low"),  # radius 2, recall 0
+        score_frame([(5, 5), (90, 90)], [(0, 0, 10, 10)], "high"),  # radius 5, prec 1/2
+        score_frame([(1, 1)], [], "high"),
+    ]  # no GT: not a row
     rows = category_table(frames)
     keys = [(r["lighting"], r["max_radius"], r["frames"]) for r in rows]
-    assert keys == [("high", None, 1), ("high", 5, 1), ("low", None, 2), ("low", 2, 1),
-                    ("low", 5, 1)]
+    assert keys == [
+        ("high", None, 1),
+        ("high", 5, 1),
+        ("low", None, 2),
+        ("low", 2, 1),
+        ("low", 5, 1),
+    ]
     low = rows[2]
     assert low["recall_counts"] == {"0": 1, "1": 1}
     assert low["precision_counts"] == {"0%": 1, "100%": 1}
-    assert low["bubbles"] == [{"recall": 0.0, "fpr": 1.0, "frames": 1},
-                              {"recall": 1.0, "fpr": 0.0, "frames": 1}]
+    assert low["bubbles"] == [
+        {"recall": 0.0, "fpr": 1.0, "frames": 1},
+        {"recall": 1.0, "fpr": 0.0, "frames": 1},
+    ]
     assert rows[1]["bubbles"] == [{"recall": 1.0, "fpr": 0.5, "frames": 1}]

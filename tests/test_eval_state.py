@@ -1,4 +1,5 @@
-"""State metrics: confusion, per-class figures, Mascetti's R-Y errors, Zheng's discriminative ratio."""
+"""State metrics: confusion, per-class figures, Mascetti's R-Y errors, Zheng's discrimination."""
+
 import pytest
 
 from tsrkit.eval.state import discriminative_ratio, state_metrics
@@ -15,8 +16,7 @@ def test_confusion_accuracy_and_red_yellow_errors():
     assert matrix[labels.index("green")][labels.index("red")] == 1
     assert m["red_yellow_errors"] == {"red_as_yellow": 1, "yellow_as_red": 1, "total": 2}
     # red: predicted 4 times, right twice; 3 true reds, 2 found.
-    assert m["per_class"]["red"] == {"precision": 0.5, "recall": pytest.approx(2 / 3),
-                                     "support": 3}
+    assert m["per_class"]["red"] == {"precision": 0.5, "recall": pytest.approx(2 / 3), "support": 3}
     assert m["per_class"]["yellow"] == {"precision": 0.0, "recall": 0.0, "support": 1}
     assert "off" not in m["per_class"]
 
@@ -48,8 +48,10 @@ def test_discriminative_ratio_zheng_5_3():
 def test_misclassification_rate_per_ratio_bin():
     scores = [{"red": 1.0, "green": 0.05}, {"red": 1.0, "green": 0.9}, {"red": 1.0, "green": 0.95}]
     m = state_metrics(["red", "green", "red"], ["red", "red", "red"], scores)
-    bins = {b["from"]: (b["pairs"], b["misclassification_rate"])
-            for b in m["discriminative_ratio"]["bins"]}
+    bins = {
+        b["from"]: (b["pairs"], b["misclassification_rate"])
+        for b in m["discriminative_ratio"]["bins"]
+    }
     # Ratios 0.95, 0.1 and 0.05 (floating point puts 1 - 0.9 just under 0.1).
     assert bins[0.9] == (1, 0.0)
     assert sum(p for p, _ in bins.values()) == 3

@@ -1,4 +1,5 @@
 """Bootstrap intervals and the paired comparison test."""
+
 import pytest
 
 from tsrkit.eval.stats import bootstrap_interval, paired_test

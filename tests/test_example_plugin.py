@@ -1,4 +1,5 @@
 """A third-party plugin, installed by pip like a stranger's package, is found and runs."""
+
 import json
 import os
 import subprocess
@@ -16,35 +17,64 @@ EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "tsrkit-brightest-b
 def installed(tmp_path_factory):
     """pip-install the example into its own folder; return an environment that sees it."""
     target = tmp_path_factory.mktemp("site")
-    subprocess.run([sys.executable, "-m", "pip", "install", "--quiet", "--no-deps",
-                    "--no-build-isolation", "--no-index", "--target", str(target),
-                    str(EXAMPLE)], check=True, capture_output=True)
+    subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "pip",
+            "install",
+            "--quiet",
+            "--no-deps",
+            "--no-build-isolation",
+            "--no-index",
+            "--target",
+            str(target),
+            str(EXAMPLE),
+        ],
+        check=True,
+        capture_output=True,
+    )
     env = dict(os.environ, PYTHONPATH=str(target))
     env.pop("TSRKIT_LOAD_PLUGINS", None)
     return env
 
 
 def tsrkit(env, *args):
-    return subprocess.run([sys.executable, "-m", "tsrkit", *args], env=env, capture_output=True,
-                          text=True)
+    return subprocess.run(
+        [sys.executable, "-m", "tsrkit", *args], env=env, capture_output=True, text=True
+    )
 
 
 def test_installed_plugin_is_listed(installed):
     done = tsrkit(installed, "plugins", "--json")
     assert done.returncode == 0, done.stderr
     found = {p["name"]: p for p in json.loads(done.stdout)}
-    for name, kind in (("brightest-blobs", "detector"), ("centre-error", "metric"),
-                       ("missed-boxes", "writer")):
-        assert found[name] == {**found[name], "kind": kind, "package": "tsrkit-brightest-blobs",
-                               "version": "0.1.0"}
+    for name, kind in (
+        ("brightest-blobs", "detector"),
+        ("centre-error", "metric"),
+        ("missed-boxes", "writer"),
+    ):
+        assert found[name] == {
+            **found[name],
+            "kind": kind,
+            "package": "tsrkit-brightest-blobs",
+            "version": "0.1.0",
+        }
 
 
 def test_installed_plugin_detects(installed, tmp_path):
     image = np.full((50, 80, 3), 20, np.uint8)
     cv2.circle(image, (60, 12), 4, (255, 255, 255), -1)
     cv2.imwrite(str(tmp_path / "lamp.png"), image)
-    done = tsrkit(installed, "detect", str(tmp_path / "lamp.png"), "--detector",
-                  "brightest-blobs", "--param", "top=1")
+    done = tsrkit(
+        installed,
+        "detect",
+        str(tmp_path / "lamp.png"),
+        "--detector",
+        "brightest-blobs",
+        "--param",
+        "top=1",
+    )
     assert done.returncode == 0, done.stderr
     (det,) = json.loads(done.stdout)["detections"]
     assert abs(det["x"] - 60) < 1 and abs(det["y"] - 12) < 1
@@ -72,18 +102,36 @@ def coco_ap50(folder: Path) -> float:
 
 
 @pytest.mark.parametrize("dataset", ["roboflow_traffic_light_kr", "sample", "coco-file"])
-def test_installed_plugin_benchmarks_real_coco_and_sample(installed, tmp_path, dataset,
-                                                          shared_datasets):
+def test_installed_plugin_benchmarks_real_coco_and_sample(
+    installed, tmp_path, dataset, shared_datasets
+):
     if dataset == "coco-file":  # a COCO path: the bundled sample's coco.json
         from tsrkit.synth import sample_path
 
         dataset = str(sample_path().parent / "coco.json")
     out = tmp_path / "bench"
-    done = tsrkit(installed, "benchmark", "--dataset", dataset, "--detector", "brightest-blobs",
-                  "--workers", "1", "--quiet", "--out", str(out))
+    done = tsrkit(
+        installed,
+        "benchmark",
+        "--dataset",
+        dataset,
+        "--detector",
+        "brightest-blobs",
+        "--workers",
+        "1",
+        "--quiet",
+        "--out",
+        str(out),
+    )
     assert done.returncode == 0, done.stderr
-    for name in ("report.json", "summary.md", "detections.jsonl", "detections.coco.json",
-                 "ground_truth.coco.json", "plots/recall_fpr_bubbles.png"):
+    for name in (
+        "report.json",
+        "summary.md",
+        "detections.jsonl",
+        "detections.coco.json",
+        "ground_truth.coco.json",
+        "plots/recall_fpr_bubbles.png",
+    ):
         assert (out / name).is_file(), name
     report = json.loads((out / "report.json").read_text())
     assert report["detector"]["name"] == "brightest-blobs"

@@ -1,4 +1,5 @@
 """Readers for formats absent from shared/datasets, on small hand-written files."""
+
 from __future__ import annotations
 
 import json
@@ -25,7 +26,10 @@ def test_bosch_yaml_maps_labels_and_repairs_boxes(tmp_path):
     assert ds.format == "bosch" and len(ds) == 2
     anns = ds.samples[0].annotations
     assert [(a.attributes["label"], a.state) for a in anns] == [
-        ("RedLeft", "red"), ("Green", "green"), ("off", "off")]
+        ("RedLeft", "red"),
+        ("Green", "green"),
+        ("off", "off"),
+    ]
     assert anns[1].bbox == (100, 50, 110, 60)
     assert anns[2].bbox == (1270, 0, 1280, 30)
     assert ds.info["repaired"] == 2 and ds.info["dropped"] == 0
@@ -33,9 +37,15 @@ def test_bosch_yaml_maps_labels_and_repairs_boxes(tmp_path):
 
 
 def test_bosch_json_reads_like_yaml_and_drops_empty_boxes(tmp_path):
-    entries = [{"path": "x.png", "boxes": [
-        {"label": "Yellow", "x_min": 1, "y_min": 2, "x_max": 5, "y_max": 9},
-        {"label": "Red", "x_min": 1300, "y_min": 2, "x_max": 1400, "y_max": 9}]}]
+    entries = [
+        {
+            "path": "x.png",
+            "boxes": [
+                {"label": "Yellow", "x_min": 1, "y_min": 2, "x_max": 5, "y_max": 9},
+                {"label": "Red", "x_min": 1300, "y_min": 2, "x_max": 1400, "y_max": 9},
+            ],
+        }
+    ]
     file = tmp_path / "test.json"
     file.write_text(json.dumps(entries))
     ds = open_dataset(file, format="bosch")
@@ -45,8 +55,9 @@ def test_bosch_json_reads_like_yaml_and_drops_empty_boxes(tmp_path):
 
 def test_bosch_unknown_label_names_entry(tmp_path):
     file = tmp_path / "bad.yaml"
-    file.write_text("- boxes:\n  - {label: Purple, x_max: 2, x_min: 1, y_max: 2, y_min: 1}\n"
-                    "  path: a.png\n")
+    file.write_text(
+        "- boxes:\n  - {label: Purple, x_max: 2, x_min: 1, y_max: 2, y_min: 1}\n  path: a.png\n"
+    )
     with pytest.raises(DatasetError, match=r"bad.yaml: entry 0 box 0: unknown label 'Purple'"):
         open_dataset(file, format="bosch")
 
@@ -67,7 +78,9 @@ def test_lisa_box_csv_groups_rows_by_frame(tmp_path):
     ds = open_dataset(folder)
     assert ds.format == "lisa" and ds.info["box"] == "housing" and len(ds) == 2
     assert [(a.attributes["label"], a.state) for a in ds.samples[0].annotations] == [
-        ("stop", "red"), ("goLeft", "green")]
+        ("stop", "red"),
+        ("goLeft", "green"),
+    ]
     assert ds.samples[1].annotations[0].state == "yellow"
     images = tmp_path / "frames"
     ds = open_dataset(folder / "frameAnnotationsBOX.csv", images=images)
@@ -89,10 +102,18 @@ def _dtld(labels):
 
 
 def test_dtld_states_and_attributes(tmp_path):
-    labels = [{"x": 10, "y": 20, "w": 5, "h": 12, "unique_id": 7, "track_id": "t1",
-               "attributes": {"state": "red_yellow", "pictogram": "circle",
-                              "direction": "front"}},
-              {"x": 40, "y": 20, "w": 5, "h": 12, "attributes": {"state": "off"}}]
+    labels = [
+        {
+            "x": 10,
+            "y": 20,
+            "w": 5,
+            "h": 12,
+            "unique_id": 7,
+            "track_id": "t1",
+            "attributes": {"state": "red_yellow", "pictogram": "circle", "direction": "front"},
+        },
+        {"x": 40, "y": 20, "w": 5, "h": 12, "attributes": {"state": "off"}},
+    ]
     file = tmp_path / "DTLD_test.json"
     file.write_text(json.dumps(_dtld(labels)))
     ds = open_dataset(file)
@@ -172,10 +193,15 @@ def test_voc_malformed_xml_names_line(tmp_path):
 
 def test_coco_unknown_category_names_entry(tmp_path):
     file = tmp_path / "c.json"
-    file.write_text(json.dumps({"images": [{"id": 1, "file_name": "a.jpg"}],
-                                "annotations": [{"image_id": 1, "category_id": 9,
-                                                 "bbox": [1, 2, 3, 4]}],
-                                "categories": [{"id": 1, "name": "red"}]}))
+    file.write_text(
+        json.dumps(
+            {
+                "images": [{"id": 1, "file_name": "a.jpg"}],
+                "annotations": [{"image_id": 1, "category_id": 9, "bbox": [1, 2, 3, 4]}],
+                "categories": [{"id": 1, "name": "red"}],
+            }
+        )
+    )
     with pytest.raises(DatasetError, match=r"c.json: annotations\[0\]: unknown category_id 9"):
         open_dataset(file)
 
@@ -193,6 +219,7 @@ def test_yolo_bad_label_line(tmp_path):
     (tmp_path / "valid/labels").mkdir()
     import cv2
     import numpy as np
+
     cv2.imwrite(str(tmp_path / "valid/images/a.png"), np.zeros((10, 20, 3), np.uint8))
     (tmp_path / "valid/labels/a.txt").write_text("0 0.5 0.5 0.2 0.2\n1 0.1 0.2 0.3\n")
     with pytest.raises(DatasetError, match=r"a.txt: line 2: expected 4 box values"):
@@ -206,8 +233,10 @@ def test_yolo_bad_label_line(tmp_path):
 
 def test_gtsrb_bad_class_id(tmp_path):
     file = tmp_path / "GT-00001.csv"
-    file.write_text("Filename;Width;Height;Roi.X1;Roi.Y1;Roi.X2;Roi.Y2;ClassId\n"
-                    "a.ppm;30;30;5;5;25;25;1\nb.ppm;30;30;5;5;25;25;x\n")
+    file.write_text(
+        "Filename;Width;Height;Roi.X1;Roi.Y1;Roi.X2;Roi.Y2;ClassId\n"
+        "a.ppm;30;30;5;5;25;25;1\nb.ppm;30;30;5;5;25;25;x\n"
+    )
     with pytest.raises(DatasetError, match=r"GT-00001.csv: line 3: class id must be"):
         open_dataset(file)
 
@@ -215,10 +244,13 @@ def test_gtsrb_bad_class_id(tmp_path):
 def test_crops_folder_labels(tmp_path):
     import cv2
     import numpy as np
+
     for split, label in (("train", "red"), ("test", "green")):
         (tmp_path / split / label).mkdir(parents=True)
         cv2.imwrite(str(tmp_path / split / label / "x.png"), np.zeros((7, 5, 3), np.uint8))
     ds = open_dataset(tmp_path)
     assert ds.format == "crops"
     assert sorted((s.split, s.annotations[0].state, s.annotations[0].bbox) for s in ds) == [
-        ("test", "green", (0, 0, 5, 7)), ("train", "red", (0, 0, 5, 7))]
+        ("test", "green", (0, 0, 5, 7)),
+        ("train", "red", (0, 0, 5, 7)),
+    ]

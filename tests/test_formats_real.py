@@ -1,4 +1,5 @@
 """Format readers on the real files of shared/datasets."""
+
 from __future__ import annotations
 
 from collections import Counter
@@ -18,8 +19,11 @@ def test_yolo_and_normalized_agree_box_for_box(shared_datasets, name):
     by_source = {s.source: s for s in normalized}
     for sample in yolo:
         expected = by_source[sample.source]
-        assert (sample.width, sample.height, sample.split) == \
-            (expected.width, expected.height, expected.split)
+        assert (sample.width, sample.height, sample.split) == (
+            expected.width,
+            expected.height,
+            expected.split,
+        )
         got = sorted((a.attributes["label"], a.bbox) for a in sample.annotations)
         want = sorted((a.attributes["label"], a.bbox) for a in expected.annotations)
         assert [g[0] for g in got] == [w[0] for w in want]
@@ -45,8 +49,7 @@ def test_mit_crops_one_whole_image_box(shared_datasets):
     ds = open_dataset("udacity_mit_tl_crops")
     assert len(ds) == 1484
     assert Counter(s.split for s in ds) == {"train": 1187, "test": 297}
-    assert Counter(s.annotations[0].state for s in ds) == {"red": 904, "green": 536,
-                                                            "yellow": 44}
+    assert Counter(s.annotations[0].state for s in ds) == {"red": 904, "green": 536, "yellow": 44}
     sample = ds.samples[0]
     assert len(sample.annotations) == 1
     assert sample.annotations[0].bbox == (0, 0, sample.width, sample.height)
@@ -56,8 +59,7 @@ def test_mit_crops_one_whole_image_box(shared_datasets):
 def test_vgis_crops_carry_lighting(shared_datasets):
     ds = open_dataset("lisa_vgis_bulb_crops", format="crops")
     assert Counter(s.metadata["lighting"] for s in ds) == {"night": 433, "day": 165}
-    assert Counter(s.annotations[0].state for s in ds) == {"green": 402, "red": 133,
-                                                            "yellow": 63}
+    assert Counter(s.annotations[0].state for s in ds) == {"green": 402, "red": 133, "yellow": 63}
     assert all(s.annotations[0].bbox == (0, 0, 20, 20) for s in ds)
 
 

@@ -1,4 +1,5 @@
 """Writers: write a dataset, read it back, get the same images, boxes, labels and splits."""
+
 from __future__ import annotations
 
 import cv2
@@ -13,15 +14,21 @@ from tsrkit.types import Annotation, Dataset, Sample
 def small_dataset(tmp_path):
     images = tmp_path / "src" / "images"
     images.mkdir(parents=True)
-    specs = [("a.png", "train", [((1.5, 2.25, 10.0, 12.0), "red", "red"),
-                                 ((20.0, 5.0, 27.5, 19.0), "left", "green")]),
-             ("b.png", "test", [((0.0, 0.0, 39.0, 29.0), "yellow", "yellow")]),
-             ("c.png", "valid", [])]
+    specs = [
+        (
+            "a.png",
+            "train",
+            [((1.5, 2.25, 10.0, 12.0), "red", "red"), ((20.0, 5.0, 27.5, 19.0), "left", "green")],
+        ),
+        ("b.png", "test", [((0.0, 0.0, 39.0, 29.0), "yellow", "yellow")]),
+        ("c.png", "valid", []),
+    ]
     samples = []
     for name, split, boxes in specs:
         cv2.imwrite(str(images / name), np.full((30, 40, 3), 90, np.uint8))
-        anns = tuple(Annotation(b, state, {"label": label, "radius": 2.5})
-                     for b, label, state in boxes)
+        anns = tuple(
+            Annotation(b, state, {"label": label, "radius": 2.5}) for b, label, state in boxes
+        )
         samples.append(Sample(str(images / name), anns, 40, 30, split, {"lighting": "night"}))
     return Dataset("small", tuple(samples))
 
@@ -29,15 +36,24 @@ def small_dataset(tmp_path):
 def _content(dataset, with_state=True):
     out = {}
     for s in dataset:
-        out[s.source] = (s.split, sorted((a.attributes["label"],
-                                          a.state if with_state else None,
-                                          tuple(round(v, 3) for v in a.bbox))
-                                         for a in s.annotations))
+        out[s.source] = (
+            s.split,
+            sorted(
+                (
+                    a.attributes["label"],
+                    a.state if with_state else None,
+                    tuple(round(v, 3) for v in a.bbox),
+                )
+                for a in s.annotations
+            ),
+        )
     return out
 
 
-@pytest.mark.parametrize("fmt,target", [("normalized", "out/annotations.json"),
-                                        ("coco", "out/coco.json"), ("voc", "voc")])
+@pytest.mark.parametrize(
+    "fmt,target",
+    [("normalized", "out/annotations.json"), ("coco", "out/coco.json"), ("voc", "voc")],
+)
 def test_round_trip_keeps_boxes_labels_states_splits(small_dataset, tmp_path, fmt, target):
     out = tmp_path / target
     write_dataset(small_dataset, fmt, out)
@@ -61,9 +77,13 @@ def test_yolo_round_trip_keeps_labels_and_links_images(small_dataset, tmp_path):
     write_dataset(small_dataset, "yolo", out)
     back = open_dataset(out)
     assert back.format == "yolo" and len(back) == 3
-    expected = {k.replace("/src/images/", f"/yolo/{v[0]}/images/"): (v[0], [
-        (label, None, box) for label, _, box in v[1]])
-        for k, v in _content(small_dataset).items()}
+    expected = {
+        k.replace("/src/images/", f"/yolo/{v[0]}/images/"): (
+            v[0],
+            [(label, None, box) for label, _, box in v[1]],
+        )
+        for k, v in _content(small_dataset).items()
+    }
     got = _content(back, with_state=False)
     assert got.keys() == expected.keys()
     for key, (split, anns) in got.items():

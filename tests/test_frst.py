@@ -1,13 +1,20 @@
 """The fast radial symmetry transform against its loop oracle and on discs of known radius."""
+
 from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from oracles.frst_oracle import frst_oracle
-from tsrkit_plugins.detectors.frst.frst import (affected_pixels, frst, kappa,
-                                           orientation_projection, radial_strength,
-                                           select_voters, sobel_gradient)
+
+from tsrkit_plugins.detectors.frst.frst import (
+    affected_pixels,
+    frst,
+    kappa,
+    orientation_projection,
+    radial_strength,
+    select_voters,
+    sobel_gradient,
+)
 
 
 def disc(radius: float, size: int = 41, bright: bool = True) -> np.ndarray:
@@ -24,8 +31,9 @@ def disc(radius: float, size: int = 41, bright: bool = True) -> np.ndarray:
 def test_fast_matches_oracle_on_random_images(mode, orientation_only, beta):
     rng = np.random.default_rng([len(mode), int(orientation_only), int(beta * 100)])
     image = rng.random((29, 37)).astype(np.float32)
-    args = dict(radii=range(1, 11), alpha=3.0, beta=beta, mode=mode,
-                orientation_only=orientation_only)
+    args = dict(
+        radii=range(1, 11), alpha=3.0, beta=beta, mode=mode, orientation_only=orientation_only
+    )
     fast = frst(image, **args)
     slow = frst_oracle(image, **args)
     assert np.abs(slow).max() > 0.05
@@ -99,13 +107,16 @@ def test_flat_image_has_no_symmetry():
     assert not frst(np.full((20, 20), 0.3, np.float32)).any()
 
 
-@pytest.mark.parametrize("kwargs, match", [
-    (dict(image=np.zeros((5, 5, 3))), "2-D"),
-    (dict(radii=[0, 1]), "radii"),
-    (dict(alpha=0), "alpha"),
-    (dict(beta=1.0), "beta"),
-    (dict(mode="grey"), "mode"),
-])
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        (dict(image=np.zeros((5, 5, 3))), "2-D"),
+        (dict(radii=[0, 1]), "radii"),
+        (dict(alpha=0), "alpha"),
+        (dict(beta=1.0), "beta"),
+        (dict(mode="grey"), "mode"),
+    ],
+)
 def test_bad_arguments_name_the_problem(kwargs, match):
     args = dict(image=np.zeros((9, 9), np.float32)) | kwargs
     with pytest.raises(ValueError, match=match):

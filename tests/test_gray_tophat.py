@@ -1,4 +1,5 @@
 """GRAY-TOPHAT baseline (Zheng 2016 5.2.2): white top-hat on grayscale + Zheng's localization."""
+
 import json
 
 import cv2
@@ -12,8 +13,8 @@ from tsrkit_plugins.detectors.gray_tophat import white_tophat
 
 def spot_image():
     image = np.full((70, 90, 3), 60, np.uint8)
-    image[:, 60:] = 200                                   # a wide bright area: no top-hat
-    cv2.circle(image, (25, 30), 4, (255, 255, 255), -1)   # a small bright spot
+    image[:, 60:] = 200  # a wide bright area: no top-hat
+    cv2.circle(image, (25, 30), 4, (255, 255, 255), -1)  # a small bright spot
     return image
 
 

@@ -1,17 +1,23 @@
 """hsi-backprojection (Lee 5.3.3-5.3.4): back-projection, training, filter size, video, files."""
+
 from __future__ import annotations
 
 import cv2
 import numpy as np
 import pytest
-
 from oracles.lamps import COLOURS, crop_sample, housing, lamp, training_set
+
 from tsrkit.models import Model, ModelError, load_model, save_model
 from tsrkit.registry import get_registry
 from tsrkit.types import Candidate, Frame
-from tsrkit_plugins.classifiers.hsi_backprojection import (back_project, expected_diameter,
-                                                           low_pass, scaled_histogram,
-                                                           smooth_hue, unclipped)
+from tsrkit_plugins.classifiers.hsi_backprojection import (
+    back_project,
+    expected_diameter,
+    low_pass,
+    scaled_histogram,
+    smooth_hue,
+    unclipped,
+)
 
 
 def make(**params):
@@ -22,8 +28,14 @@ def make(**params):
 def model_path(tmp_path_factory):
     classifier = make()
     path = tmp_path_factory.mktemp("hsi") / "model"
-    save_model(path, classifier.fit(training_set()), plugin="hsi-backprojection",
-               plugin_version="t", params=classifier.params, training={})
+    save_model(
+        path,
+        classifier.fit(training_set()),
+        plugin="hsi-backprojection",
+        plugin_version="t",
+        params=classifier.params,
+        training={},
+    )
     return path
 
 
@@ -45,8 +57,10 @@ def test_hue_smoothing_wraps_around_red():
 
 def test_back_projection_matches_a_pixel_loop():
     rng = np.random.default_rng(2)
-    hsv = np.stack([rng.integers(0, 180, (6, 7)), rng.integers(0, 256, (6, 7)),
-                    rng.integers(0, 256, (6, 7))], axis=-1).astype(np.uint8)
+    hsv = np.stack(
+        [rng.integers(0, 180, (6, 7)), rng.integers(0, 256, (6, 7)), rng.integers(0, 256, (6, 7))],
+        axis=-1,
+    ).astype(np.uint8)
     hue, sat, val = rng.random((3, 180)), rng.random(256), rng.random(256)
     got = back_project(hsv, hue, sat, val)
     for state in range(3):
@@ -81,8 +95,10 @@ def test_warm_red_prior_reads_orange_red_as_red(model_path):
     orange_red = lamp((10, 120, 240), size=40, radius=8, seed=4)  # OpenCV hue 14
     cand = Candidate.from_circle(20, 20, 8, 1.0)
     assert classify_one(make(model=str(model_path)), orange_red, cand).state == "red"
-    assert classify_one(make(model=str(model_path), red_prior=False), orange_red,
-                        cand).state == "yellow"
+    assert (
+        classify_one(make(model=str(model_path), red_prior=False), orange_red, cand).state
+        == "yellow"
+    )
 
 
 @pytest.mark.parametrize("lit,state", [(0, "red"), (1, "yellow"), (2, "green")])
@@ -97,25 +113,29 @@ def test_metadata_sets_the_filter_size(model_path):
     image = lamp(COLOURS["green"], size=40, radius=3)
     cand = Candidate.from_box((0, 0, 40, 40), 1.0)
     wide = classify_one(classifier, image, cand).state_scores["green"]
-    sized = classify_one(classifier, image, cand,
-                         metadata={"focal_px": 1000.0, "distance_m": 50.0}).state_scores["green"]
+    sized = classify_one(
+        classifier, image, cand, metadata={"focal_px": 1000.0, "distance_m": 50.0}
+    ).state_scores["green"]
     assert sized > 2 * wide
 
 
 def test_threshold_gives_unknown(model_path):
     dark = lamp((30, 30, 30), size=24, radius=8)
-    det = classify_one(make(model=str(model_path), threshold=0.05), dark,
-                       Candidate.from_box((4, 4, 20, 20), 1.0))
+    det = classify_one(
+        make(model=str(model_path), threshold=0.05), dark, Candidate.from_box((4, 4, 20, 20), 1.0)
+    )
     assert det.state == "unknown"
 
 
 def test_fusion_gives_every_light_the_approach_state(model_path):
-    image = np.hstack([lamp(COLOURS["green"], size=24, radius=8),
-                       lamp((30, 30, 30), size=24, radius=8)])
+    image = np.hstack(
+        [lamp(COLOURS["green"], size=24, radius=8), lamp((30, 30, 30), size=24, radius=8)]
+    )
     cands = [Candidate.from_circle(12, 12, 8, 1.0), Candidate.from_circle(36, 12, 8, 1.0)]
     plain = make(model=str(model_path), threshold=0.05).classify(Frame(image, "t"), cands)
-    fused = make(model=str(model_path), threshold=0.05, fuse=True).classify(Frame(image, "t"),
-                                                                           cands)
+    fused = make(model=str(model_path), threshold=0.05, fuse=True).classify(
+        Frame(image, "t"), cands
+    )
     assert [d.state for d in plain] == ["green", "unknown"]
     assert [d.state for d in fused] == ["green", "green"]
 
@@ -144,17 +164,21 @@ def test_training_takes_equal_pixels_per_sample_and_is_deterministic():
 def test_model_round_trip_and_wrong_models(tmp_path, model_path):
     model = load_model(model_path, plugin="hsi-backprojection")
     assert model.arrays["hue"].shape == (3, 180)
-    save_model(tmp_path / "ab", model, plugin="ab-hist", plugin_version="t", params={},
-               training={})
+    save_model(tmp_path / "ab", model, plugin="ab-hist", plugin_version="t", params={}, training={})
     cand = Candidate.from_circle(12, 12, 8, 1.0)
     with pytest.raises(ModelError, match="ab-hist"):
         classify_one(make(model=str(tmp_path / "ab")), lamp(COLOURS["red"]), cand)
     bad = {"hue": np.ones((3, 10), np.float32)}
-    save_model(tmp_path / "short", type(model)(arrays=bad), plugin="hsi-backprojection",
-               plugin_version="t", params={}, training={})
+    save_model(
+        tmp_path / "short",
+        type(model)(arrays=bad),
+        plugin="hsi-backprojection",
+        plugin_version="t",
+        params={},
+        training={},
+    )
     with pytest.raises(ModelError, match="expected hue"):
         classify_one(make(model=str(tmp_path / "short")), lamp(COLOURS["red"]), cand)
-
 
 
 def test_unclipped_keeps_order_and_falls_back_when_all_are_clipped():
@@ -185,8 +209,14 @@ def hand_model(tmp_path):
     hue[0, :11] = hue[0, 170:] = hue[1, 18:33] = hue[2, 60:91] = 1
     rising = np.arange(256, dtype=np.float32) / 255
     model = Model(arrays={"hue": hue, "saturation": rising, "intensity": rising})
-    return save_model(tmp_path / "hand", model, plugin="hsi-backprojection", plugin_version="t",
-                      params={}, training={})
+    return save_model(
+        tmp_path / "hand",
+        model,
+        plugin="hsi-backprojection",
+        plugin_version="t",
+        params={},
+        training={},
+    )
 
 
 def test_clipped_core_is_left_out_so_an_overexposed_red_stays_red(hand_model):
@@ -200,16 +230,20 @@ def test_clipped_core_is_left_out_so_an_overexposed_red_stays_red(hand_model):
 def test_a_fully_clipped_lamp_falls_back_to_its_clipped_pixels(hand_model):
     image = np.full((40, 40, 3), 35, np.uint8)
     cv2.circle(image, (20, 20), 10, CLIPPED_CORE, -1)
-    det = classify_one(make(model=str(hand_model), red_prior=False, clip=250), image,
-                       Candidate.from_circle(20, 20, 10, 1.0))
+    det = classify_one(
+        make(model=str(hand_model), red_prior=False, clip=250),
+        image,
+        Candidate.from_circle(20, 20, 10, 1.0),
+    )
     assert det.state == "yellow" and det.state_scores["yellow"] > 0.5
     assert det.state_scores["red"] == det.state_scores["green"] == 0.0
 
 
 def test_training_leaves_clipped_pixels_out():
     samples = [crop_sample(overexposed_red(size=20), "red")] + [
-        crop_sample(lamp(COLOURS[state], size=20, radius=10), state) for state in
-        ("yellow", "green")]
+        crop_sample(lamp(COLOURS[state], size=20, radius=10), state)
+        for state in ("yellow", "green")
+    ]
     kept = make(clip=250, hue_smooth=0).fit(samples).arrays["hue"][0]
     every = make(clip=256, hue_smooth=0).fit(samples).arrays["hue"][0]
     assert every.argmax() == 23  # Lee as printed: the clipped core's hue dominates red

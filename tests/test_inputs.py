@@ -1,4 +1,5 @@
 """Input decoding: every image format to BGR uint8, bad files skipped with a reason, videos."""
+
 import cv2
 import numpy as np
 import pytest
@@ -63,8 +64,13 @@ def test_bad_files_raise_with_the_reason(tmp_path):
     png = cv2.imencode(".png", scene(64, 64))[1].tobytes()
     (tmp_path / "cut.png").write_bytes(png[: len(png) // 2])
     (tmp_path / "fake.png").write_text("not an image at all")
-    cases = {"empty.png": "empty file", "cut.jpg": "truncated JPEG", "cut.png": "truncated PNG",
-             "fake.png": "not a decodable image", "missing.png": "no such file"}
+    cases = {
+        "empty.png": "empty file",
+        "cut.jpg": "truncated JPEG",
+        "cut.png": "truncated PNG",
+        "fake.png": "not a decodable image",
+        "missing.png": "no such file",
+    }
     for name, reason in cases.items():
         with pytest.raises(ImageReadError, match=reason):
             read_image(tmp_path / name)

@@ -1,4 +1,5 @@
 """The LAB-FRST detector on synthetic frames with lit discs, and its feature map."""
+
 from __future__ import annotations
 
 import cv2
@@ -40,8 +41,9 @@ def test_red_and_green_discs_get_their_own_state():
     found = tsrkit.detector("lab-frst").detect(frame)
     assert nearest(found, 40.5, 40.5).state == "red"
     assert nearest(found, 110.5, 40.5).state == "green"
-    assert np.hypot(nearest(found, 110.5, 40.5).x - 110.5,
-                    nearest(found, 110.5, 40.5).y - 40.5) <= 1.5
+    assert (
+        np.hypot(nearest(found, 110.5, 40.5).x - 110.5, nearest(found, 110.5, 40.5).y - 40.5) <= 1.5
+    )
     assert [c.score for c in found] == sorted((c.score for c in found), reverse=True)
 
 
@@ -69,8 +71,10 @@ def test_spot_candidates_rank_by_peak_and_binarise_at_the_fraction():
     symmetry[5, 5], symmetry[20, 8:11] = 1.0, 0.6
     symmetry[25, 25] = 0.4
     spots = spot_candidates(symmetry, 0.5, 5, "red")
-    assert [(c.x, c.y, c.score) for c in spots] == [(5.5, 5.5, 1.0),
-                                                    (9.5, 20.5, pytest.approx(0.6))]
+    assert [(c.x, c.y, c.score) for c in spots] == [
+        (5.5, 5.5, 1.0),
+        (9.5, 20.5, pytest.approx(0.6)),
+    ]
     assert spots[1].radius == 1.5
 
 

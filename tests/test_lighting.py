@@ -1,4 +1,5 @@
 """Tests for the light condition of Mascetti 3.2 (Table 4 thresholds on the mean V value)."""
+
 from __future__ import annotations
 
 import cv2
@@ -16,16 +17,26 @@ def test_mean_v_matches_opencv_hsv():
     assert mean_v(image) == pytest.approx(expected)
 
 
-@pytest.mark.parametrize("m, expected", [
-    (0.0, "low"), (5.0, "low"), (5.01, "mid"), (60.0, "mid"), (60.5, "high"),
-    (120.0, "high"), (120.01, "very_high"), (255.0, "very_high"),
-])
+@pytest.mark.parametrize(
+    "m, expected",
+    [
+        (0.0, "low"),
+        (5.0, "low"),
+        (5.01, "mid"),
+        (60.0, "mid"),
+        (60.5, "high"),
+        (120.0, "high"),
+        (120.01, "very_high"),
+        (255.0, "very_high"),
+    ],
+)
 def test_table4_boundaries(m, expected):
     assert condition_of_m(m) == expected
 
 
-@pytest.mark.parametrize("value, expected", [(0, "low"), (40, "mid"), (100, "high"),
-                                             (200, "very_high")])
+@pytest.mark.parametrize(
+    "value, expected", [(0, "low"), (40, "mid"), (100, "high"), (200, "very_high")]
+)
 def test_light_condition_of_uniform_frames(value, expected):
     image = np.zeros((8, 8, 3), np.uint8)
     image[..., 1] = value  # V is the max channel, so a pure-green frame has V = value
@@ -33,8 +44,10 @@ def test_light_condition_of_uniform_frames(value, expected):
     assert expected in LIGHT_CONDITIONS
 
 
-@pytest.mark.parametrize("bad", [np.zeros((4, 4), np.uint8), np.zeros((4, 4, 3), np.float32),
-                                 np.zeros((0, 4, 3), np.uint8)])
+@pytest.mark.parametrize(
+    "bad",
+    [np.zeros((4, 4), np.uint8), np.zeros((4, 4, 3), np.float32), np.zeros((0, 4, 3), np.uint8)],
+)
 def test_bad_input_is_a_value_error(bad):
     with pytest.raises(ValueError):
         mean_v(bad)

@@ -1,32 +1,44 @@
 """Zheng's localization (3.2.2, Figure 3-10, Eq. 3.13-3.15, Algorithm 3-1)."""
+
 import numpy as np
 import pytest
-
-from tsrkit_plugins.detectors import localization as loc
 from oracles.conspicuity_oracle import drmshift_reference
 
-PARAMS = {"h_peak": 0.9, "n_top": 10, "n_pi": 20, "asp_min": 0.6, "pd_min": 0.0,
-          "shift_tol": 0.5, "shift_iter": 10, "max_iter": 50}
+from tsrkit_plugins.detectors import localization as loc
+
+PARAMS = {
+    "h_peak": 0.9,
+    "n_top": 10,
+    "n_pi": 20,
+    "asp_min": 0.6,
+    "pd_min": 0.0,
+    "shift_tol": 0.5,
+    "shift_iter": 10,
+    "max_iter": 50,
+}
 
 
 def blob(shape, centre, sigma, height=1.0):
-    yy, xx = np.mgrid[:shape[0], :shape[1]]
-    return height * np.exp(-((yy - centre[0]) ** 2 + (xx - centre[1]) ** 2) / (2 * sigma ** 2))
+    yy, xx = np.mgrid[: shape[0], : shape[1]]
+    return height * np.exp(-((yy - centre[0]) ** 2 + (xx - centre[1]) ** 2) / (2 * sigma**2))
 
 
 def test_drmshift_converges_to_the_mass_centre_of_a_blob():
     cm = blob((60, 70), (30.0, 41.0), 3.0).astype(np.float32)
     rm = np.full(cm.shape, 6, np.int32)
-    centres, radius = loc.drmshift(cm, np.array([[26.0, 45.0], [33.0, 38.0]]), rm,
-                                   tol=0.01, n_max=50)
+    centres, radius = loc.drmshift(
+        cm, np.array([[26.0, 45.0], [33.0, 38.0]]), rm, tol=0.01, n_max=50
+    )
     np.testing.assert_allclose(centres, [[30.0, 41.0], [30.0, 41.0]], atol=0.05)
     assert list(radius) == [6, 6]
 
 
 def test_drmshift_follows_the_radius_map_like_the_reference():
     rng = np.random.default_rng(0)
-    cm = sum(blob((50, 60), c, s, h) for c, s, h in
-             [((12, 15), 3, 1.0), ((30, 40), 5, 0.7), ((40, 10), 2, 0.5)])
+    cm = sum(
+        blob((50, 60), c, s, h)
+        for c, s, h in [((12, 15), 3, 1.0), ((30, 40), 5, 0.7), ((40, 10), 2, 0.5)]
+    )
     cm = (cm + 0.05 * rng.random(cm.shape)).astype(np.float32)
     rm = rng.integers(1, 8, cm.shape).astype(np.int32)
     starts = rng.uniform(0, 49, (12, 2))
@@ -44,8 +56,8 @@ def test_drmshift_needs_radii():
 
 def test_peak_mask_after_normalisation_and_opening():
     wcm = np.zeros((20, 20), np.float32)
-    wcm[3, 3] = 4.0                  # a lone peak pixel: noise for the opening
-    wcm[10:14, 10:14] = 3.8          # a 4x4 peak region survives
+    wcm[3, 3] = 4.0  # a lone peak pixel: noise for the opening
+    wcm[10:14, 10:14] = 3.8  # a 4x4 peak region survives
     norm = loc.normalise(wcm)
     assert norm.max() == 1.0
     mask = loc.peak_mask(norm, 0.9)
@@ -57,9 +69,9 @@ def test_peak_mask_after_normalisation_and_opening():
 
 def test_components_and_shape_filter():
     mask = np.zeros((30, 30), np.uint8)
-    mask[2:6, 2:6] = 1            # square: kept
-    mask[10:12, 5:20] = 1         # elongated: aspect 2/15 < 0.6
-    mask[20, 20] = mask[21, 21] = 1   # diagonal pair: one 8-connected component, density 0.5
+    mask[2:6, 2:6] = 1  # square: kept
+    mask[10:12, 5:20] = 1  # elongated: aspect 2/15 < 0.6
+    mask[20, 20] = mask[21, 21] = 1  # diagonal pair: one 8-connected component, density 0.5
     found = loc.components(mask)
     assert len(found.areas) == 3
     keep = loc.shape_filter(found, 0.6, 0.0)
@@ -74,9 +86,10 @@ def test_non_overlapping_keeps_the_larger_and_respects_earlier():
     centres = np.array([[10.0, 10.0], [10.0, 14.0], [40.0, 40.0], [70.0, 70.0]])
     radius = np.array([2, 3, 2, 2])
     kept = loc.non_overlapping(centres, radius, np.array([[70.0, 73.0]]), np.array([1]))
-    assert list(kept) == [1, 2]   # 0 touches the larger 1; 3 touches an earlier candidate
-    touching = loc.non_overlapping(np.array([[0.0, 0.0], [0.0, 5.0]]), np.array([2, 3]),
-                                   np.zeros((0, 2)), np.zeros(0, int))
+    assert list(kept) == [1, 2]  # 0 touches the larger 1; 3 touches an earlier candidate
+    touching = loc.non_overlapping(
+        np.array([[0.0, 0.0], [0.0, 5.0]]), np.array([2, 3]), np.zeros((0, 2)), np.zeros(0, int)
+    )
     assert list(touching) == [1]
 
 
@@ -89,16 +102,20 @@ def test_stop_checks():
 
 def test_localize_finds_peaks_in_descending_order_with_their_radius():
     shape = (80, 100)
-    cm = blob(shape, (20, 20), 2.5, 1.0) + blob(shape, (50, 70), 2.5, 0.6) \
+    cm = (
+        blob(shape, (20, 20), 2.5, 1.0)
+        + blob(shape, (50, 70), 2.5, 0.6)
         + blob(shape, (60, 20), 2.5, 0.3)
+    )
     rm = np.full(shape, 3, np.int32)
     rm[40:60, 60:80] = 5
     found = loc.localize(cm.astype(np.float32), PARAMS, radius_map=rm)
     got = [(round(c.y - 0.5), round(c.x - 0.5), c.radius) for c in found]
     assert got[:3] == [(20, 20, 3), (50, 70, 5), (60, 20, 3)]
     assert found[0].score == pytest.approx(1.0, abs=1e-3)
-    assert found[0].bbox == pytest.approx((found[0].x - 3, found[0].y - 3,
-                                           found[0].x + 3, found[0].y + 3))
+    assert found[0].bbox == pytest.approx(
+        (found[0].x - 3, found[0].y - 3, found[0].x + 3, found[0].y + 3)
+    )
 
 
 def test_localize_without_radius_map_uses_component_size():
@@ -115,7 +132,7 @@ def test_localize_stops_when_too_many_equal_peaks():
     cm = np.zeros((100, 100), np.float32)
     for i in range(5):
         for j in range(6):
-            cm[5 + 18 * i:9 + 18 * i, 5 + 15 * j:9 + 15 * j] = 1.0
+            cm[5 + 18 * i : 9 + 18 * i, 5 + 15 * j : 9 + 15 * j] = 1.0
     assert loc.localize(cm, PARAMS) == []
     assert len(loc.localize(cm, dict(PARAMS, n_pi=40, n_top=7))) == 7
 

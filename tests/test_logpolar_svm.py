@@ -1,4 +1,5 @@
 """logpolar-svm: the log-polar rotation property, training, our SVM decision, model I/O."""
+
 from __future__ import annotations
 
 import cv2
@@ -22,8 +23,9 @@ def draw(shape, rng, size=40):
     if shape == "disc":
         cv2.circle(image, (int(c[0]), int(c[1])), int(r), white, -1)
     elif shape == "square":
-        cv2.rectangle(image, (int(c[0] - r), int(c[1] - r)), (int(c[0] + r), int(c[1] + r)),
-                      white, -1)
+        cv2.rectangle(
+            image, (int(c[0] - r), int(c[1] - r)), (int(c[0] + r), int(c[1] + r)), white, -1
+        )
     elif shape == "triangle":
         pts = np.array([[c[0], c[1] - r], [c[0] - r, c[1] + r], [c[0] + r, c[1] + r]], np.int32)
         cv2.fillPoly(image, [pts], white)
@@ -35,8 +37,11 @@ def draw(shape, rng, size=40):
 
 def crops(seed, per_class=12, shapes=SHAPES):
     rng = np.random.default_rng(seed)
-    return [Sample(f"{shape}-{i}", (Annotation((0, 0, 40, 40), shape),), image=draw(shape, rng))
-            for shape in shapes for i in range(per_class)]
+    return [
+        Sample(f"{shape}-{i}", (Annotation((0, 0, 40, 40), shape),), image=draw(shape, rng))
+        for shape in shapes
+        for i in range(per_class)
+    ]
 
 
 def make(**params):
@@ -84,33 +89,42 @@ def test_training_is_deterministic(fitted):
 def test_classifies_held_out_shapes(fitted):
     clf, _ = fitted
     test = crops(2, per_class=5)
-    right = sum(clf.classify(s.load(), [Candidate.from_box(s.annotations[0].bbox, 1)])[0].state
-                == s.annotations[0].state for s in test)
+    right = sum(
+        clf.classify(s.load(), [Candidate.from_box(s.annotations[0].bbox, 1)])[0].state
+        == s.annotations[0].state
+        for s in test
+    )
     assert right / len(test) >= 0.9
 
 
-@pytest.mark.parametrize("shapes,kernel", [(SHAPES, "rbf"), (SHAPES, "poly"),
-                                           (SHAPES[:2], "linear"), (SHAPES[:2], "sigmoid")])
+@pytest.mark.parametrize(
+    "shapes,kernel",
+    [(SHAPES, "rbf"), (SHAPES, "poly"), (SHAPES[:2], "linear"), (SHAPES[:2], "sigmoid")],
+)
 def test_votes_match_scikit_learn(shapes, kernel):
     clf = make(kernel=kernel, C=1.0)
     samples = crops(3, shapes=shapes)
     clf.use_model(clf.fit(samples))
     info = clf.model().info
     x = clf._vectors(((s.image, s.annotations[0].bbox) for s in samples), info)
-    test_x = clf._vectors(((s.image, s.annotations[0].bbox) for s in crops(4, shapes=shapes)),
-                          info)
+    test_x = clf._vectors(((s.image, s.annotations[0].bbox) for s in crops(4, shapes=shapes)), info)
     projected = clf.project(x)
     svm = lp.SVC(kernel=kernel, C=1.0, gamma=info["gamma"], degree=3, coef0=0.0)
-    svm.fit(projected, np.searchsorted(info["classes"], [s.annotations[0].state
-                                                         for s in samples]))
+    svm.fit(projected, np.searchsorted(info["classes"], [s.annotations[0].state for s in samples]))
     ours = np.argmax(clf.votes(np.vstack([x, test_x])), axis=1)
     np.testing.assert_array_equal(ours, svm.predict(clf.project(np.vstack([x, test_x]))))
 
 
 def test_model_round_trip(tmp_path, fitted):
     clf, model = fitted
-    path = save_model(tmp_path / "lp", model, plugin="logpolar-svm", plugin_version="0",
-                      params=clf.params, training={})
+    path = save_model(
+        tmp_path / "lp",
+        model,
+        plugin="logpolar-svm",
+        plugin_version="0",
+        params=clf.params,
+        training={},
+    )
     loaded = make(model=str(path))
     frame = Frame(np.hstack([s.image for s in crops(5, per_class=1)]), "row")
     boxes = [Candidate.from_box((40 * i, 0, 40 * i + 40, 40), 1) for i in range(len(SHAPES))]
@@ -120,8 +134,9 @@ def test_model_round_trip(tmp_path, fitted):
 
 def test_errors():
     with pytest.raises(TsrkitError, match="needs a model"):
-        make().classify(Frame(np.zeros((4, 4, 3), np.uint8), "x"),
-                        [Candidate.from_box((0, 0, 4, 4), 1)])
+        make().classify(
+            Frame(np.zeros((4, 4, 3), np.uint8), "x"), [Candidate.from_box((0, 0, 4, 4), 1)]
+        )
     with pytest.raises(ValueError, match="two classes"):
         make().fit(crops(0, shapes=SHAPES[:1]))
     with pytest.raises(ValueError, match="outside"):

@@ -1,4 +1,5 @@
 """meanshift tracker: equation pieces, following a synthetic lamp, scale change, pipeline use."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -14,7 +15,7 @@ def lamp_frame(cx, cy, radius, index=0, seed=0, size=(120, 160)):
     """Grey noisy background and a lamp: saturated orange rim, paler yellow centre."""
     rng = np.random.default_rng(seed + index)
     image = rng.integers(90, 140, (*size, 1)).repeat(3, axis=2).astype(np.uint8)
-    ys, xs = np.mgrid[:size[0], :size[1]]
+    ys, xs = np.mgrid[: size[0], : size[1]]
     r = np.hypot(xs - cx, ys - cy) / radius
     inner, outer = r <= 0.5, (r > 0.5) & (r <= 1.0)
     image[inner] = (90, 220, 255)
@@ -38,10 +39,10 @@ def test_histogram_similarity_and_weights():
     assert ms.bhattacharyya(target, target) == pytest.approx(1.0)
     assert ms.bhattacharyya(target, np.array([0, 0, 1.0, 0])) == 0.0
     candidate = np.array([0.25, 0.25, 0.5, 0])
-    np.testing.assert_allclose(ms.pixel_weights(target, candidate, np.array([0, 2, 3])),
-                               [np.sqrt(2), 0, 0])
-    np.testing.assert_allclose(ms.epanechnikov_profile(np.array([0, 0.25, 1, 2])),
-                               [1, 0.75, 0, 0])
+    np.testing.assert_allclose(
+        ms.pixel_weights(target, candidate, np.array([0, 2, 3])), [np.sqrt(2), 0, 0]
+    )
+    np.testing.assert_allclose(ms.epanechnikov_profile(np.array([0, 0.25, 1, 2])), [1, 0.75, 0, 0])
 
 
 def test_mean_shift_step_is_weighted_mean():

@@ -1,4 +1,5 @@
 """Model files: .npz + JSON round trip, and clear refusals for corrupt or foreign models."""
+
 import json
 
 import numpy as np
@@ -8,10 +9,18 @@ from tsrkit.models import Model, ModelError, load_model, save_model
 
 
 def saved(tmp_path):
-    model = Model({"hist": np.arange(12, dtype=np.float32).reshape(3, 4),
-                   "bins": np.array([8, 8])}, info={"states": ["red", "green"]})
-    path = save_model(tmp_path / "m", model, plugin="ab-hist", plugin_version="1.0",
-                      params={"bins": (8, 8)}, training={"checksum": "abc", "samples": 3})
+    model = Model(
+        {"hist": np.arange(12, dtype=np.float32).reshape(3, 4), "bins": np.array([8, 8])},
+        info={"states": ["red", "green"]},
+    )
+    path = save_model(
+        tmp_path / "m",
+        model,
+        plugin="ab-hist",
+        plugin_version="1.0",
+        params={"bins": (8, 8)},
+        training={"checksum": "abc", "samples": 3},
+    )
     return model, path
 
 
@@ -50,5 +59,11 @@ def test_missing_files_and_object_arrays(tmp_path):
     with pytest.raises(ModelError, match="no such file"):
         load_model(tmp_path / "nothing", plugin="x")
     with pytest.raises(ModelError, match="not numeric"):
-        save_model(tmp_path / "o", Model({"o": np.array([object()])}), plugin="x",
-                   plugin_version="1", params={}, training={})
+        save_model(
+            tmp_path / "o",
+            Model({"o": np.array([object()])}),
+            plugin="x",
+            plugin_version="1",
+            params={},
+            training={},
+        )

@@ -1,4 +1,5 @@
 """Parameter schemas: coercion from strings and objects, ranges, choices, and clear errors."""
+
 import pytest
 
 from tsrkit.params import Param, ParamError, load_config, parse_assignments, validate
@@ -16,34 +17,50 @@ SCHEMA = (
 
 def test_defaults_fill_every_key():
     values = validate(SCHEMA, {}, "detector 'x'")
-    assert values == {"h_peak": 0.9, "n_top": 10, "radii": tuple(range(1, 11)),
-                      "weights": (1.0, 1.0, 1.0), "mode": "max", "roi": False, "model": None}
+    assert values == {
+        "h_peak": 0.9,
+        "n_top": 10,
+        "radii": tuple(range(1, 11)),
+        "weights": (1.0, 1.0, 1.0),
+        "mode": "max",
+        "roi": False,
+        "model": None,
+    }
 
 
-@pytest.mark.parametrize("given, key, expected", [
-    ({"h_peak": "0.5"}, "h_peak", 0.5),
-    ({"n_top": "3"}, "n_top", 3),
-    ({"radii": "2..4"}, "radii", (2, 3, 4)),
-    ({"radii": "1,3,5"}, "radii", (1, 3, 5)),
-    ({"weights": "1,1,2"}, "weights", (1.0, 1.0, 2.0)),
-    ({"weights": (1, 1, 2)}, "weights", (1.0, 1.0, 2.0)),
-    ({"roi": "yes"}, "roi", True),
-    ({"mode": "saturation"}, "mode", "saturation"),
-])
+@pytest.mark.parametrize(
+    "given, key, expected",
+    [
+        ({"h_peak": "0.5"}, "h_peak", 0.5),
+        ({"n_top": "3"}, "n_top", 3),
+        ({"radii": "2..4"}, "radii", (2, 3, 4)),
+        ({"radii": "1,3,5"}, "radii", (1, 3, 5)),
+        ({"weights": "1,1,2"}, "weights", (1.0, 1.0, 2.0)),
+        ({"weights": (1, 1, 2)}, "weights", (1.0, 1.0, 2.0)),
+        ({"roi": "yes"}, "roi", True),
+        ({"mode": "saturation"}, "mode", "saturation"),
+    ],
+)
 def test_strings_and_objects_are_coerced(given, key, expected):
     assert validate(SCHEMA, given, "d")[key] == expected
 
 
-@pytest.mark.parametrize("given, fragment", [
-    ({"h_peak": "1.5"}, "'h_peak' must be a number in [0, 1]"),
-    ({"h_peak": "abc"}, "'h_peak' must be a number"),
-    ({"n_top": "2.5"}, "'n_top' must be an integer"),
-    ({"n_top": 0}, "out of range"),
-    ({"weights": "1,2"}, "of length 3"),
-    ({"mode": "median"}, "one of max, saturation"),
-    ({"roi": "maybe"}, "true or false"),
-    ({"hpeak": 1}, "unknown parameter 'hpeak' (allowed: h_peak, mode, model, n_top, radii, roi, weights)"),
-])
+@pytest.mark.parametrize(
+    "given, fragment",
+    [
+        ({"h_peak": "1.5"}, "'h_peak' must be a number in [0, 1]"),
+        ({"h_peak": "abc"}, "'h_peak' must be a number"),
+        ({"n_top": "2.5"}, "'n_top' must be an integer"),
+        ({"n_top": 0}, "out of range"),
+        ({"weights": "1,2"}, "of length 3"),
+        ({"mode": "median"}, "one of max, saturation"),
+        ({"roi": "maybe"}, "true or false"),
+        (
+            {"hpeak": 1},
+            "unknown parameter 'hpeak' (allowed: h_peak, mode, model, n_top, radii, roi, weights)",
+        ),
+    ],
+)
 def test_errors_name_plugin_key_and_allowed_values(given, fragment):
     with pytest.raises(ParamError) as info:
         validate(SCHEMA, given, "detector 'x'")

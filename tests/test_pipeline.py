@@ -1,4 +1,5 @@
 """The pipeline: detector alone, with a classifier, and a tracker that pauses detection."""
+
 import numpy as np
 
 import tsrkit
@@ -14,7 +15,10 @@ class Fixed(tsrkit.Detector):
 
     def detect(self, frame):
         self.calls += 1
-        return [Candidate.from_circle(5, 6, 2, 0.9, state="red"), Candidate.from_circle(1, 1, 1, 0.1)]
+        return [
+            Candidate.from_circle(5, 6, 2, 0.9, state="red"),
+            Candidate.from_circle(1, 1, 1, 0.1),
+        ]
 
 
 class Greenify(tsrkit.Classifier):

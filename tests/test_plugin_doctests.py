@@ -1,5 +1,6 @@
 """The docstring examples of the built-in plugins run (the core's run through pytest's
 ``--doctest-modules``; ``plugins/`` installs as ``tsrkit_plugins``, so it is walked here)."""
+
 import doctest
 import importlib
 import pkgutil
@@ -8,8 +9,7 @@ import pytest
 
 import tsrkit_plugins
 
-MODULES = sorted(m.name for m in pkgutil.walk_packages(tsrkit_plugins.__path__,
-                                                       "tsrkit_plugins."))
+MODULES = sorted(m.name for m in pkgutil.walk_packages(tsrkit_plugins.__path__, "tsrkit_plugins."))
 
 
 @pytest.mark.parametrize("name", MODULES)

@@ -4,6 +4,7 @@
 issue-14 refactor (commands in its README), without the machine-dependent fields (timing,
 versions, the dataset root, source hashes, file lists). Every stored key must come back equal.
 """
+
 from __future__ import annotations
 
 import gzip
@@ -46,8 +47,9 @@ def reference(name: str) -> dict:
 
 
 def test_gray_tophat_on_the_sample_reproduces(tmp_path):
-    report = tsrkit.benchmark(tsrkit.dataset("sample"), tsrkit.detector("gray-tophat"),
-                              out=tmp_path, cache=False)
+    report = tsrkit.benchmark(
+        tsrkit.dataset("sample"), tsrkit.detector("gray-tophat"), out=tmp_path, cache=False
+    )
     assert_reproduces(comparable(report), reference("sample_gray-tophat"))
 
 
@@ -62,12 +64,15 @@ def replay(name: str, dataset, plugins: dict):
     return evaluate(dataset, stored_records(name), settings, plugins)
 
 
-@pytest.mark.parametrize("name, dataset, split", [
-    ("sample_conspicuity_ab-hist", "sample", None),
-    ("sample_gray-tophat", "sample", None),
-    ("sample_lab-frst", "sample", None),
-    ("udacity_mit_tl_crops_test_ab-hist", "udacity_mit_tl_crops", "test"),
-])
+@pytest.mark.parametrize(
+    "name, dataset, split",
+    [
+        ("sample_conspicuity_ab-hist", "sample", None),
+        ("sample_gray-tophat", "sample", None),
+        ("sample_lab-frst", "sample", None),
+        ("udacity_mit_tl_crops_test_ab-hist", "udacity_mit_tl_crops", "test"),
+    ],
+)
 def test_stored_records_evaluate_to_the_stored_report(name, dataset, split, shared_datasets):
     data = tsrkit.dataset(dataset)
     data = data.split(split) if split else data
@@ -79,9 +84,14 @@ def test_stored_records_evaluate_to_the_stored_report(name, dataset, split, shar
 def test_compare_replay_reproduces_reports_and_paired_tests():
     stored = json.loads((REFERENCE / "compare_sample.compare.json").read_text())
     data = tsrkit.dataset("sample")
-    runs = [replay(f"compare_sample_{name}", data, {"detector": report["detector"],
-                                                     "classifier": report["classifier"]})
-            for name, report in zip(stored["detectors"], stored["reports"])]
+    runs = [
+        replay(
+            f"compare_sample_{name}",
+            data,
+            {"detector": report["detector"], "classifier": report["classifier"]},
+        )
+        for name, report in zip(stored["detectors"], stored["reports"])
+    ]
     for run, report in zip(runs, stored["reports"]):
         assert_reproduces(comparable(run.report), report)
     assert paired_tests(stored["detectors"], runs) == stored["paired_tests"]

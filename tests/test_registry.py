@@ -1,4 +1,5 @@
 """The plugin registry: in-process registration, entry-point discovery, failures, filtering."""
+
 import json
 import subprocess
 import sys
@@ -62,7 +63,9 @@ def test_a_register_hook_that_raises_does_not_stop_the_others():
     reg.add(Broken, "broken")
     reg.add(DummyPlugin, "good")
     assert [p.name for p in reg.plugins("detector")] == ["dummy"]
-    assert [(f.plugin, f.error) for f in reg.failures] == [("broken", "register: RuntimeError: boom")]
+    assert [(f.plugin, f.error) for f in reg.failures] == [
+        ("broken", "register: RuntimeError: boom")
+    ]
 
 
 def test_a_misspelled_hook_fails_loudly():
@@ -115,8 +118,13 @@ def test_plugins_json_lists_a_failing_entry_point(tmp_path):
     (dist / "METADATA").write_text("Metadata-Version: 2.1\nName: broken-plugin\nVersion: 0.1\n")
     (dist / "entry_points.txt").write_text("[tsrkit]\nbroken = module_that_does_not_exist\n")
     env = {"PYTHONPATH": str(tmp_path), "PATH": ""}
-    out = subprocess.run([sys.executable, "-m", "tsrkit.cli.main", "plugins", "--json"],
-                         capture_output=True, text=True, env=env, check=True).stdout
+    out = subprocess.run(
+        [sys.executable, "-m", "tsrkit.cli.main", "plugins", "--json"],
+        capture_output=True,
+        text=True,
+        env=env,
+        check=True,
+    ).stdout
     listing = json.loads(out)
     failed = [p for p in listing if p["kind"] == "failed" and p["name"] == "broken"]
     assert failed and "module_that_does_not_exist" in failed[0]["error"]

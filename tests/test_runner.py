@@ -1,4 +1,5 @@
 """The benchmark runner: parallel engines agree, failures are skipped, a killed run resumes."""
+
 import json
 import os
 import signal
@@ -10,8 +11,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
-from benchmark_fakes import (OracleDetector, RedClassifier, ShiftedDetector, hand_dataset,
-                             make)
+from benchmark_fakes import OracleDetector, RedClassifier, ShiftedDetector, hand_dataset, make
 
 from tsrkit.benchmarking import benchmark
 from tsrkit.comparison import compare
@@ -35,9 +35,17 @@ def test_hand_built_report_numbers(tmp_path):
     # Matched pairs: 6 red boxes (right) and 3 green boxes (called red).
     assert report["state"]["accuracy"] == pytest.approx(6 / 9)
     assert report["frames"] == 6 and report["skipped"] == []
-    for name in ("report.json", "summary.md", "detections.jsonl", "detections.coco.json",
-                 "ground_truth.coco.json", "plots/recall_fpr_bubbles.png",
-                 "plots/categories.png", "plots/pr_curve.png", "plots/confusion.png"):
+    for name in (
+        "report.json",
+        "summary.md",
+        "detections.jsonl",
+        "detections.coco.json",
+        "ground_truth.coco.json",
+        "plots/recall_fpr_bubbles.png",
+        "plots/categories.png",
+        "plots/pr_curve.png",
+        "plots/confusion.png",
+    ):
         assert (tmp_path / name).is_file(), name
     lines = (tmp_path / "detections.jsonl").read_text().splitlines()
     assert len(lines) == 6 and json.loads(lines[1])["detections"][1]["x"] == 35
@@ -59,10 +67,12 @@ def test_dask_local_cluster_matches_serial_run():
 
     data = hand_dataset(6)
     serial = benchmark(data, make(OracleDetector), cache=False)
-    with LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
-                      dashboard_address=None) as cluster:
-        distributed = benchmark(data, make(OracleDetector), engine="dask", scheduler=cluster,
-                                cache=False)
+    with LocalCluster(
+        n_workers=1, threads_per_worker=2, processes=False, dashboard_address=None
+    ) as cluster:
+        distributed = benchmark(
+            data, make(OracleDetector), engine="dask", scheduler=cluster, cache=False
+        )
     assert without_timing(serial) == without_timing(distributed)
     assert distributed["timing"]["engine"] == "dask"
 
@@ -73,12 +83,15 @@ def test_unreadable_image_and_crashing_plugin_are_skipped(tmp_path):
     broken = tmp_path / "broken.png"
     broken.write_bytes(b"not an image")
     box = (Annotation((2, 2, 8, 8), "red"),)
-    samples = (Sample(str(good), box, metadata={"dets": [(5, 5, 1.0)]}),
-               Sample(str(broken), box, metadata={"dets": []}),
-               Sample(str(tmp_path / "missing.png"), box, metadata={"dets": []}),
-               Sample("crash", box, metadata={"dets": []}, image=np.zeros((9, 9, 3), np.uint8)))
-    report = benchmark(Dataset("mixed", samples), make(OracleDetector, crash_on="crash"),
-                       cache=False)
+    samples = (
+        Sample(str(good), box, metadata={"dets": [(5, 5, 1.0)]}),
+        Sample(str(broken), box, metadata={"dets": []}),
+        Sample(str(tmp_path / "missing.png"), box, metadata={"dets": []}),
+        Sample("crash", box, metadata={"dets": []}, image=np.zeros((9, 9, 3), np.uint8)),
+    )
+    report = benchmark(
+        Dataset("mixed", samples), make(OracleDetector, crash_on="crash"), cache=False
+    )
     reasons = {Path(s["source"]).name: s["reason"] for s in report["skipped"]}
     assert set(reasons) == {"broken.png", "missing.png", "crash"}
     assert "plugin error: RuntimeError: deliberate crash" in reasons["crash"]
@@ -87,9 +100,16 @@ def test_unreadable_image_and_crashing_plugin_are_skipped(tmp_path):
 
 
 def test_classifier_alone_on_crops():
-    crops = tuple(Sample(f"crop{i}", (Annotation((0, 0, 10, 10), state),), 10, 10,
-                         image=np.full((10, 10, 3), 9 * i, np.uint8))
-                  for i, state in enumerate(["red", "red", "yellow", "green"]))
+    crops = tuple(
+        Sample(
+            f"crop{i}",
+            (Annotation((0, 0, 10, 10), state),),
+            10,
+            10,
+            image=np.full((10, 10, 3), 9 * i, np.uint8),
+        )
+        for i, state in enumerate(["red", "red", "yellow", "green"])
+    )
     report = benchmark(Dataset("crops", crops), None, make(RedClassifier), cache=False)
     assert report["state"]["accuracy"] == 0.5
     assert report["state"]["red_yellow_errors"]["yellow_as_red"] == 1
@@ -108,8 +128,9 @@ def test_cache_is_keyed_by_plugin_parameters(tmp_path):
 
 
 def test_compare_writes_side_by_side_report_and_paired_test(tmp_path):
-    result = compare(hand_dataset(12), [make(OracleDetector), make(ShiftedDetector)],
-                     out=tmp_path, cache=False)
+    result = compare(
+        hand_dataset(12), [make(OracleDetector), make(ShiftedDetector)], out=tmp_path, cache=False
+    )
     assert [r["detector"]["name"] for r in result["reports"]] == ["oracle", "shifted"]
     test = result["paired_tests"][0]
     assert test["frames"] == 12 and test["verdict"] == "oracle better"

@@ -1,4 +1,5 @@
 """The synthetic scene generator: determinism, labels that match the pixels, outputs on disk."""
+
 from __future__ import annotations
 
 import multiprocessing
@@ -10,18 +11,21 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from tsrkit.synth import scenes as synth
 from tsrkit.errors import TsrkitError
 from tsrkit.lighting import mean_v
 from tsrkit.registry import get_registry
+from tsrkit.synth import scenes as synth
 
 #: OpenCV hue ranges (0-179) that vote for each state; cf. Mascetti Table 6 and 4.1.
 HUE_RANGES = {"red": ((0, 10), (160, 179)), "yellow": ((11, 34),), "green": ((60, 100),)}
 
 
 def files_of(folder: Path) -> dict[str, bytes]:
-    return {p.relative_to(folder).as_posix(): p.read_bytes()
-            for p in sorted(folder.rglob("*")) if p.is_file()}
+    return {
+        p.relative_to(folder).as_posix(): p.read_bytes()
+        for p in sorted(folder.rglob("*"))
+        if p.is_file()
+    }
 
 
 def generated_files(folder: Path, frames: int, seed: int) -> dict[str, bytes]:
@@ -41,12 +45,15 @@ def hue_votes(hsv: np.ndarray, x: float, y: float, radius: float) -> Counter:
     h, w = hsv.shape[:2]
     yy, xx = np.mgrid[:h, :w]
     reach = max(2 * radius, 3.0)
-    inside = (xx + 0.5 - x) ** 2 + (yy + 0.5 - y) ** 2 <= reach ** 2
+    inside = (xx + 0.5 - x) ** 2 + (yy + 0.5 - y) ** 2 <= reach**2
     hue, sat, val = (hsv[..., k][inside].astype(int) for k in range(3))
     colourful = (sat >= 50) & (val >= 90)
-    return Counter({state: int(sum(((hue >= lo) & (hue <= hi) & colourful).sum()
-                                   for lo, hi in ranges))
-                    for state, ranges in HUE_RANGES.items()})
+    return Counter(
+        {
+            state: int(sum(((hue >= lo) & (hue <= hi) & colourful).sum() for lo, hi in ranges))
+            for state, ranges in HUE_RANGES.items()
+        }
+    )
 
 
 def test_same_arguments_give_identical_files_and_other_seeds_differ(tmp_path):
@@ -83,8 +90,7 @@ def test_lighting_classes_separate_by_mean_brightness(generated):
     _, dataset = generated
     by_light: dict[str, list[float]] = {}
     for sample in dataset:
-        by_light.setdefault(sample.metadata["lighting"], []).append(
-            mean_v(sample.load().image))
+        by_light.setdefault(sample.metadata["lighting"], []).append(mean_v(sample.load().image))
     assert {k: len(v) for k, v in by_light.items()} == {"day": 6, "dusk": 6, "night": 6}
     assert min(by_light["day"]) > max(by_light["dusk"])
     assert min(by_light["dusk"]) > max(by_light["night"])
@@ -103,9 +109,10 @@ def test_boxes_are_lens_boxes_inside_the_image_with_balanced_splits(generated):
             hx0, hy0, hx1, hy1 = ann.attributes["housing"]
             assert hx0 <= x0 and hy0 <= y0 and x1 <= hx1 and y1 <= hy1
             radii.append(r)
-    assert 1.5 <= min(radii) and max(radii) <= 9.0
+    assert min(radii) >= 1.5 and max(radii) <= 9.0
     assert Counter((s.metadata["lighting"], s.split) for s in dataset) == {
-        (light, split): 3 for light in synth.LIGHTINGS for split in ("train", "test")}
+        (light, split): 3 for light in synth.LIGHTINGS for split in ("train", "test")
+    }
 
 
 def test_coco_and_normalized_outputs_agree(generated):
@@ -115,9 +122,18 @@ def test_coco_and_normalized_outputs_agree(generated):
     coco = registry.create("format", "coco").read(out / "coco.json")
 
     def facts(ds):
-        return [(Path(s.source).resolve(), s.split, s.metadata["lighting"],
-                 [(tuple(round(v, 3) for v in a.bbox), a.state, a.attributes["radius"])
-                  for a in s.annotations]) for s in ds]
+        return [
+            (
+                Path(s.source).resolve(),
+                s.split,
+                s.metadata["lighting"],
+                [
+                    (tuple(round(v, 3) for v in a.bbox), a.state, a.attributes["radius"])
+                    for a in s.annotations
+                ],
+            )
+            for s in ds
+        ]
 
     assert facts(normalized) == facts(coco) == facts(dataset)
     assert sum(len(s.annotations) for s in coco) == sum(len(s.annotations) for s in dataset)
@@ -160,9 +176,15 @@ def test_existing_folder_with_other_data_needs_overwrite(tmp_path):
     assert synth._read_stamp(out)["seed"] == 1
 
 
-@pytest.mark.parametrize("kwargs, message", [
-    ({"frames": 0}, "frames"), ({"lighting": ("noon",)}, "lighting"),
-    ({"quality": 0}, "quality"), ({"colour": 1}, "unknown synth option")])
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        ({"frames": 0}, "frames"),
+        ({"lighting": ("noon",)}, "lighting"),
+        ({"quality": 0}, "quality"),
+        ({"colour": 1}, "unknown synth option"),
+    ],
+)
 def test_bad_arguments_are_rejected(tmp_path, kwargs, message):
     args = {"frames": 2, "seed": 0, **kwargs}
     with pytest.raises(ValueError, match=message):
@@ -174,12 +196,26 @@ def test_cli_writes_the_dataset_and_reports_mistakes_in_one_line(tmp_path):
     from tsrkit.cli.main import cli
 
     runner = CliRunner()
-    result = runner.invoke(cli, ["datasets", "synth", "--out", str(tmp_path / "s"),
-                                 "--frames", "3", "--seed", "2", "--lighting", "night"])
+    result = runner.invoke(
+        cli,
+        [
+            "datasets",
+            "synth",
+            "--out",
+            str(tmp_path / "s"),
+            "--frames",
+            "3",
+            "--seed",
+            "2",
+            "--lighting",
+            "night",
+        ],
+    )
     assert result.exit_code == 0, result.output
     assert "wrote 3 frames" in result.output
     dataset = get_registry().create("format", "normalized").read(tmp_path / "s")
     assert {s.metadata["lighting"] for s in dataset} == {"night"}
-    bad = runner.invoke(cli, ["datasets", "synth", "--out", str(tmp_path / "t"),
-                              "--lighting", "noon"])
+    bad = runner.invoke(
+        cli, ["datasets", "synth", "--out", str(tmp_path / "t"), "--lighting", "noon"]
+    )
     assert bad.exit_code == 2 and "lighting" in bad.output and "Traceback" not in bad.output

@@ -1,4 +1,5 @@
 """Tests for the TL-recognizer detector (Mascetti 2016) on synthetic frames and real data."""
+
 from __future__ import annotations
 
 import json
@@ -8,19 +9,22 @@ import numpy as np
 import pytest
 
 import tsrkit
-
 from tsrkit.models import load_model, save_model
 from tsrkit.registry import get_registry
 from tsrkit.types import Annotation, Frame, Sample
-from tsrkit_plugins.detectors.tl_recognizer import tl_geometry as geo
 from tsrkit_plugins.detectors.tl_recognizer import TlRecognizer, enclosed_cores, red_or_yellow
+from tsrkit_plugins.detectors.tl_recognizer import tl_geometry as geo
 from tsrkit_plugins.detectors.tl_recognizer.tl_templates import disc_template, extract_patch, ncc
-from tsrkit_plugins.detectors.tl_recognizer.tl_tuning import patch_scores, smallest_ranges, tune_threshold
+from tsrkit_plugins.detectors.tl_recognizer.tl_tuning import (
+    patch_scores,
+    smallest_ranges,
+    tune_threshold,
+)
 
 #: Lit-lens colours as a camera records them (BGR), distinct from the templates' own colours.
 LIT = {"green": (170, 250, 40), "red": (50, 30, 235), "yellow": (20, 180, 245)}
-SODIUM = (0, 120, 255)          # low-pressure sodium: saturated orange, hue about 14
-WARM_WHITE = (150, 230, 255)    # warm-white lamp: S about 105, passes the yellowRed filter
+SODIUM = (0, 120, 255)  # low-pressure sodium: saturated orange, hue about 14
+WARM_WHITE = (150, 230, 255)  # warm-white lamp: S about 105, passes the yellowRed filter
 
 
 def scene(height=240, width=320, background=(30, 30, 30)):
@@ -60,17 +64,20 @@ def test_lit_disc_found_with_its_state(state):
 
 def test_three_lights_in_one_frame_each_get_their_state():
     image = scene()
-    for (x, state) in zip((60, 160, 260), ("red", "yellow", "green")):
+    for x, state in zip((60, 160, 260), ("red", "yellow", "green")):
         lit_disc(image, (x, 120), 10, LIT[state])
     found = lens_detector(resize_factor=2).detect(Frame(image, "synthetic"))
     assert sorted((round(c.x / 100), c.state) for c in found) == [
-        (1, "red"), (2, "yellow"), (3, "green")]
+        (1, "red"),
+        (2, "yellow"),
+        (3, "green"),
+    ]
 
 
 def test_lamps_pass_extraction_but_fail_validation():
     image = scene()
-    cv2.rectangle(image, (40, 60), (100, 100), SODIUM, thickness=-1)       # sodium luminaire
-    cv2.rectangle(image, (200, 60), (250, 95), WARM_WHITE, thickness=-1)   # white lamp panel
+    cv2.rectangle(image, (40, 60), (100, 100), SODIUM, thickness=-1)  # sodium luminaire
+    cv2.rectangle(image, (200, 60), (250, 95), WARM_WHITE, thickness=-1)  # white lamp panel
     det = lens_detector(resize_factor=1)
     scored = det.scored(Frame(image, "synthetic"))
     assert len(scored) == 2  # both survive extraction and pruning...
@@ -89,8 +96,13 @@ def signal_head(image, centre, radius, state, horizontal=False):
     first = np.array(centre) - (k * pitch if horizontal else 0, 0 if horizontal else k * pitch)
     step = np.array((pitch, 0) if horizontal else (0, pitch))
     end = first + 2 * step
-    cv2.rectangle(image, tuple(int(v) for v in first - radius - border),
-                  tuple(int(v) for v in end + radius + border), (20, 20, 20), -1)
+    cv2.rectangle(
+        image,
+        tuple(int(v) for v in first - radius - border),
+        tuple(int(v) for v in end + radius + border),
+        (20, 20, 20),
+        -1,
+    )
     for j in range(3):
         lit_disc(image, tuple(int(v) for v in first + j * step), radius, (40, 40, 40))
     return lit_disc(image, centre, radius, LIT[state])
@@ -98,8 +110,9 @@ def signal_head(image, centre, radius, state, horizontal=False):
 
 def street_lamp(image, centre, radius, colour):
     """A round lamp on a thin dark pole."""
-    cv2.rectangle(image, (centre[0] - 2, centre[1]), (centre[0] + 2, image.shape[0]), (50, 50, 50),
-                  -1)
+    cv2.rectangle(
+        image, (centre[0] - 2, centre[1]), (centre[0] + 2, image.shape[0]), (50, 50, 50), -1
+    )
     return lit_disc(image, centre, radius, colour)
 
 
@@ -120,27 +133,32 @@ def test_lit_lens_in_its_housing_is_accepted(state, horizontal):
 @pytest.mark.parametrize("lamp", sorted(LAMPS))
 def test_round_street_lamps_are_rejected_by_housing_validation(lamp):
     hsv = cv2.cvtColor(np.uint8([[LAMPS[lamp]]]), cv2.COLOR_BGR2HSV)[0, 0]
-    assert hsv[0] <= 25 and hsv[1] >= 100 and hsv[2] >= 80      # inside the yellowRed filter
+    assert hsv[0] <= 25 and hsv[1] >= 100 and hsv[2] >= 80  # inside the yellowRed filter
     image = street_lamp(scene(background=DUSK_SKY), (160, 80), 10, LAMPS[lamp])
     frame = Frame(image, "synthetic")
     for orientation in ("vertical", "both"):
         det = detector(resize_factor=1, orientation=orientation)
         scored = det.scored(frame)
-        assert len(scored) == 1 and abs(scored[0].x - 160) <= 1.5   # extracted and pruned...
-        assert scored[0].score < det.threshold - 0.1                # ...but not a lens
+        assert len(scored) == 1 and abs(scored[0].x - 160) <= 1.5  # extracted and pruned...
+        assert scored[0].score < det.threshold - 0.1  # ...but not a lens
         assert det.detect(frame) == []
     # the bare-lens reading of 3.5 scores the same lamp as high as a lens
     assert lens_detector(resize_factor=1).scored(frame)[0].score > 0.586
 
 
 def test_housing_template_layout():
-    from tsrkit_plugins.detectors.tl_recognizer.tl_templates import Layout, housing_template, patch_box
+    from tsrkit_plugins.detectors.tl_recognizer.tl_templates import (
+        Layout,
+        housing_template,
+        patch_box,
+    )
+
     layout = Layout(True, 20, pitch=1.5, margin=0.5)
     t = housing_template("red", "vertical", layout)
-    assert t.shape == (20 * 5 // 2, 20, 3)           # along (2 * 1.5 + 1 + 1) / across 2
-    lens_row = 20 // 2                                 # red lens centred 1 diameter from the top
-    assert t[lens_row, 10, 2] > 200 and t[lens_row + 15, 10, 2] < 80   # lit red, dim yellow
-    assert t[1, 1].min() > 150 and t[lens_row, 3].max() < 40          # surround, screen
+    assert t.shape == (20 * 5 // 2, 20, 3)  # along (2 * 1.5 + 1 + 1) / across 2
+    lens_row = 20 // 2  # red lens centred 1 diameter from the top
+    assert t[lens_row, 10, 2] > 200 and t[lens_row + 15, 10, 2] < 80  # lit red, dim yellow
+    assert t[1, 1].min() > 150 and t[lens_row, 3].max() < 40  # surround, screen
     assert np.array_equal(housing_template("red", "horizontal", layout), t.transpose(1, 0, 2))
     # green at the bottom: the patch reaches two pitches above the lens
     assert patch_box((-5, -5, 5, 5), "green", "vertical", layout) == (-10, -40, 10, 10)
@@ -200,7 +218,7 @@ def test_horizon_hand_worked_case():
 
 def test_property2_distances_against_a_pinhole_projection():
     f, pitch, lens = 800.0, np.radians(5), 0.2
-    d_h, height = 10.0, 2.0                   # light 10 m ahead, lens bottom 2 m above camera
+    d_h, height = 10.0, 2.0  # light 10 m ahead, lens bottom 2 m above camera
     # project lens bottom and top into a camera pitched up by 5 degrees
     d1 = f * np.tan(np.arctan2(height, d_h) - pitch)
     d2 = f * np.tan(np.arctan2(height + lens, d_h) - pitch)
@@ -221,20 +239,26 @@ def metric_frame(distance_m, height_m, state, focal=800.0, pitch_deg=5.0, roll_d
     if roll_deg:
         rot = cv2.getRotationMatrix2D((319.5, 239.5), roll_deg, 1.0)
         image = cv2.warpAffine(image, rot, (640, 480), borderValue=(30, 30, 30))
-    return Frame(image, "synthetic", metadata={"focal_px": focal, "pitch_deg": pitch_deg,
-                                               "roll_deg": roll_deg})
+    return Frame(
+        image,
+        "synthetic",
+        metadata={"focal_px": focal, "pitch_deg": pitch_deg, "roll_deg": roll_deg},
+    )
 
 
 def f_over(focal, distance):
     return focal / distance
 
 
-@pytest.mark.parametrize("distance, height, kept", [
-    (8.0, 2.0, True),     # inside 2.5-20 m and 0.5-4 m
-    (40.0, 2.0, False),   # too far
-    (8.0, 6.0, False),    # too high
-    (8.0, -0.5, False),   # below the camera
-])
+@pytest.mark.parametrize(
+    "distance, height, kept",
+    [
+        (8.0, 2.0, True),  # inside 2.5-20 m and 0.5-4 m
+        (40.0, 2.0, False),  # too far
+        (8.0, 6.0, False),  # too high
+        (8.0, -0.5, False),  # below the camera
+    ],
+)
 def test_metadata_pruning_by_distance(distance, height, kept):
     frame = metric_frame(distance, height, "green")
     found = lens_detector(resize_factor=1).detect(frame)
@@ -257,8 +281,8 @@ def test_width_property_prunes_a_wide_blob_with_metadata():
 
 def test_patch_follows_the_roll():
     image = scene(200, 200)
-    cv2.rectangle(image, (90, 60), (110, 140), (255, 255, 255), -1)   # a tall bar
-    rot = cv2.getRotationMatrix2D((99.5, 99.5), 30, 1.0)              # turned 30 deg ccw
+    cv2.rectangle(image, (90, 60), (110, 140), (255, 255, 255), -1)  # a tall bar
+    rot = cv2.getRotationMatrix2D((99.5, 99.5), 30, 1.0)  # turned 30 deg ccw
     rotated = cv2.warpAffine(image, rot, (200, 200), borderValue=(30, 30, 30))
     upright = extract_patch(image, (-10.5, -40.5, 11.5, 41.5), 0.0, (99.5, 99.5), 16)
     levelled = extract_patch(rotated, (-10.5, -40.5, 11.5, 41.5), np.radians(30), (99.5, 99.5), 16)
@@ -268,10 +292,11 @@ def test_patch_follows_the_roll():
 @pytest.mark.parametrize("factor", [1, 2, 3, 4])
 def test_resize_factor_keeps_large_lights(factor):
     image = scene(480, 640)
-    for (x, state) in zip((120, 320, 520), ("red", "yellow", "green")):
+    for x, state in zip((120, 320, 520), ("red", "yellow", "green")):
         lit_disc(image, (x, 200), 18, LIT[state])
-    found = sorted(lens_detector(resize_factor=factor).detect(Frame(image, "synthetic")),
-                   key=lambda c: c.x)
+    found = sorted(
+        lens_detector(resize_factor=factor).detect(Frame(image, "synthetic")), key=lambda c: c.x
+    )
     assert [c.state for c in found] == ["red", "yellow", "green"]
     for c, x in zip(found, (120, 320, 520)):
         assert abs(c.x - x) <= 1.5 and abs(c.y - 200) <= 1.5 and abs(c.radius - 18.5) <= 2
@@ -279,7 +304,7 @@ def test_resize_factor_keeps_large_lights(factor):
 
 def test_two_threads_give_the_same_result():
     image = scene()
-    for (x, state) in zip((60, 160, 260), ("red", "yellow", "green")):
+    for x, state in zip((60, 160, 260), ("red", "yellow", "green")):
         lit_disc(image, (x, 120), 10, LIT[state])
     frame = Frame(image, "synthetic")
     assert lens_detector(threads=2).detect(frame) == lens_detector(threads=1).detect(frame)
@@ -293,9 +318,10 @@ def synthetic_samples(n=6, seed=0):
         state = ("red", "yellow", "green")[i % 3]
         x, y = int(rng.integers(40, 280)), int(rng.integers(40, 200))
         lit_disc(image, (x, y), 9, LIT[state])
-        cv2.rectangle(image, (10, 10), (40, 30), SODIUM, -1)           # a non-light
-        samples.append(Sample(f"s{i}", (Annotation((x - 9, y - 9, x + 10, y + 10), state),),
-                              image=image))
+        cv2.rectangle(image, (10, 10), (40, 30), SODIUM, -1)  # a non-light
+        samples.append(
+            Sample(f"s{i}", (Annotation((x - 9, y - 9, x + 10, y + 10), state),), image=image)
+        )
     return samples
 
 
@@ -303,7 +329,7 @@ def test_patch_scores_split_lights_from_others():
     det = lens_detector(resize_factor=1)
     samples = synthetic_samples()
     lights, others = patch_scores(det, samples)
-    assert len(lights) == len(others) == len(samples)     # one lens and one sodium panel each
+    assert len(lights) == len(others) == len(samples)  # one lens and one sodium panel each
     assert lights.min() > others.max()
     assert tune_threshold(det, samples) == (others.max(), 6, 6)
 
@@ -317,14 +343,14 @@ def overexposed_lens(colour, arc, centre=(160, 120), radius=12):
 
 def test_enclosed_cores_joins_ringed_white_blobs_only():
     hsv = np.zeros((9, 9, 3), np.uint8)
-    hsv[2:5, 2:5] = (0, 0, 250)                     # white core, fully ringed
-    hsv[6:8, 6:8] = (0, 0, 250)                     # white blob with no coloured border
+    hsv[2:5, 2:5] = (0, 0, 250)  # white core, fully ringed
+    hsv[6:8, 6:8] = (0, 0, 250)  # white blob with no coloured border
     mask = np.zeros((9, 9), np.uint8)
     mask[1:6, 1:6] = 255
     mask[2:5, 2:5] = 0
     out = enclosed_cores(hsv, mask, 230, 0.5)
     assert out[2:5, 2:5].all() and not out[6:8, 6:8].any()
-    assert np.array_equal(enclosed_cores(hsv, mask, 251, 0.5), mask)   # core too dark
+    assert np.array_equal(enclosed_cores(hsv, mask, 251, 0.5), mask)  # core too dark
 
 
 def test_fill_cores_recovers_the_whole_overexposed_lens():
@@ -349,8 +375,14 @@ def test_fit_tunes_threshold_and_ranges(tmp_path):
     # the green hue range shrinks from the broad one around the lit green disc's hue
     hue = int(cv2.cvtColor(np.uint8([[LIT["green"]]]), cv2.COLOR_BGR2HSV)[0, 0, 0])
     assert 50 < ranges[0, 0, 0] <= hue <= ranges[0, 1, 0] < 115
-    path = save_model(tmp_path / "m", model, plugin="tl-recognizer", plugin_version="t",
-                      params=det.params, training={})
+    path = save_model(
+        tmp_path / "m",
+        model,
+        plugin="tl-recognizer",
+        plugin_version="t",
+        params=det.params,
+        training={},
+    )
     # T holds for the resize factor it was tuned at
     loaded = lens_detector(model=str(path), resize_factor=1)
     assert loaded.threshold == pytest.approx(threshold)
@@ -367,18 +399,21 @@ def test_fit_without_ranges_tunes_t_alone():
     model = det.fit(synthetic_samples())
     assert np.array_equal(model.arrays["ranges"], table6)
     assert float(model.arrays["threshold"]) == pytest.approx(
-        tune_threshold(lens_detector(resize_factor=1), synthetic_samples())[0])
+        tune_threshold(lens_detector(resize_factor=1), synthetic_samples())[0]
+    )
     assert model.info["lens_pixels"] == {"green": 0, "yellowred": 0}
 
 
 def test_smallest_ranges_cover_all_pixels():
-    pixels = {"green": np.array([[72, 120, 90], [90, 200, 254], [80, 150, 255]], np.uint8),
-              "yellowred": np.array([[5, 110, 100], [170, 130, 200], [20, 255, 130]], np.uint8)}
+    pixels = {
+        "green": np.array([[72, 120, 90], [90, 200, 254], [80, 150, 255]], np.uint8),
+        "yellowred": np.array([[5, 110, 100], [170, 130, 200], [20, 255, 130]], np.uint8),
+    }
     fallback = np.zeros((3, 2, 3))
     r = smallest_ranges(pixels, fallback, 1.0)
     assert r[0, :, 0].tolist() == [72, 90]
     assert r[1, :, 0].tolist() == [0, 20] and r[2, :, 0].tolist() == [170, 180]
-    assert r[0, 0, 1:].tolist() == [110, 90]    # the V=255 pixel is excluded
+    assert r[0, 0, 1:].tolist() == [110, 90]  # the V=255 pixel is excluded
 
 
 def test_templates_folder_is_used_and_checked(tmp_path):
@@ -401,6 +436,7 @@ def test_registered_and_listed_as_trainable():
 
 def test_real_frames_run_and_states_are_valid(shared_datasets):
     from tsrkit.inputs import read_image
+
     images = sorted((shared_datasets / "roboflow_cinta_v2_id").rglob("*.jpg"))[:8]
     assert images
     det = detector(resize_factor=1)

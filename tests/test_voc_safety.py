@@ -1,4 +1,5 @@
 """VOC XML is parsed with defusedxml: an entity-expansion file is one clear error, not a hang."""
+
 import pytest
 
 from tsrkit.datasets import DatasetError, read_dataset

@@ -11,6 +11,7 @@ Everything the command line does is a plain call here first::
 It is also the whole plugin API: ``from tsrkit import hookimpl, Detector, Param, Candidate``
 (and the other public names below) is all a plugin module needs to import.
 """
+
 from __future__ import annotations
 
 from importlib import metadata as _metadata
@@ -24,15 +25,22 @@ from tsrkit.inputs import iter_frames
 from tsrkit.models import Model, ModelError, load_model, save_model
 from tsrkit.params import Param, ParamError
 from tsrkit.pipeline import FrameResult, Pipeline
-from tsrkit.plugin import (Classifier, DatasetFormat, Detector, Metric, ReportWriter, Tracker,
-                           Trainable, Verifier)
+from tsrkit.plugin import (
+    Classifier,
+    DatasetFormat,
+    Detector,
+    Metric,
+    ReportWriter,
+    Tracker,
+    Trainable,
+    Verifier,
+)
 from tsrkit.records import DetectionRecord, FrameRecord
 from tsrkit.registry import PluginNotFound, get_registry
 from tsrkit.report import RunResult
 from tsrkit.selection import Selection
 from tsrkit.selection import build as select
-from tsrkit.types import (STATES, Annotation, Candidate, Dataset, Detection, Frame, Sample,
-                          Skipped)
+from tsrkit.types import STATES, Annotation, Candidate, Dataset, Detection, Frame, Sample, Skipped
 
 try:
     __version__ = _metadata.version("tsrkit")
@@ -79,8 +87,12 @@ def dataset(ref: str, format: str | None = None, images: str | None = None) -> D
     return open_dataset(ref, format=format, images=images)
 
 
-def benchmark(dataset: Dataset, detector: Detector | None = None,
-              classifier: Classifier | None = None, **options: Any) -> dict[str, Any]:
+def benchmark(
+    dataset: Dataset,
+    detector: Detector | None = None,
+    classifier: Classifier | None = None,
+    **options: Any,
+) -> dict[str, Any]:
     """Run a detector (and verifier, classifier) over a dataset and return the report dict.
 
     ``options`` are those of :func:`tsrkit.benchmarking.benchmark` (``verifier=``, ``box=``,
@@ -91,8 +103,12 @@ def benchmark(dataset: Dataset, detector: Detector | None = None,
     return _benchmark(dataset, detector, classifier, **options)
 
 
-def compare(dataset: Dataset, detectors: list[Detector], classifier: Classifier | None = None,
-            **options: Any) -> dict[str, Any]:
+def compare(
+    dataset: Dataset,
+    detectors: list[Detector],
+    classifier: Classifier | None = None,
+    **options: Any,
+) -> dict[str, Any]:
     """Benchmark several detectors on the same frames, with paired tests
     (:func:`tsrkit.comparison.compare`)."""
     from tsrkit.comparison import compare as _compare
@@ -100,8 +116,7 @@ def compare(dataset: Dataset, detectors: list[Detector], classifier: Classifier 
     return _compare(dataset, detectors, classifier, **options)
 
 
-def train(name: str, dataset: Dataset, out: str, detector: Detector | None = None,
-          **params: Any):
+def train(name: str, dataset: Dataset, out: str, detector: Detector | None = None, **params: Any):
     """Fit the trainable plugin ``name`` on ``dataset`` and save the model to ``out``.
 
     ``detector`` is the detector a trainable verifier learns on.
@@ -112,11 +127,50 @@ def train(name: str, dataset: Dataset, out: str, detector: Detector | None = Non
 
 
 __all__ = [
-    "STATES", "Annotation", "Candidate", "Classifier", "Dataset", "DatasetFormat", "Detection",
-    "DetectionRecord", "Detector", "EvalSettings", "Frame", "FrameRecord", "FrameResult",
-    "ImageReadError", "Metric", "Model", "ModelError", "Param", "ParamError", "Pipeline",
-    "PluginNotFound", "ReportWriter", "RunResult", "Sample", "Selection", "Skipped", "Tracker",
-    "Trainable", "TsrkitError", "Verifier", "benchmark", "classifier", "compare", "dataset",
-    "detector", "hookimpl", "iter_frames", "load_model", "plugins", "read_frame", "read_image",
-    "save_model", "select", "tracker", "train", "verifier",
+    "STATES",
+    "Annotation",
+    "Candidate",
+    "Classifier",
+    "Dataset",
+    "DatasetFormat",
+    "Detection",
+    "DetectionRecord",
+    "Detector",
+    "EvalSettings",
+    "Frame",
+    "FrameRecord",
+    "FrameResult",
+    "ImageReadError",
+    "Metric",
+    "Model",
+    "ModelError",
+    "Param",
+    "ParamError",
+    "Pipeline",
+    "PluginNotFound",
+    "ReportWriter",
+    "RunResult",
+    "Sample",
+    "Selection",
+    "Skipped",
+    "Tracker",
+    "Trainable",
+    "TsrkitError",
+    "Verifier",
+    "benchmark",
+    "classifier",
+    "compare",
+    "dataset",
+    "detector",
+    "hookimpl",
+    "iter_frames",
+    "load_model",
+    "plugins",
+    "read_frame",
+    "read_image",
+    "save_model",
+    "select",
+    "tracker",
+    "train",
+    "verifier",
 ]

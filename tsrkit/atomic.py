@@ -1,4 +1,5 @@
 """Atomic file output: write beside the target, then rename over it in one step."""
+
 from __future__ import annotations
 
 import contextlib

@@ -9,6 +9,7 @@ Memory: the engine streams frames, and images are never kept; the evaluated reco
 hundred bytes per detection), because the writers (JSON Lines, COCO, CSV, the HTML gallery) need
 them after the metrics are computed.
 """
+
 from __future__ import annotations
 
 import json
@@ -30,12 +31,18 @@ from tsrkit.report import ProgressBar, RunResult, build_report, merge_sections
 from tsrkit.types import Dataset
 
 
-def eval_settings(dataset: Dataset, detection: bool = True, iou_threshold: float = 0.5,
-                  box: str = "auto") -> EvalSettings:
+def eval_settings(
+    dataset: Dataset, detection: bool = True, iou_threshold: float = 0.5, box: str = "auto"
+) -> EvalSettings:
     """The evaluation settings of ``dataset``: the box (``auto`` follows its registry ``box``
     convention) and whether it is exhaustively labelled (registry ``exhaustive``)."""
-    return EvalSettings(dataset.name, iou_threshold, resolve_box(box, dataset.info),
-                        dataset.info.get("exhaustive", True) is not False, detection)
+    return EvalSettings(
+        dataset.name,
+        iou_threshold,
+        resolve_box(box, dataset.info),
+        dataset.info.get("exhaustive", True) is not False,
+        detection,
+    )
 
 
 def metrics_for(settings: EvalSettings) -> list[Metric]:
@@ -51,15 +58,22 @@ def writers_for(names: Sequence[str] | None) -> list[ReportWriter]:
     """The named report writers, or every registered writer that runs by default."""
     registry = get_registry()
     if names is None:
-        names = [info.name for info in registry.plugins("writer")
-                 if getattr(info.cls, "default", False)]
+        names = [
+            info.name for info in registry.plugins("writer") if getattr(info.cls, "default", False)
+        ]
     return [registry.create("writer", name) for name in names]
 
 
-def evaluate(dataset: Dataset, records: Iterable[FrameRecord], settings: EvalSettings,
-             plugins: Mapping[str, dict | None], *, out: str | os.PathLike | None = None,
-             writers: Sequence[str] | None = None,
-             run_info: Mapping[str, Any] | None = None) -> RunResult:
+def evaluate(
+    dataset: Dataset,
+    records: Iterable[FrameRecord],
+    settings: EvalSettings,
+    plugins: Mapping[str, dict | None],
+    *,
+    out: str | os.PathLike | None = None,
+    writers: Sequence[str] | None = None,
+    run_info: Mapping[str, Any] | None = None,
+) -> RunResult:
     """Fold records into every metric, build ``report.json`` and let the writers write ``out``.
 
     Parameters
@@ -94,15 +108,20 @@ def evaluate(dataset: Dataset, records: Iterable[FrameRecord], settings: EvalSet
     wall = time.perf_counter() - start
     sections = merge_sections((m.name, m.compute()) for m in metrics)
     cached = sum(r.cached for r in kept)
-    timing = {"ms_per_frame_median": float(np.median([r.ms for r in kept])) if kept else None,
-              "frames_per_second": len(kept) / wall if wall > 0 else None,
-              "wall_seconds": wall, **(run_info or {}),
-              "frames_computed": len(kept) - cached, "frames_cached": cached}
+    timing = {
+        "ms_per_frame_median": float(np.median([r.ms for r in kept])) if kept else None,
+        "frames_per_second": len(kept) / wall if wall > 0 else None,
+        "wall_seconds": wall,
+        **(run_info or {}),
+        "frames_computed": len(kept) - cached,
+        "frames_cached": cached,
+    }
     notes = [] if settings.exhaustive else [not_exhaustive_note(dataset.name)]
 
     def report(files: Sequence[str]) -> dict[str, Any]:
-        return build_report(dataset, plugins, settings, sections, len(kept), timing, skipped,
-                            files, notes)
+        return build_report(
+            dataset, plugins, settings, sections, len(kept), timing, skipped, files, notes
+        )
 
     run = RunResult(report(()), dataset, settings, tuple(kept))
     if out is None:
@@ -116,13 +135,23 @@ def evaluate(dataset: Dataset, records: Iterable[FrameRecord], settings: EvalSet
     return run
 
 
-def run_benchmark(dataset: Dataset, detector: Detector | None = None,
-                  classifier: Classifier | None = None, *, verifier: Verifier | None = None,
-                  workers: int = 1, engine: str = "local", scheduler: Any = None,
-                  out: str | os.PathLike | None = None, cache: bool = True,
-                  cache_dir: str | os.PathLike | None = None, progress: bool = False,
-                  iou_threshold: float = 0.5, box: str = "auto",
-                  writers: Sequence[str] | None = None) -> RunResult:
+def run_benchmark(
+    dataset: Dataset,
+    detector: Detector | None = None,
+    classifier: Classifier | None = None,
+    *,
+    verifier: Verifier | None = None,
+    workers: int = 1,
+    engine: str = "local",
+    scheduler: Any = None,
+    out: str | os.PathLike | None = None,
+    cache: bool = True,
+    cache_dir: str | os.PathLike | None = None,
+    progress: bool = False,
+    iou_threshold: float = 0.5,
+    box: str = "auto",
+    writers: Sequence[str] | None = None,
+) -> RunResult:
     """:func:`benchmark`, returning the whole :class:`~tsrkit.report.RunResult` (records too)."""
     if detector is None and classifier is None:
         raise BenchmarkError("a benchmark needs a detector, a classifier, or both")
@@ -131,17 +160,33 @@ def run_benchmark(dataset: Dataset, detector: Detector | None = None,
     if verifier is not None:
         plugins["verifier"] = plugin_identity(verifier)
     folder = (Path(cache_dir) if cache_dir else default_cache_dir(out)) if cache else None
-    job = Job(detector, classifier, json.dumps(plugins, sort_keys=True),
-              str(folder) if folder else None, verifier)
+    job = Job(
+        detector,
+        classifier,
+        json.dumps(plugins, sort_keys=True),
+        str(folder) if folder else None,
+        verifier,
+    )
     label = (detector or classifier).name  # type: ignore[union-attr]
     with ProgressBar(len(dataset), progress, label) as bar:
         records = bar.track(run_records(dataset.samples, job, workers, engine, scheduler))
-        return evaluate(dataset, records, settings, plugins, out=out, writers=writers,
-                        run_info={"workers": workers, "engine": engine})
+        return evaluate(
+            dataset,
+            records,
+            settings,
+            plugins,
+            out=out,
+            writers=writers,
+            run_info={"workers": workers, "engine": engine},
+        )
 
 
-def benchmark(dataset: Dataset, detector: Detector | None = None,
-              classifier: Classifier | None = None, **options: Any) -> dict[str, Any]:
+def benchmark(
+    dataset: Dataset,
+    detector: Detector | None = None,
+    classifier: Classifier | None = None,
+    **options: Any,
+) -> dict[str, Any]:
     """Run a detector (and verifier, classifier) over ``dataset`` and return the report dict.
 
     Parameters

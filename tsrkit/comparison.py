@@ -4,6 +4,7 @@ Each run writes its folder ``OUT/<detector>/``; ``OUT/compare.json`` and ``OUT/c
 the reports side by side and, for every pair, a Wilcoxon signed-rank test on per-frame recall
 over the ground-truth frames both evaluated.
 """
+
 from __future__ import annotations
 
 import os
@@ -35,14 +36,21 @@ def paired_tests(names: Sequence[str], runs: Sequence[RunResult]) -> list[dict[s
     for a in range(len(runs)):
         for b in range(a + 1, len(runs)):
             common = sorted(recalls[a].keys() & recalls[b].keys())
-            test = paired_test([recalls[a][i] for i in common], [recalls[b][i] for i in common],
-                               names[a], names[b])
+            test = paired_test(
+                [recalls[a][i] for i in common], [recalls[b][i] for i in common], names[a], names[b]
+            )
             tests.append({"a": names[a], "b": names[b], "metric": "per-frame recall", **test})
     return tests
 
 
-def compare(dataset: Dataset, detectors: Sequence[Detector], classifier: Classifier | None = None,
-            *, out: str | os.PathLike | None = None, **options: Any) -> dict[str, Any]:
+def compare(
+    dataset: Dataset,
+    detectors: Sequence[Detector],
+    classifier: Classifier | None = None,
+    *,
+    out: str | os.PathLike | None = None,
+    **options: Any,
+) -> dict[str, Any]:
     """Benchmark several detectors on the same frames and test each pair.
 
     Other keyword options are those of :func:`tsrkit.benchmarking.benchmark` (``verifier=``,
@@ -51,12 +59,22 @@ def compare(dataset: Dataset, detectors: Sequence[Detector], classifier: Classif
     names = [d.name for d in detectors]
     if len(set(names)) != len(names) or len(names) < 2:
         raise BenchmarkError(f"compare needs at least two different detectors; got {names}")
-    runs = [run_benchmark(dataset, detector, classifier,
-                          out=Path(out) / detector.name if out is not None else None, **options)
-            for detector in detectors]
-    comparison = {"dataset": dataset.name, "detectors": names,
-                  "reports": [run.report for run in runs],
-                  "paired_tests": paired_tests(names, runs)}
+    runs = [
+        run_benchmark(
+            dataset,
+            detector,
+            classifier,
+            out=Path(out) / detector.name if out is not None else None,
+            **options,
+        )
+        for detector in detectors
+    ]
+    comparison = {
+        "dataset": dataset.name,
+        "detectors": names,
+        "reports": [run.report for run in runs],
+        "paired_tests": paired_tests(names, runs),
+    }
     if out is not None:
         write_compare(Path(out), comparison)
     return comparison
@@ -65,14 +83,33 @@ def compare(dataset: Dataset, detectors: Sequence[Detector], classifier: Classif
 def compare_markdown(comparison: dict) -> str:
     """compare.md: the side-by-side headline table and the paired tests."""
     reports = comparison["reports"]
-    lines = [f"# Comparison on {comparison['dataset']}", "",
-             markdown_table(["method"] + [label for _, _, label, _ in HEADLINE],
-                            [[title(r)] + list(headline(r).values()) for r in reports]), "",
-             "## Paired tests on the same frames (Wilcoxon signed-rank, per-frame recall)", ""]
-    lines.append(markdown_table(
-        ["A", "B", "frames", "mean A - B", "p", "verdict"],
-        [[t["a"], t["b"], str(t["frames"]), fmt(t["mean_difference"]), fmt(t["p_value"]),
-          t["verdict"]] for t in comparison["paired_tests"]]))
+    lines = [
+        f"# Comparison on {comparison['dataset']}",
+        "",
+        markdown_table(
+            ["method"] + [label for _, _, label, _ in HEADLINE],
+            [[title(r)] + list(headline(r).values()) for r in reports],
+        ),
+        "",
+        "## Paired tests on the same frames (Wilcoxon signed-rank, per-frame recall)",
+        "",
+    ]
+    lines.append(
+        markdown_table(
+            ["A", "B", "frames", "mean A - B", "p", "verdict"],
+            [
+                [
+                    t["a"],
+                    t["b"],
+                    str(t["frames"]),
+                    fmt(t["mean_difference"]),
+                    fmt(t["p_value"]),
+                    t["verdict"],
+                ]
+                for t in comparison["paired_tests"]
+            ],
+        )
+    )
     return "\n".join(lines) + "\n"
 
 

@@ -5,6 +5,7 @@ flat whatever the dataset size. Each frame's :class:`~tsrkit.records.FrameRecord
 a key made of the image's hash and the plugins' names, versions and parameters, so a killed run
 resumes where it stopped.
 """
+
 from __future__ import annotations
 
 import hashlib
@@ -57,8 +58,12 @@ def plugin_identity(plugin: Plugin | None) -> dict[str, Any] | None:
     except PluginNotFound:
         version = plugin.version or "0"
     params = json.loads(json.dumps(plugin.params, default=str, sort_keys=True))
-    return {"name": plugin.name, "version": version, "params": params,
-            "source_sha256": source_hash(type(plugin))}
+    return {
+        "name": plugin.name,
+        "version": version,
+        "params": params,
+        "source_sha256": source_hash(type(plugin)),
+    }
 
 
 def source_hash(cls: type) -> str | None:
@@ -115,8 +120,9 @@ def compute_record(index: int, sample: Sample, job: Job) -> FrameRecord:
     except TsrkitError:  # a setup problem (missing model...) would recur on every frame
         raise
     except Exception as exc:  # a crashing plugin costs one frame, not the run
-        return FrameRecord(sample.source, index,
-                           skipped=f"plugin error: {type(exc).__name__}: {exc}")
+        return FrameRecord(
+            sample.source, index, skipped=f"plugin error: {type(exc).__name__}: {exc}"
+        )
     return replace(FrameRecord.from_result(result, str(lighting)), index=index)
 
 
@@ -126,8 +132,7 @@ def classify_annotations(classifier: Classifier, frame: Frame, sample: Sample) -
     start = time.perf_counter()
     detections = classifier.classify(frame, candidates)
     ms = (time.perf_counter() - start) * 1000.0
-    return FrameResult(frame.source, frame.index, frame.width, frame.height, ms,
-                       tuple(detections))
+    return FrameResult(frame.source, frame.index, frame.width, frame.height, ms, tuple(detections))
 
 
 _WORKER_JOB: Job | None = None
@@ -158,8 +163,12 @@ def _run_in_worker(index: int, sample: Sample) -> FrameRecord:
     return process_sample(index, sample, _WORKER_JOB)
 
 
-def ordered(submit: Callable[[int, Sample], Any], result: Callable[[Any], FrameRecord],
-            samples: Iterable[Sample], window: int) -> Iterator[FrameRecord]:
+def ordered(
+    submit: Callable[[int, Sample], Any],
+    result: Callable[[Any], FrameRecord],
+    samples: Iterable[Sample],
+    window: int,
+) -> Iterator[FrameRecord]:
     """Submit tasks with at most ``window`` in flight; yield their results in dataset order."""
     pending: deque = deque()
     for index, sample in enumerate(samples):
@@ -170,8 +179,13 @@ def ordered(submit: Callable[[int, Sample], Any], result: Callable[[Any], FrameR
         yield result(pending.popleft())
 
 
-def run_records(samples: Iterable[Sample], job: Job, workers: int = 1, engine: str = "local",
-                scheduler: Any = None) -> Iterator[FrameRecord]:
+def run_records(
+    samples: Iterable[Sample],
+    job: Job,
+    workers: int = 1,
+    engine: str = "local",
+    scheduler: Any = None,
+) -> Iterator[FrameRecord]:
     """Frame records in dataset order, computed in this process, a process pool or on Dask."""
     if engine not in ENGINES:
         raise BenchmarkError(f"unknown engine '{engine}' (choose {' or '.join(ENGINES)})")
@@ -182,14 +196,20 @@ def run_records(samples: Iterable[Sample], job: Job, workers: int = 1, engine: s
     elif workers == 1:
         yield from (process_sample(i, s, job) for i, s in enumerate(samples))
     else:
-        with ProcessPoolExecutor(workers, mp_context=_pool_context(), initializer=_init_worker,
-                                 initargs=(job,)) as pool:
-            yield from ordered(lambda i, s: pool.submit(_run_in_worker, i, s),
-                               lambda f: f.result(), samples, 4 * workers)
+        with ProcessPoolExecutor(
+            workers, mp_context=_pool_context(), initializer=_init_worker, initargs=(job,)
+        ) as pool:
+            yield from ordered(
+                lambda i, s: pool.submit(_run_in_worker, i, s),
+                lambda f: f.result(),
+                samples,
+                4 * workers,
+            )
 
 
-def _run_dask(samples: Iterable[Sample], job: Job, workers: int,
-              scheduler: Any) -> Iterator[FrameRecord]:
+def _run_dask(
+    samples: Iterable[Sample], job: Job, workers: int, scheduler: Any
+) -> Iterator[FrameRecord]:
     from distributed import Client, LocalCluster
 
     cluster = None
@@ -204,8 +224,12 @@ def _run_dask(samples: Iterable[Sample], job: Job, workers: int,
     try:
         shared = client.scatter(job, broadcast=True)
         window = 4 * max(workers, len(client.scheduler_info()["workers"]))
-        yield from ordered(lambda i, s: client.submit(process_sample, i, s, shared, pure=False),
-                           lambda f: f.result(), samples, window)
+        yield from ordered(
+            lambda i, s: client.submit(process_sample, i, s, shared, pure=False),
+            lambda f: f.result(),
+            samples,
+            window,
+        )
     finally:
         client.close()
         if cluster is not None:

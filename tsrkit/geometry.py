@@ -4,6 +4,7 @@ Every box in tsrkit is ``(x_min, y_min, x_max, y_max)`` (x right, y down); COCO'
 ``[x, y, width, height]`` exists only at the file boundary (:func:`xyxy_to_xywh`,
 :func:`xywh_to_xyxy`). Array functions take any ``(N, 4)`` array-like and return NumPy arrays.
 """
+
 from __future__ import annotations
 
 from collections.abc import Sequence
@@ -23,8 +24,9 @@ def as_boxes(boxes) -> np.ndarray:
     """
     array = np.asarray(boxes, dtype=float).reshape(-1, 4)
     if np.any(array[:, 2] < array[:, 0]) or np.any(array[:, 3] < array[:, 1]):
-        raise ValueError("boxes must be (x_min, y_min, x_max, y_max) with x_min <= x_max "
-                         "and y_min <= y_max")
+        raise ValueError(
+            "boxes must be (x_min, y_min, x_max, y_max) with x_min <= x_max and y_min <= y_max"
+        )
     return array
 
 
@@ -140,5 +142,9 @@ def clip_box(box: Sequence[float], width: int, height: int) -> tuple[int, int, i
     (0, 3, 8, 20)
     """
     x0, y0, x1, y1 = box
-    return (max(0, int(np.floor(x0))), max(0, int(np.floor(y0))),
-            min(width, int(np.ceil(x1))), min(height, int(np.ceil(y1))))
+    return (
+        max(0, int(np.floor(x0))),
+        max(0, int(np.floor(y0))),
+        min(width, int(np.ceil(x1))),
+        min(height, int(np.ceil(y1))),
+    )

@@ -4,6 +4,7 @@ Each ``register_*`` hook receives a ``register`` callable; call it once per plug
 ``register_commands`` receives the root click group so a plugin can add a verb. The built-in
 methods, metrics, report writers and verbs are registered through these same hooks.
 """
+
 from __future__ import annotations
 
 from collections.abc import Callable
@@ -14,8 +15,15 @@ import pluggy
 if TYPE_CHECKING:
     import click
 
-    from tsrkit.plugin import (Classifier, DatasetFormat, Detector, Metric, ReportWriter,
-                               Tracker, Verifier)
+    from tsrkit.plugin import (
+        Classifier,
+        DatasetFormat,
+        Detector,
+        Metric,
+        ReportWriter,
+        Tracker,
+        Verifier,
+    )
 
 hookspec = pluggy.HookspecMarker("tsrkit")
 hookimpl = pluggy.HookimplMarker("tsrkit")

@@ -3,6 +3,7 @@
 16-bit samples are scaled down, alpha is dropped, grayscale is promoted to three channels
 (:func:`to_bgr8`). The error is a :class:`ImageReadError` naming the file and the problem.
 """
+
 from __future__ import annotations
 
 import os

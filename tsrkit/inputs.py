@@ -4,6 +4,7 @@ Images are returned as BGR uint8 whatever their file holds: 16-bit samples are s
 alpha is dropped, grayscale is promoted to three channels. Videos are decoded with OpenCV's
 FFmpeg backend.
 """
+
 from __future__ import annotations
 
 import os
@@ -15,10 +16,41 @@ import cv2
 from tsrkit.images import ImageReadError, read_image, to_bgr8
 from tsrkit.types import Frame, Skipped
 
-IMAGE_EXTENSIONS = {".jpg", ".jpeg", ".jpe", ".png", ".ppm", ".pgm", ".pbm", ".pnm", ".bmp",
-                    ".dib", ".tif", ".tiff", ".webp", ".jp2", ".sr", ".ras", ".exr", ".hdr"}
-VIDEO_EXTENSIONS = {".mp4", ".avi", ".mov", ".mkv", ".webm", ".m4v", ".mpg", ".mpeg", ".wmv",
-                    ".flv", ".ts", ".mts", ".3gp"}
+IMAGE_EXTENSIONS = {
+    ".jpg",
+    ".jpeg",
+    ".jpe",
+    ".png",
+    ".ppm",
+    ".pgm",
+    ".pbm",
+    ".pnm",
+    ".bmp",
+    ".dib",
+    ".tif",
+    ".tiff",
+    ".webp",
+    ".jp2",
+    ".sr",
+    ".ras",
+    ".exr",
+    ".hdr",
+}
+VIDEO_EXTENSIONS = {
+    ".mp4",
+    ".avi",
+    ".mov",
+    ".mkv",
+    ".webm",
+    ".m4v",
+    ".mpg",
+    ".mpeg",
+    ".wmv",
+    ".flv",
+    ".ts",
+    ".mts",
+    ".3gp",
+}
 
 
 def expand_paths(paths: Iterable[str | os.PathLike]) -> Iterator[Path | Skipped]:
@@ -37,8 +69,9 @@ def expand_paths(paths: Iterable[str | os.PathLike]) -> Iterator[Path | Skipped]
             yield Skipped(str(path), "no such file or folder")
 
 
-def iter_frames(paths: Iterable[str | os.PathLike], every: int = 1, start: int = 0,
-                end: int | None = None) -> Iterator[Frame | Skipped]:
+def iter_frames(
+    paths: Iterable[str | os.PathLike], every: int = 1, start: int = 0, end: int | None = None
+) -> Iterator[Frame | Skipped]:
     """Yield the frames of images, folders and videos; unusable inputs as :class:`Skipped`.
 
     Parameters
@@ -68,8 +101,9 @@ def iter_frames(paths: Iterable[str | os.PathLike], every: int = 1, start: int =
             yield Skipped(str(item), f"not an image or video (unsupported type '{suffix}')")
 
 
-def iter_video(path: Path, every: int = 1, start: int = 0,
-               end: int | None = None) -> Iterator[Frame | Skipped]:
+def iter_video(
+    path: Path, every: int = 1, start: int = 0, end: int | None = None
+) -> Iterator[Frame | Skipped]:
     """Decode ``path`` frame by frame, keeping frames ``start, start+every, ...`` before ``end``."""
     capture = cv2.VideoCapture(str(path), cv2.CAP_FFMPEG)
     try:
@@ -90,8 +124,9 @@ def iter_video(path: Path, every: int = 1, start: int = 0,
                 else:
                     decoded += 1
                     stamp = index / fps if fps > 0 else None
-                    yield Frame(image=to_bgr8(image), source=str(path), index=index,
-                                timestamp=stamp)
+                    yield Frame(
+                        image=to_bgr8(image), source=str(path), index=index, timestamp=stamp
+                    )
             index += 1
         if decoded == 0 and index <= start:
             yield Skipped(str(path), "no frames decoded (empty or unreadable video)")

@@ -4,6 +4,7 @@
 ``light_condition`` maps M onto the four classes of Table 4. The evaluation's lighting
 categories and the TL-recognizer detector both use it.
 """
+
 from __future__ import annotations
 
 import numpy as np

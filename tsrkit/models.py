@@ -4,6 +4,7 @@
 its version, the parameters, the training set's checksum and a sha256 of every array, so
 ``load_model`` can refuse a corrupt, truncated or mismatched file with a clear message.
 """
+
 from __future__ import annotations
 
 import hashlib
@@ -52,8 +53,15 @@ def _digest(array: np.ndarray) -> str:
     return hashlib.sha256(np.ascontiguousarray(array).tobytes()).hexdigest()
 
 
-def save_model(path: str | os.PathLike, model: Model, *, plugin: str, plugin_version: str,
-               params: Mapping[str, Any], training: Mapping[str, Any]) -> Path:
+def save_model(
+    path: str | os.PathLike,
+    model: Model,
+    *,
+    plugin: str,
+    plugin_version: str,
+    params: Mapping[str, Any],
+    training: Mapping[str, Any],
+) -> Path:
     """Write ``model`` for ``plugin``; return the ``.npz`` path.
 
     Raises
@@ -73,13 +81,26 @@ def save_model(path: str | os.PathLike, model: Model, *, plugin: str, plugin_ver
         fh.write(buffer.getvalue())
     from tsrkit import __version__
 
-    write_json(json_path, {
-        "format_version": FORMAT_VERSION, "plugin": plugin, "plugin_version": plugin_version,
-        "tsrkit_version": __version__, "params": _plain(params), "training": _plain(training),
-        "info": _plain(model.info),
-        "arrays": {k: {"shape": list(np.shape(v)), "dtype": str(np.asarray(v).dtype),
-                       "sha256": _digest(np.asarray(v))} for k, v in model.arrays.items()},
-    })
+    write_json(
+        json_path,
+        {
+            "format_version": FORMAT_VERSION,
+            "plugin": plugin,
+            "plugin_version": plugin_version,
+            "tsrkit_version": __version__,
+            "params": _plain(params),
+            "training": _plain(training),
+            "info": _plain(model.info),
+            "arrays": {
+                k: {
+                    "shape": list(np.shape(v)),
+                    "dtype": str(np.asarray(v).dtype),
+                    "sha256": _digest(np.asarray(v)),
+                }
+                for k, v in model.arrays.items()
+            },
+        },
+    )
     return npz_path
 
 
@@ -111,8 +132,10 @@ def load_model(path: str | os.PathLike, plugin: str) -> Model:
         raise ModelError(f"model {npz_path}: corrupt archive ({exc})") from None
     expected = meta["arrays"]
     if set(arrays) != set(expected):
-        raise ModelError(f"model {npz_path}: arrays {sorted(arrays)} do not match the "
-                         f"metadata {sorted(expected)}")
+        raise ModelError(
+            f"model {npz_path}: arrays {sorted(arrays)} do not match the "
+            f"metadata {sorted(expected)}"
+        )
     for name, array in arrays.items():
         if _digest(array) != expected[name].get("sha256"):
             raise ModelError(f"model {npz_path}: array '{name}' does not match its checksum")

@@ -4,6 +4,7 @@ A plugin lists :class:`Param` objects; values arrive as Python objects (API, YAM
 ``key=value`` strings (``--param``) and are checked against the schema. Every failure is a
 :class:`ParamError` whose message names the plugin, the key and what is allowed.
 """
+
 from __future__ import annotations
 
 import os
@@ -11,9 +12,9 @@ from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from tsrkit.errors import TsrkitError
-
 import yaml
+
+from tsrkit.errors import TsrkitError
 
 #: Parameter types and what they accept.
 TYPES = {
@@ -89,8 +90,12 @@ class Param:
 
     def to_json(self) -> dict[str, Any]:
         """The schema entry as plain JSON data."""
-        out = {"name": self.name, "type": self.type, "default": _jsonable(self.default),
-               "help": self.help}
+        out = {
+            "name": self.name,
+            "type": self.type,
+            "default": _jsonable(self.default),
+            "help": self.help,
+        }
         for key in ("min", "max", "length", "section"):
             if getattr(self, key) not in (None, ""):
                 out[key] = getattr(self, key)
@@ -105,8 +110,9 @@ class Param:
 
         def fail(reason: str = "") -> ParamError:
             why = f" ({reason})" if reason else ""
-            return ParamError(f"{owner}: parameter '{self.name}' must be {self.allowed()}; "
-                              f"got {value!r}{why}")
+            return ParamError(
+                f"{owner}: parameter '{self.name}' must be {self.allowed()}; got {value!r}{why}"
+            )
 
         try:
             out = _convert(self.type, value)
@@ -121,8 +127,9 @@ class Param:
             raise fail()
         if self.type in ("int", "float", "ints", "floats"):
             for item in items:
-                if (self.min is not None and item < self.min) or \
-                        (self.max is not None and item > self.max):
+                if (self.min is not None and item < self.min) or (
+                    self.max is not None and item > self.max
+                ):
                     raise fail("out of range")
         return out
 

@@ -2,6 +2,7 @@
 
 ``FrameResult.ms`` is the compute time of the plugins on that frame (decoding and I/O excluded).
 """
+
 from __future__ import annotations
 
 import time
@@ -25,7 +26,7 @@ class FrameResult:
     detections: tuple[Detection, ...]
 
     def to_record(self) -> dict[str, Any]:
-        """The JSON Lines record of ``tsrkit detect`` (:meth:`tsrkit.records.FrameRecord.to_json`)."""
+        """The JSON Lines record of ``tsrkit detect`` (``FrameRecord.to_json``)."""
         return FrameRecord.from_result(self).to_json()
 
 
@@ -64,8 +65,10 @@ class Pipeline:
             detections = self.tracker.update(frame, detections)
         if self.classifier is not None:
             states = self.classifier.classify(frame, [d.candidate for d in detections])
-            detections = [replace(s, origin=d.origin, track_id=d.track_id)
-                          for s, d in zip(states, detections)]
+            detections = [
+                replace(s, origin=d.origin, track_id=d.track_id) for s, d in zip(states, detections)
+            ]
         ms = (time.perf_counter() - start) * 1000.0
-        return FrameResult(frame.source, frame.index, frame.width, frame.height, ms,
-                           tuple(detections))
+        return FrameResult(
+            frame.source, frame.index, frame.width, frame.height, ms, tuple(detections)
+        )

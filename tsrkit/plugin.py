@@ -6,6 +6,7 @@ implements) and ``params`` (a tuple of :class:`tsrkit.params.Param`), then imple
 method of its kind. The core validates parameters before calling ``__init__``, so
 ``self.params`` always holds every declared key with a checked value.
 """
+
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
@@ -23,7 +24,7 @@ if TYPE_CHECKING:
     from tsrkit.report import RunResult
 
 
-class Plugin(ABC):
+class Plugin(ABC):  # noqa: B024 - the ABC metaclass serves the kinds' abstract methods
     """Common part of every plugin kind."""
 
     kind: ClassVar[str] = ""

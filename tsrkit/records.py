@@ -5,6 +5,7 @@ A :class:`FrameRecord` holds one frame's size, compute time, lighting and its de
 ``to_json`` / ``from_json`` are the one place records become JSON (the cache, ``detect`` and
 ``detections.jsonl`` all write this form) and come back.
 """
+
 from __future__ import annotations
 
 from collections.abc import Mapping
@@ -48,11 +49,19 @@ class DetectionRecord:
     def from_detection(cls, detection) -> DetectionRecord:
         """The record of a :class:`tsrkit.types.Detection` (coordinates rounded)."""
         c = detection.candidate
-        return cls(round(c.x, DECIMALS), round(c.y, DECIMALS), round(c.radius, DECIMALS),
-                   _rounded(c.object_bbox), _rounded(c.bbox), float(c.score), detection.state,
-                   {k: float(v) for k, v in detection.state_scores.items()}, detection.origin,
-                   None if c.housing_score is None else round(float(c.housing_score), 4),
-                   detection.track_id)
+        return cls(
+            round(c.x, DECIMALS),
+            round(c.y, DECIMALS),
+            round(c.radius, DECIMALS),
+            _rounded(c.object_bbox),
+            _rounded(c.bbox),
+            float(c.score),
+            detection.state,
+            {k: float(v) for k, v in detection.state_scores.items()},
+            detection.origin,
+            None if c.housing_score is None else round(float(c.housing_score), 4),
+            detection.track_id,
+        )
 
     def box(self, which: str) -> Box:
         """``lens_bbox`` for ``"lens"``, ``bbox`` (housing when fitted) for ``"housing"``."""
@@ -63,9 +72,16 @@ class DetectionRecord:
     def to_json(self) -> dict[str, Any]:
         """The JSON object of ``tsrkit detect`` for this detection."""
         out: dict[str, Any] = {
-            "x": self.x, "y": self.y, "radius": self.radius, "bbox": list(self.bbox),
-            "lens_bbox": list(self.lens_bbox), "score": self.score, "state": self.state,
-            "state_scores": dict(self.state_scores), "origin": self.origin}
+            "x": self.x,
+            "y": self.y,
+            "radius": self.radius,
+            "bbox": list(self.bbox),
+            "lens_bbox": list(self.lens_bbox),
+            "score": self.score,
+            "state": self.state,
+            "state_scores": dict(self.state_scores),
+            "origin": self.origin,
+        }
         if self.housing_score is not None:
             out["housing_score"] = self.housing_score
         if self.track_id is not None:
@@ -76,11 +92,19 @@ class DetectionRecord:
     def from_json(cls, data: Mapping[str, Any]) -> DetectionRecord:
         """Read :meth:`to_json`'s form back (older records without ``lens_bbox`` too)."""
         bbox = tuple(data["bbox"])
-        return cls(data["x"], data["y"], data["radius"], bbox,
-                   tuple(data.get("lens_bbox", bbox)), data["score"],
-                   data.get("state", "unknown"), dict(data.get("state_scores", {})),
-                   data.get("origin", "detected"), data.get("housing_score"),
-                   data.get("track_id"))
+        return cls(
+            data["x"],
+            data["y"],
+            data["radius"],
+            bbox,
+            tuple(data.get("lens_bbox", bbox)),
+            data["score"],
+            data.get("state", "unknown"),
+            dict(data.get("state_scores", {})),
+            data.get("origin", "detected"),
+            data.get("housing_score"),
+            data.get("track_id"),
+        )
 
 
 @dataclass(frozen=True)
@@ -104,16 +128,28 @@ class FrameRecord:
     @classmethod
     def from_result(cls, result, lighting: str | None = None) -> FrameRecord:
         """The record of a :class:`tsrkit.pipeline.FrameResult`."""
-        return cls(result.source, result.index, result.width, result.height, result.ms,
-                   lighting, tuple(DetectionRecord.from_detection(d) for d in result.detections))
+        return cls(
+            result.source,
+            result.index,
+            result.width,
+            result.height,
+            result.ms,
+            lighting,
+            tuple(DetectionRecord.from_detection(d) for d in result.detections),
+        )
 
     def to_json(self) -> dict[str, Any]:
         """``{"source", "frame", "width", "height", "ms", ["lighting"], "detections"}``, or
         ``{"source", "frame", "skipped"}``."""
         if self.skipped is not None:
             return {"source": self.source, "frame": self.index, "skipped": self.skipped}
-        out: dict[str, Any] = {"source": self.source, "frame": self.index, "width": self.width,
-                               "height": self.height, "ms": round(self.ms, DECIMALS)}
+        out: dict[str, Any] = {
+            "source": self.source,
+            "frame": self.index,
+            "width": self.width,
+            "height": self.height,
+            "ms": round(self.ms, DECIMALS),
+        }
         if self.lighting is not None:
             out["lighting"] = self.lighting
         out["detections"] = [d.to_json() for d in self.detections]
@@ -124,6 +160,12 @@ class FrameRecord:
         """Read :meth:`to_json`'s form back."""
         if "skipped" in data:
             return cls(data["source"], data.get("frame", 0), skipped=data["skipped"])
-        return cls(data["source"], data.get("frame", 0), data["width"], data["height"],
-                   data["ms"], data.get("lighting"),
-                   tuple(DetectionRecord.from_json(d) for d in data["detections"]))
+        return cls(
+            data["source"],
+            data.get("frame", 0),
+            data["width"],
+            data["height"],
+            data["ms"],
+            data.get("lighting"),
+            tuple(DetectionRecord.from_json(d) for d in data["detections"]),
+        )

@@ -7,6 +7,7 @@ others still load. ``TSRKIT_LOAD_PLUGINS`` (comma-separated entry-point names or
 empty for none) limits which installed plugins load; report writers (``writer-*``) and the
 internal plugins always load, since every report needs them.
 """
+
 from __future__ import annotations
 
 import fnmatch
@@ -22,15 +23,29 @@ import pluggy
 from tsrkit import hookspecs
 from tsrkit.errors import TsrkitError
 from tsrkit.params import ParamError, validate
-from tsrkit.plugin import (Classifier, DatasetFormat, Detector, Metric, Plugin, ReportWriter,
-                           Tracker, Verifier, is_trainable)
+from tsrkit.plugin import (
+    Classifier,
+    DatasetFormat,
+    Detector,
+    Metric,
+    Plugin,
+    ReportWriter,
+    Tracker,
+    Verifier,
+    is_trainable,
+)
 
 ENTRY_POINT_GROUP = "tsrkit"
 LOAD_ENV = "TSRKIT_LOAD_PLUGINS"
-KINDS = {"detector": "register_detectors", "verifier": "register_verifiers",
-         "classifier": "register_classifiers", "tracker": "register_trackers",
-         "format": "register_dataset_formats", "metric": "register_metrics",
-         "writer": "register_report_writers"}
+KINDS = {
+    "detector": "register_detectors",
+    "verifier": "register_verifiers",
+    "classifier": "register_classifiers",
+    "tracker": "register_trackers",
+    "format": "register_dataset_formats",
+    "metric": "register_metrics",
+    "writer": "register_report_writers",
+}
 #: The core's own plugin modules: the built-in metrics and command-line verbs.
 INTERNAL = {"tsrkit-metrics": "tsrkit.eval.builtin", "tsrkit-commands": "tsrkit.cli.commands"}
 #: Entry points that load whatever ``TSRKIT_LOAD_PLUGINS`` says.
@@ -68,10 +83,16 @@ class PluginInfo:
 
     def to_json(self) -> dict[str, Any]:
         """What ``tsrkit plugins --json`` prints for this plugin."""
-        return {"name": self.name, "kind": self.kind, "package": self.package,
-                "version": self.version, "summary": self.cls.summary,
-                "section": self.cls.section, "trainable": is_trainable(self.cls),
-                "params": [p.to_json() for p in self.cls.params]}
+        return {
+            "name": self.name,
+            "kind": self.kind,
+            "package": self.package,
+            "version": self.version,
+            "summary": self.cls.summary,
+            "section": self.cls.section,
+            "trainable": is_trainable(self.cls),
+            "params": [p.to_json() for p in self.cls.params],
+        }
 
 
 @dataclass(frozen=True)
@@ -83,8 +104,7 @@ class PluginFailure:
     error: str
 
     def to_json(self) -> dict[str, str]:
-        return {"name": self.plugin, "kind": "failed", "package": self.package,
-                "error": self.error}
+        return {"name": self.plugin, "kind": "failed", "package": self.package, "error": self.error}
 
 
 @dataclass
@@ -118,8 +138,9 @@ class Registry:
                 self.failures.append(PluginFailure(ep.name, dist, _describe(exc)))
         self.pm.check_pending()
 
-    def add(self, plugin: object, name: str, package: str = "<in-process>",
-            version: str = "0") -> None:
+    def add(
+        self, plugin: object, name: str, package: str = "<in-process>", version: str = "0"
+    ) -> None:
         """Register a plugin object (module or instance with hook implementations)."""
         self.pm.register(plugin, name=name)
         self._origin[name] = (package, version)
@@ -148,29 +169,35 @@ class Registry:
             raise PluginNotFound(f"no {kind} called '{name}' (available: {known})") from None
 
     @overload
-    def create(self, kind: Literal["detector"], name: str,
-               params: Mapping[str, Any] | None = None) -> Detector: ...
+    def create(
+        self, kind: Literal["detector"], name: str, params: Mapping[str, Any] | None = None
+    ) -> Detector: ...
     @overload
-    def create(self, kind: Literal["verifier"], name: str,
-               params: Mapping[str, Any] | None = None) -> Verifier: ...
+    def create(
+        self, kind: Literal["verifier"], name: str, params: Mapping[str, Any] | None = None
+    ) -> Verifier: ...
     @overload
-    def create(self, kind: Literal["classifier"], name: str,
-               params: Mapping[str, Any] | None = None) -> Classifier: ...
+    def create(
+        self, kind: Literal["classifier"], name: str, params: Mapping[str, Any] | None = None
+    ) -> Classifier: ...
     @overload
-    def create(self, kind: Literal["tracker"], name: str,
-               params: Mapping[str, Any] | None = None) -> Tracker: ...
+    def create(
+        self, kind: Literal["tracker"], name: str, params: Mapping[str, Any] | None = None
+    ) -> Tracker: ...
     @overload
-    def create(self, kind: Literal["format"], name: str,
-               params: Mapping[str, Any] | None = None) -> DatasetFormat: ...
+    def create(
+        self, kind: Literal["format"], name: str, params: Mapping[str, Any] | None = None
+    ) -> DatasetFormat: ...
     @overload
-    def create(self, kind: Literal["metric"], name: str,
-               params: Mapping[str, Any] | None = None) -> Metric: ...
+    def create(
+        self, kind: Literal["metric"], name: str, params: Mapping[str, Any] | None = None
+    ) -> Metric: ...
     @overload
-    def create(self, kind: Literal["writer"], name: str,
-               params: Mapping[str, Any] | None = None) -> ReportWriter: ...
+    def create(
+        self, kind: Literal["writer"], name: str, params: Mapping[str, Any] | None = None
+    ) -> ReportWriter: ...
     @overload
-    def create(self, kind: str, name: str,
-               params: Mapping[str, Any] | None = None) -> Plugin: ...
+    def create(self, kind: str, name: str, params: Mapping[str, Any] | None = None) -> Plugin: ...
 
     def create(self, kind: str, name: str, params: Mapping[str, Any] | None = None) -> Plugin:
         """Instantiate a plugin with validated parameters (typed by ``kind`` for the checker)."""
@@ -188,14 +215,16 @@ class Registry:
                 try:
                     impl.function(register=found.append)
                 except Exception as exc:
-                    self.failures.append(PluginFailure(
-                        impl.plugin_name, package, f"register: {_describe(exc)}"))
+                    self.failures.append(
+                        PluginFailure(impl.plugin_name, package, f"register: {_describe(exc)}")
+                    )
                     continue
                 for cls in found:
                     problem = _check_class(cls, kind, table[kind])
                     if problem:
                         self.failures.append(
-                            PluginFailure(impl.plugin_name, package, f"register: {problem}"))
+                            PluginFailure(impl.plugin_name, package, f"register: {problem}")
+                        )
                     else:
                         table[kind][cls.name] = PluginInfo(cls, package, version)
         self._plugins = table
@@ -225,8 +254,10 @@ def _check_class(cls: object, kind: str, seen: Mapping[str, PluginInfo]) -> str 
     if not cls.name:
         return f"{cls.__name__} has no name"
     if cls.name in seen:
-        return (f"duplicate {kind} name '{cls.name}' (already registered by "
-                f"{seen[cls.name].package}); the first one is kept")
+        return (
+            f"duplicate {kind} name '{cls.name}' (already registered by "
+            f"{seen[cls.name].package}); the first one is kept"
+        )
     try:
         validate(cls.params, {}, f"{kind} '{cls.name}'")
     except (ParamError, ValueError) as exc:

@@ -4,6 +4,7 @@ the headline figures as tables (rich on the terminal, Markdown for the writers).
 The files of a run's folder are written by report writers (``register_report_writers``; the
 built-in ones are in ``tsrkit_plugins.writers``), each atomically (:mod:`tsrkit.atomic`).
 """
+
 from __future__ import annotations
 
 import platform
@@ -15,8 +16,7 @@ from typing import Any
 
 from rich import box
 from rich.console import Console
-from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TextColumn,
-                           TimeRemainingColumn)
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 
 from tsrkit.errors import TsrkitError
@@ -25,11 +25,15 @@ from tsrkit.records import FrameRecord
 from tsrkit.types import Dataset, Sample
 
 #: (section, key, column label, format) of the headline figures.
-HEADLINE = (("per_frame", "recall_mean", "recall", ".3f"),
-            ("per_frame", "precision_mean", "prec.", ".3f"),
-            ("per_frame", "hit_frame_fraction", "hit", ".3f"), ("iou50", "ap", "AP50", ".3f"),
-            ("iou50", "ap_50_95", "AP", ".3f"), ("state", "accuracy", "state", ".3f"),
-            ("timing", "ms_per_frame_median", "ms", ".1f"))
+HEADLINE = (
+    ("per_frame", "recall_mean", "recall", ".3f"),
+    ("per_frame", "precision_mean", "prec.", ".3f"),
+    ("per_frame", "hit_frame_fraction", "hit", ".3f"),
+    ("iou50", "ap", "AP50", ".3f"),
+    ("iou50", "ap_50_95", "AP", ".3f"),
+    ("state", "accuracy", "state", ".3f"),
+    ("timing", "ms_per_frame_median", "ms", ".1f"),
+)
 
 
 class ProgressBar:
@@ -37,9 +41,15 @@ class ProgressBar:
 
     def __init__(self, total: int, enabled: bool, label: str = "benchmark"):
         self.progress = Progress(
-            TextColumn(f"[bold]{label}"), BarColumn(), MofNCompleteColumn(),
-            TextColumn("{task.fields[rate]} frames/s"), TimeRemainingColumn(),
-            console=Console(stderr=True), disable=not enabled, transient=False)
+            TextColumn(f"[bold]{label}"),
+            BarColumn(),
+            MofNCompleteColumn(),
+            TextColumn("{task.fields[rate]} frames/s"),
+            TimeRemainingColumn(),
+            console=Console(stderr=True),
+            disable=not enabled,
+            transient=False,
+        )
         self.task = self.progress.add_task("frames", total=total, rate="-")
 
     def __enter__(self) -> ProgressBar:
@@ -64,8 +74,15 @@ class ProgressBar:
 def versions() -> dict[str, str]:
     """Versions of Python and the libraries that shape the numbers."""
     found = {"python": platform.python_version()}
-    for package in ("tsrkit", "numpy", "opencv-python-headless", "opencv-python", "scipy",
-                    "scikit-learn", "pycocotools"):
+    for package in (
+        "tsrkit",
+        "numpy",
+        "opencv-python-headless",
+        "opencv-python",
+        "scipy",
+        "scikit-learn",
+        "pycocotools",
+    ):
         try:
             found[package] = metadata.version(package)
         except metadata.PackageNotFoundError:
@@ -101,19 +118,31 @@ def merge_sections(results: Iterable[tuple[str, Mapping[str, Any]]]) -> dict[str
         for section, value in sections.items():
             if section not in merged:
                 merged[section] = dict(value) if isinstance(value, Mapping) else value
-            elif (isinstance(value, Mapping) and isinstance(merged[section], dict)
-                  and not value.keys() & merged[section].keys()):
+            elif (
+                isinstance(value, Mapping)
+                and isinstance(merged[section], dict)
+                and not value.keys() & merged[section].keys()
+            ):
                 merged[section].update(value)
             else:
-                raise TsrkitError(f"metric '{name}' writes report section '{section}', which "
-                                  "another metric already wrote")
+                raise TsrkitError(
+                    f"metric '{name}' writes report section '{section}', which "
+                    "another metric already wrote"
+                )
     return merged
 
 
-def build_report(dataset: Dataset, plugins: Mapping[str, dict | None], settings: EvalSettings,
-                 sections: Mapping[str, Any], frames: int, timing: Mapping[str, Any],
-                 skipped: Sequence[Mapping[str, str]], files: Sequence[str] = (),
-                 notes: Sequence[str] = ()) -> dict[str, Any]:
+def build_report(
+    dataset: Dataset,
+    plugins: Mapping[str, dict | None],
+    settings: EvalSettings,
+    sections: Mapping[str, Any],
+    frames: int,
+    timing: Mapping[str, Any],
+    skipped: Sequence[Mapping[str, str]],
+    files: Sequence[str] = (),
+    notes: Sequence[str] = (),
+) -> dict[str, Any]:
     """``report.json``: the run's description, the metrics' sections, timing and outputs.
 
     Parameters
@@ -129,11 +158,16 @@ def build_report(dataset: Dataset, plugins: Mapping[str, dict | None], settings:
         Caveats a reader must see (e.g. a dataset that is not exhaustively labelled).
     """
     report: dict[str, Any] = {
-        "dataset": {"name": dataset.name, "format": dataset.format, "root": dataset.root,
-                    "samples": len(dataset),
-                    "box_convention": (dataset.info.get("box")
-                                       or dataset.info.get("box_convention") or "unknown")},
-        **{kind: identity for kind, identity in plugins.items()},
+        "dataset": {
+            "name": dataset.name,
+            "format": dataset.format,
+            "root": dataset.root,
+            "samples": len(dataset),
+            "box_convention": (
+                dataset.info.get("box") or dataset.info.get("box_convention") or "unknown"
+            ),
+        },
+        **dict(plugins.items()),
         "params": {kind: identity["params"] for kind, identity in plugins.items() if identity},
         "versions": versions(),
         "evaluated_box": settings.box if settings.detection else None,
@@ -158,8 +192,10 @@ def fmt(value: Any, spec: str = ".3f") -> str:
 
 def headline(report: dict) -> dict[str, str]:
     """The headline figures of a report, formatted."""
-    return {label: fmt((report.get(section) or {}).get(key), spec)
-            for section, key, label, spec in HEADLINE}
+    return {
+        label: fmt((report.get(section) or {}).get(key), spec)
+        for section, key, label, spec in HEADLINE
+    }
 
 
 def title(report: dict) -> str:
@@ -177,10 +213,13 @@ def markdown_table(header: list[str], rows: list[list[str]]) -> str:
 
 def report_table(reports: list[dict]) -> Table:
     """A rich table of the headline figures, one row per run."""
-    table = Table(title=f"tsrkit benchmark: {reports[0]['dataset']['name']} "
-                        f"({reports[0]['frames']} frames)", box=box.SIMPLE_HEAD, pad_edge=False,
-                  caption="recall, precision, hit: Zheng 5.2.1 per-frame means; AP50 / AP "
-                          "(0.5:0.95): pycocotools; state: accuracy; ms: median per frame")
+    table = Table(
+        title=f"tsrkit benchmark: {reports[0]['dataset']['name']} ({reports[0]['frames']} frames)",
+        box=box.SIMPLE_HEAD,
+        pad_edge=False,
+        caption="recall, precision, hit: Zheng 5.2.1 per-frame means; AP50 / AP "
+        "(0.5:0.95): pycocotools; state: accuracy; ms: median per frame",
+    )
     table.add_column("method", overflow="fold")
     for _, _, label, _ in HEADLINE:
         table.add_column(label, justify="right", min_width=5, no_wrap=True)

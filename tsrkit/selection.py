@@ -5,6 +5,7 @@ and the command line.
 config, which wins over the default detector) and gives each ``key=value`` to the plugin that
 declares ``key``; :func:`build_compare` does the same for several detectors side by side.
 """
+
 from __future__ import annotations
 
 import os
@@ -40,9 +41,15 @@ class Selection:
         return Pipeline(self.detector, self.classifier, self.tracker, self.verifier)
 
 
-def build(detector: str | None = None, verifier: str | None = None,
-          classifier: str | None = None, tracker: str | None = None, params: Params = (),
-          config: Config = None, classifier_alone: bool = False) -> Selection:
+def build(
+    detector: str | None = None,
+    verifier: str | None = None,
+    classifier: str | None = None,
+    tracker: str | None = None,
+    params: Params = (),
+    config: Config = None,
+    classifier_alone: bool = False,
+) -> Selection:
     """Instantiate the chosen plugins with validated, routed parameters.
 
     Parameters
@@ -70,12 +77,20 @@ def build(detector: str | None = None, verifier: str | None = None,
     for kind, name in chosen.items():
         registry.get(kind, name)  # a clear error for an unknown name before routing params
     routed = route_params(chosen, _assignments(params), settings)
-    return Selection(**{kind: registry.create(kind, name, routed[kind])  # type: ignore[arg-type]
-                        for kind, name in chosen.items()})
+    return Selection(
+        **{
+            kind: registry.create(kind, name, routed[kind])  # type: ignore[arg-type]
+            for kind, name in chosen.items()
+        }
+    )
 
 
-def build_compare(detectors: Sequence[str], classifier: str | None = None,
-                  verifier: str | None = None, params: Params = ()) -> list[Selection]:
+def build_compare(
+    detectors: Sequence[str],
+    classifier: str | None = None,
+    verifier: str | None = None,
+    params: Params = (),
+) -> list[Selection]:
     """One :class:`Selection` per detector, sharing the classifier and verifier.
 
     A key prefixed with a detector's name (``conspicuity.weights``) goes to that detector, one
@@ -84,39 +99,58 @@ def build_compare(detectors: Sequence[str], classifier: str | None = None,
     """
     assignments = _assignments(params)
     registry = get_registry()
-    shared = {kind: name for kind, name in (("verifier", verifier), ("classifier", classifier))
-              if name}
+    shared = {
+        kind: name for kind, name in (("verifier", verifier), ("classifier", classifier)) if name
+    }
     for kind, name in [*(("detector", d) for d in detectors), *shared.items()]:
         registry.get(kind, name)
-    declared = {(kind, name): {p.name for p in registry.get(kind, name).cls.params}
-                for kind, name in [*(("detector", d) for d in detectors), *shared.items()]}
-    per_run: list[dict[str, dict[str, Any]]] = [{kind: {} for kind in ("detector", *shared)}
-                                                for _ in detectors]
+    declared = {
+        (kind, name): {p.name for p in registry.get(kind, name).cls.params}
+        for kind, name in [*(("detector", d) for d in detectors), *shared.items()]
+    }
+    per_run: list[dict[str, dict[str, Any]]] = [
+        {kind: {} for kind in ("detector", *shared)} for _ in detectors
+    ]
     for key, value in assignments.items():
         prefix, dot, bare = key.partition(".")
         if dot and (prefix in detectors or prefix in ("detector", *shared)):
-            targets = [(i, "detector") for i, d in enumerate(detectors)
-                       if prefix in (d, "detector")] or [(i, prefix) for i in range(len(detectors))]
+            targets = [
+                (i, "detector") for i, d in enumerate(detectors) if prefix in (d, "detector")
+            ] or [(i, prefix) for i in range(len(detectors))]
         else:
             bare = key
-            targets = [(i, kind) for i, d in enumerate(detectors)
-                       for kind, name in (("detector", d), *shared.items())
-                       if bare in declared[(kind, name)]]
+            targets = [
+                (i, kind)
+                for i, d in enumerate(detectors)
+                for kind, name in (("detector", d), *shared.items())
+                if bare in declared[(kind, name)]
+            ]
             if not targets:
                 names = ", ".join([*detectors, *shared.values()])
-                raise ParamError(f"unknown parameter '{key}': none of {names} declares it "
-                                 "(prefix it with a detector name or with classifier. / "
-                                 "verifier.)")
+                raise ParamError(
+                    f"unknown parameter '{key}': none of {names} declares it "
+                    "(prefix it with a detector name or with classifier. / "
+                    "verifier.)"
+                )
         for i, kind in targets:
             per_run[i][kind][bare] = value
-    return [Selection(detector=registry.create("detector", d, per_run[i]["detector"]),
-                      **{kind: registry.create(kind, name, per_run[i][kind])  # type: ignore[arg-type]
-                         for kind, name in shared.items()})
-            for i, d in enumerate(detectors)]
+    return [
+        Selection(
+            detector=registry.create("detector", d, per_run[i]["detector"]),
+            **{
+                kind: registry.create(kind, name, per_run[i][kind])  # type: ignore[arg-type]
+                for kind, name in shared.items()
+            },
+        )
+        for i, d in enumerate(detectors)
+    ]
 
 
-def route_params(selected: Mapping[str, str], assignments: Mapping[str, Any],
-                 config: Mapping[str, Any] | None = None) -> dict[str, dict[str, Any]]:
+def route_params(
+    selected: Mapping[str, str],
+    assignments: Mapping[str, Any],
+    config: Mapping[str, Any] | None = None,
+) -> dict[str, dict[str, Any]]:
     """Give each ``key: value`` to the selected plugin that declares ``key``.
 
     A key may be prefixed with the plugin kind (``classifier.model``); an unprefixed key goes
@@ -132,19 +166,26 @@ def route_params(selected: Mapping[str, str], assignments: Mapping[str, Any],
         if dot and kind in selected:
             routed[kind][bare] = value
             continue
-        owners = [k for k, name in selected.items()
-                  if key in {p.name for p in registry.get(k, name).cls.params}]
+        owners = [
+            k
+            for k, name in selected.items()
+            if key in {p.name for p in registry.get(k, name).cls.params}
+        ]
         if len(owners) == 1:
             routed[owners[0]][key] = value
         elif owners:
-            raise ParamError(f"parameter '{key}' is declared by both {' and '.join(owners)}; "
-                             f"write {owners[0]}.{key}=...")
+            raise ParamError(
+                f"parameter '{key}' is declared by both {' and '.join(owners)}; "
+                f"write {owners[0]}.{key}=..."
+            )
         else:
             names = " or ".join(f"{k} '{n}'" for k, n in selected.items())
-            allowed = sorted({p.name for k, n in selected.items()
-                              for p in registry.get(k, n).cls.params})
-            raise ParamError(f"{names}: unknown parameter '{key}' "
-                             f"(allowed: {', '.join(allowed) or 'none'})")
+            allowed = sorted(
+                {p.name for k, n in selected.items() for p in registry.get(k, n).cls.params}
+            )
+            raise ParamError(
+                f"{names}: unknown parameter '{key}' (allowed: {', '.join(allowed) or 'none'})"
+            )
     return routed
 
 

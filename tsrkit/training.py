@@ -3,6 +3,7 @@
 Every trainable plugin follows :class:`tsrkit.plugin.Trainable`: ``fit(samples, *, detector=None)``;
 a verifier receives the detector whose candidates it learns to verify.
 """
+
 from __future__ import annotations
 
 import hashlib
@@ -20,12 +21,17 @@ from tsrkit.types import Dataset
 def trainable_plugin(name: str) -> PluginInfo:
     """The trainable detector, verifier or classifier called ``name``."""
     registry = get_registry()
-    candidates = [info for info in registry.plugins() if info.name == name
-                  and info.kind in ("detector", "verifier", "classifier")]
+    candidates = [
+        info
+        for info in registry.plugins()
+        if info.name == name and info.kind in ("detector", "verifier", "classifier")
+    ]
     if not candidates:
         known = sorted(i.name for i in registry.plugins() if is_trainable(i.cls))
-        raise TsrkitError(f"no trainable plugin called '{name}' (trainable: "
-                          f"{', '.join(known) or 'none installed'})")
+        raise TsrkitError(
+            f"no trainable plugin called '{name}' (trainable: "
+            f"{', '.join(known) or 'none installed'})"
+        )
     info = candidates[0]
     if not is_trainable(info.cls):
         raise TsrkitError(f"{info.kind} '{name}' is not trainable")
@@ -42,23 +48,38 @@ def dataset_checksum(dataset: Dataset) -> str:
     return digest.hexdigest()
 
 
-def train(name: str, dataset: Dataset, out: str | Path, params: Mapping[str, Any],
-          detector: Detector | None = None) -> Path:
+def train(
+    name: str,
+    dataset: Dataset,
+    out: str | Path,
+    params: Mapping[str, Any],
+    detector: Detector | None = None,
+) -> Path:
     """Fit plugin ``name`` on ``dataset`` with ``params``; write the model; return its path.
 
     ``detector`` is passed to ``fit`` (a verifier learns on that detector's candidates).
     """
     info = trainable_plugin(name)
     if info.kind == "verifier" and detector is None:
-        raise TsrkitError(f"verifier '{name}' learns on a detector's candidates: give one "
-                          "(tsrkit train NAME --detector X)")
+        raise TsrkitError(
+            f"verifier '{name}' learns on a detector's candidates: give one "
+            "(tsrkit train NAME --detector X)"
+        )
     plugin = info.create(**params)
     extra = {"detector": detector} if detector is not None else {}
     model = plugin.fit(dataset, **extra)  # type: ignore[attr-defined]
-    training = {"dataset": dataset.name, "samples": len(dataset),
-                "checksum": dataset_checksum(dataset)}
+    training = {
+        "dataset": dataset.name,
+        "samples": len(dataset),
+        "checksum": dataset_checksum(dataset),
+    }
     if detector is not None:
         training["detector"] = {"name": detector.name, "params": detector.params}
-    return save_model(out, model, plugin=info.name, plugin_version=info.version,
-                      params=plugin.params,  # type: ignore[arg-type]  # the instance's values
-                      training=training)
+    return save_model(
+        out,
+        model,
+        plugin=info.name,
+        plugin_version=info.version,
+        params=plugin.params,  # type: ignore[arg-type]  # the instance's values
+        training=training,
+    )

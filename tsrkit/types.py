@@ -3,6 +3,7 @@
 Images are NumPy arrays, BGR uint8, as OpenCV reads them. Coordinates are pixels, x right and
 y down; boxes are ``(x_min, y_min, x_max, y_max)``. See ``shared/DESIGN.md`` for the data path.
 """
+
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
@@ -63,11 +64,11 @@ class Candidate:
         return self.housing if self.housing is not None else self.bbox
 
     @classmethod
-    def from_circle(cls, x: float, y: float, radius: float, score: float,
-                    state: str | None = None) -> Candidate:
+    def from_circle(
+        cls, x: float, y: float, radius: float, score: float, state: str | None = None
+    ) -> Candidate:
         """Build a candidate whose box circumscribes the circle ``(x, y, radius)``."""
-        return cls(float(x), float(y), float(radius), circle_box(x, y, radius), float(score),
-                   state)
+        return cls(float(x), float(y), float(radius), circle_box(x, y, radius), float(score), state)
 
     @classmethod
     def from_box(cls, bbox: Sequence[float], score: float, state: str | None = None) -> Candidate:

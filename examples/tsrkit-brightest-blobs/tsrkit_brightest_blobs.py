@@ -3,6 +3,7 @@
 Threshold the HSV value channel at a top percentile, label 8-connected blobs, and report the
 ``top`` brightest as circles. Deliberately simple: a template for plugin authors.
 """
+
 import cv2
 import numpy as np
 
@@ -33,8 +34,15 @@ class BrightestBlobs(Detector):
                 continue
             brightness = float(value[labels == label].mean())
             cx, cy = centroids[label]
-            found.append(Candidate(float(cx), float(cy), max(w, h) / 2.0,
-                                   (float(x), float(y), float(x + w), float(y + h)), brightness))
+            found.append(
+                Candidate(
+                    float(cx),
+                    float(cy),
+                    max(w, h) / 2.0,
+                    (float(x), float(y), float(x + w), float(y + h)),
+                    brightness,
+                )
+            )
         found.sort(key=lambda c: c.score, reverse=True)
         return found[: self.params["top"]]
 

@@ -4,6 +4,7 @@ A detection is matched as in Zheng 5.2.1 (its centre in the minimum enclosing ci
 ground-truth box, one detection per box, best score first); the metric reports the distance in
 pixels from its centre to the box centre, as the ``centre_error`` section of ``report.json``.
 """
+
 import math
 import statistics
 
@@ -29,9 +30,13 @@ class CentreError(Metric):
 
     def compute(self):
         d = self.distances
-        return {"centre_error": {"pairs": len(d),
-                                 "mean_px": statistics.fmean(d) if d else None,
-                                 "median_px": statistics.median(d) if d else None}}
+        return {
+            "centre_error": {
+                "pairs": len(d),
+                "mean_px": statistics.fmean(d) if d else None,
+                "median_px": statistics.median(d) if d else None,
+            }
+        }
 
 
 @hookimpl

@@ -1,5 +1,6 @@
 """Example third-party tsrkit report writer: ``missed.csv``, every ground-truth box no detection
 centre fell into (Zheng 5.2.1's rule), with its frame, state and size, to look at by hand."""
+
 import csv
 
 from tsrkit import ReportWriter, hookimpl

@@ -2,6 +2,7 @@
 histograms over its lens disk A1 and annulus A3 are matched by angle against one trained
 histogram per colour; the best match wins, and a low discriminative ratio gives ``unknown``.
 """
+
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
@@ -69,8 +70,9 @@ def chroma(lab: np.ndarray) -> np.ndarray:
     return np.sqrt(a * a + b * b)
 
 
-def lens_histograms(image: np.ndarray, lens: Candidate, bins: int, min_chroma: float,
-                    sigma: float) -> tuple[np.ndarray, np.ndarray, bool]:
+def lens_histograms(
+    image: np.ndarray, lens: Candidate, bins: int, min_chroma: float, sigma: float
+) -> tuple[np.ndarray, np.ndarray, bool]:
     """The A1 and A3 histograms of ``lens`` over its pixels of at least ``min_chroma``,
     smoothed by ``sigma`` bins, and whether A1 is the more saturated area."""
     area = rings(image, lens.x, lens.y, lens.radius)
@@ -78,13 +80,16 @@ def lens_histograms(image: np.ndarray, lens: Candidate, bins: int, min_chroma: f
     hsv = cv2.cvtColor(area.patch, cv2.COLOR_BGR2HSV)
     a1_saturated = mean_saturation(hsv, area.disk) >= mean_saturation(hsv, area.annulus)
     coloured = chroma(lab) >= min_chroma
-    return (smooth_histogram(ab_histogram(lab, area.disk & coloured, bins), sigma),
-            smooth_histogram(ab_histogram(lab, area.annulus & coloured, bins), sigma),
-            a1_saturated)
+    return (
+        smooth_histogram(ab_histogram(lab, area.disk & coloured, bins), sigma),
+        smooth_histogram(ab_histogram(lab, area.annulus & coloured, bins), sigma),
+        a1_saturated,
+    )
 
 
-def colour_score(a1: np.ndarray, a3: np.ndarray, a1_saturated: bool, trained: np.ndarray,
-                 mode: str) -> float:
+def colour_score(
+    a1: np.ndarray, a3: np.ndarray, a1_saturated: bool, trained: np.ndarray, mode: str
+) -> float:
     """Eq. 3.19 under either reading: the better of the A1 and A3 matches (``max``, the
     equation as printed) or the match of the more saturated area (``saturation``, the prose
     under it)."""
@@ -106,23 +111,68 @@ class AbHist(Classifier):
     summary = "CIELab a-b histogram angle matching of lens disk and annulus (trainable)"
     section = "Zheng 2016, 3.3 Eq. 3.16-3.20, 5.3"
     params = (
-        Param("model", "path", None, help="trained model (.npz); unset: the shipped default "
-              "trained on udacity_mit_tl_crops train"),
-        Param("bins", "int", 32, min=2, max=256, help="bins per axis of the a-b histogram "
-              "(used when training; a loaded model brings its own)", section="Eq. 3.18"),
-        Param("mode", "str", "saturation", choices=MODES, help="Eq. 3.19 reading: max over "
-              "A1/A3, or the more saturated area", section="Eq. 3.19"),
-        Param("min_chroma", "float", 10.0, min=0.0, max=180.0, help="leave pixels of lower "
-              "CIELab chroma (grey housing, white-hot centres) out of the histograms; 0 keeps "
-              "every pixel as Zheng does"),
-        Param("smooth", "float", 3.0, min=0.0, max=16.0, help="Gaussian sigma, in bins, "
-              "applied to every histogram before matching; 0 matches raw histograms as Zheng "
-              "does"),
-        Param("red_prior", "bool", True, help="warm-red prior: a-b angles between the trained "
-              "red and yellow modes count as red (see priors.py); off: Zheng's histograms as "
-              "trained"),
-        Param("min_ratio", "float", 0.0, min=0.0, max=1.0, help="discriminative ratio below "
-              "which the state is unknown", section="5.3"),
+        Param(
+            "model",
+            "path",
+            None,
+            help="trained model (.npz); unset: the shipped default "
+            "trained on udacity_mit_tl_crops train",
+        ),
+        Param(
+            "bins",
+            "int",
+            32,
+            min=2,
+            max=256,
+            help="bins per axis of the a-b histogram "
+            "(used when training; a loaded model brings its own)",
+            section="Eq. 3.18",
+        ),
+        Param(
+            "mode",
+            "str",
+            "saturation",
+            choices=MODES,
+            help="Eq. 3.19 reading: max over A1/A3, or the more saturated area",
+            section="Eq. 3.19",
+        ),
+        Param(
+            "min_chroma",
+            "float",
+            10.0,
+            min=0.0,
+            max=180.0,
+            help="leave pixels of lower "
+            "CIELab chroma (grey housing, white-hot centres) out of the histograms; 0 keeps "
+            "every pixel as Zheng does",
+        ),
+        Param(
+            "smooth",
+            "float",
+            3.0,
+            min=0.0,
+            max=16.0,
+            help="Gaussian sigma, in bins, "
+            "applied to every histogram before matching; 0 matches raw histograms as Zheng "
+            "does",
+        ),
+        Param(
+            "red_prior",
+            "bool",
+            True,
+            help="warm-red prior: a-b angles between the trained "
+            "red and yellow modes count as red (see priors.py); off: Zheng's histograms as "
+            "trained",
+        ),
+        Param(
+            "min_ratio",
+            "float",
+            0.0,
+            min=0.0,
+            max=1.0,
+            help="discriminative ratio below which the state is unknown",
+            section="5.3",
+        ),
     ) + region_params(lens_fraction=0.4)
 
     def __init__(self, **params):
@@ -137,23 +187,29 @@ class AbHist(Classifier):
             model = load_model(self.params["model"] or DEFAULT_MODEL, plugin=self.name)
             hist = model.arrays.get("histograms")
             if hist is None or hist.ndim != 3 or hist.shape[0] != len(self.states):
-                raise ModelError(f"model {self.params['model'] or DEFAULT_MODEL}: expected "
-                                 f"'histograms' of shape ({len(self.states)}, bins, bins)")
+                raise ModelError(
+                    f"model {self.params['model'] or DEFAULT_MODEL}: expected "
+                    f"'histograms' of shape ({len(self.states)}, bins, bins)"
+                )
             if self.params["red_prior"]:
                 red, yellow = self.states.index("red"), self.states.index("yellow")
                 hist = hist.copy()
-                hist[red], hist[yellow] = warm_red(hist[red], hist[yellow],
-                                                   bin_angles(hist.shape[1]))
+                hist[red], hist[yellow] = warm_red(
+                    hist[red], hist[yellow], bin_angles(hist.shape[1])
+                )
             self._trained = hist
         return self._trained
 
     def scores(self, image: np.ndarray, lens: Candidate) -> dict[str, float]:
         """Eq. 3.19 score of every colour for one lens."""
         trained = self.trained
-        a1, a3, a1_saturated = lens_histograms(image, lens, trained.shape[1],
-                                                 self.params["min_chroma"], self.params["smooth"])
-        return {state: colour_score(a1, a3, a1_saturated, trained[i], self.params["mode"])
-                for i, state in enumerate(self.states)}
+        a1, a3, a1_saturated = lens_histograms(
+            image, lens, trained.shape[1], self.params["min_chroma"], self.params["smooth"]
+        )
+        return {
+            state: colour_score(a1, a3, a1_saturated, trained[i], self.params["mode"])
+            for i, state in enumerate(self.states)
+        }
 
     def classify(self, frame: Frame, candidates: Sequence[Candidate]) -> list[Detection]:
         out = []
@@ -171,17 +227,22 @@ class AbHist(Classifier):
         sums = np.zeros((len(self.states), bins, bins), np.float64)
         counts = np.zeros(len(self.states), np.int64)
         for state, frame, lens in labelled_lenses(samples, self.states, self.params):
-            a1, a3, a1_saturated = lens_histograms(frame.image, lens, bins,
-                                                 self.params["min_chroma"], self.params["smooth"])
+            a1, a3, a1_saturated = lens_histograms(
+                frame.image, lens, bins, self.params["min_chroma"], self.params["smooth"]
+            )
             i = self.states.index(state)
             sums[i] += a1 if a1_saturated else a3
             counts[i] += 1
         missing = [s for s, n in zip(self.states, counts) if n == 0]
         if missing:
             raise ValueError(f"ab-hist: no training samples for {', '.join(missing)}")
-        return Model(arrays={"histograms": (sums / counts[:, None, None]).astype(np.float32),
-                             "counts": counts},
-                     info={"states": list(self.states), "bins": bins})
+        return Model(
+            arrays={
+                "histograms": (sums / counts[:, None, None]).astype(np.float32),
+                "counts": counts,
+            },
+            info={"states": list(self.states), "bins": bins},
+        )
 
 
 @hookimpl

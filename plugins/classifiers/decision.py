@@ -1,5 +1,6 @@
 """Turning per-state scores into a state: the best state, Zheng's discriminative ratio (5.3),
 and Lee's fusion of the lights of one approach (5.3.4)."""
+
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence

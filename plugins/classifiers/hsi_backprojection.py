@@ -3,6 +3,7 @@ Trained hue histograms per state and one saturation and one intensity histogram 
 back-projected onto the candidate's region, multiplied per pixel, averaged by a circular filter
 of the expected lens size, and the most probable state wins; below a threshold it is unknown.
 """
+
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
@@ -19,8 +20,14 @@ from tsrkit.plugin import Classifier, Detector
 from tsrkit.types import Candidate, Detection, Frame, Sample
 from tsrkit_plugins.classifiers.decision import UNKNOWN, best_state, fuse_lights
 from tsrkit_plugins.classifiers.priors import warm_red
-from tsrkit_plugins.classifiers.regions import (clip_box, disk_kernel, is_housing,
-                                                labelled_lenses, region_params, rings)
+from tsrkit_plugins.classifiers.regions import (
+    clip_box,
+    disk_kernel,
+    is_housing,
+    labelled_lenses,
+    region_params,
+    rings,
+)
 
 DEFAULT_MODEL = Path(__file__).parent / "models" / "hsi_backprojection_default"
 #: OpenCV 8-bit HSV ranges: hue 0-179, saturation and value 0-255 (Lee 5.3.3).
@@ -70,8 +77,9 @@ def unclipped(pixels: np.ndarray, clip: int) -> np.ndarray:
     return pixels[below] if below.any() else pixels
 
 
-def back_project(hsv: np.ndarray, hue: np.ndarray, saturation: np.ndarray,
-                 intensity: np.ndarray) -> np.ndarray:
+def back_project(
+    hsv: np.ndarray, hue: np.ndarray, saturation: np.ndarray, intensity: np.ndarray
+) -> np.ndarray:
     """Eq. 5.6-5.7: ``P_state = H_state(h) * S(s) * I(v)`` per pixel, shape ``(states, h, w)``."""
     si = saturation[hsv[..., 1]] * intensity[hsv[..., 2]]
     return hue[:, hsv[..., 0]] * si[None]
@@ -81,8 +89,9 @@ def expected_diameter(lens_size_m: float, focal_px: float, distance_m: float) ->
     """Eq. 5.8: ``d = 2 D f / L`` pixels, D in metres (read as the lens radius, see the class
     docstring), f in pixels, L in metres."""
     if distance_m <= 0 or focal_px <= 0:
-        raise ValueError(f"Eq. 5.8 needs a positive focal length and distance; got "
-                         f"f={focal_px}, L={distance_m}")
+        raise ValueError(
+            f"Eq. 5.8 needs a positive focal length and distance; got f={focal_px}, L={distance_m}"
+        )
     return 2.0 * lens_size_m * focal_px / distance_m
 
 
@@ -111,26 +120,84 @@ class HsiBackprojection(Classifier):
     summary = "HSI histogram back-projection with a lens-sized circular filter (trainable)"
     section = "Lee 2017, 5.3.3-5.3.4 Eq. 5.6-5.8"
     params = (
-        Param("model", "path", None, help="trained model (.npz); unset: the shipped default "
-              "trained on udacity_mit_tl_crops train"),
-        Param("pixels_per_sample", "int", 0, min=0, help="lit pixels taken from each training "
-              "sample; 0: the smallest lens of the training set (Lee 5.3.3)", section="5.3.3"),
-        Param("hue_smooth", "float", 8.0, min=0.0, max=30.0, help="circular Gaussian sigma, "
-              "in hue bins, applied to the trained hue histograms (0: Lee's raw histograms)"),
-        Param("clip", "int", 250, min=1, max=SV_BINS, help="pixels whose HSV value "
-              "(brightest channel, 0-255) reaches this count as sensor-clipped and get "
-              "probability 0 unless nothing else is lit; training leaves them out likewise "
-              "(256: every pixel, as Lee does; see unclipped())"),
-        Param("red_prior", "bool", True, help="warm-red prior: hues between the trained red "
-              "and yellow modes count as red (see priors.py); off: Lee's histograms as trained"),
-        Param("threshold", "float", 0.0, min=0.0, max=1.0, help="unknown when the best state's "
-              "probability is below this (t of 5.3.4)", section="5.3.4"),
-        Param("lens_size_m", "float", 0.15, min=0.0, help="D of Eq. 5.8 in metres (lens "
-              "radius), used with frame metadata focal_px and distance_m", section="Eq. 5.8"),
-        Param("lowpass", "float", 0.0, min=0.0, max=0.99, help="weight of the previous "
-              "frame's probabilities (0: off)", section="5.3.4"),
-        Param("fuse", "bool", False, help="fuse the candidates of a frame as lights of one "
-              "approach: consensus, else the most probable, else unknown", section="5.3.4"),
+        Param(
+            "model",
+            "path",
+            None,
+            help="trained model (.npz); unset: the shipped default "
+            "trained on udacity_mit_tl_crops train",
+        ),
+        Param(
+            "pixels_per_sample",
+            "int",
+            0,
+            min=0,
+            help="lit pixels taken from each training "
+            "sample; 0: the smallest lens of the training set (Lee 5.3.3)",
+            section="5.3.3",
+        ),
+        Param(
+            "hue_smooth",
+            "float",
+            8.0,
+            min=0.0,
+            max=30.0,
+            help="circular Gaussian sigma, "
+            "in hue bins, applied to the trained hue histograms (0: Lee's raw histograms)",
+        ),
+        Param(
+            "clip",
+            "int",
+            250,
+            min=1,
+            max=SV_BINS,
+            help="pixels whose HSV value "
+            "(brightest channel, 0-255) reaches this count as sensor-clipped and get "
+            "probability 0 unless nothing else is lit; training leaves them out likewise "
+            "(256: every pixel, as Lee does; see unclipped())",
+        ),
+        Param(
+            "red_prior",
+            "bool",
+            True,
+            help="warm-red prior: hues between the trained red "
+            "and yellow modes count as red (see priors.py); off: Lee's histograms as trained",
+        ),
+        Param(
+            "threshold",
+            "float",
+            0.0,
+            min=0.0,
+            max=1.0,
+            help="unknown when the best state's probability is below this (t of 5.3.4)",
+            section="5.3.4",
+        ),
+        Param(
+            "lens_size_m",
+            "float",
+            0.15,
+            min=0.0,
+            help="D of Eq. 5.8 in metres (lens "
+            "radius), used with frame metadata focal_px and distance_m",
+            section="Eq. 5.8",
+        ),
+        Param(
+            "lowpass",
+            "float",
+            0.0,
+            min=0.0,
+            max=0.99,
+            help="weight of the previous frame's probabilities (0: off)",
+            section="5.3.4",
+        ),
+        Param(
+            "fuse",
+            "bool",
+            False,
+            help="fuse the candidates of a frame as lights of one "
+            "approach: consensus, else the most probable, else unknown",
+            section="5.3.4",
+        ),
     ) + region_params(lens_fraction=0.3)
 
     def __init__(self, **params):
@@ -146,10 +213,15 @@ class HsiBackprojection(Classifier):
             path = self.params["model"] or DEFAULT_MODEL
             model = load_model(path, plugin=self.name)
             shapes = {k: v.shape for k, v in model.arrays.items()}
-            if shapes.get("hue") != (len(self.states), HUE_BINS) or \
-                    shapes.get("saturation") != (SV_BINS,) or shapes.get("intensity") != (SV_BINS,):
-                raise ModelError(f"model {path}: expected hue ({len(self.states)}, {HUE_BINS}), "
-                                 f"saturation and intensity ({SV_BINS},); got {shapes}")
+            if (
+                shapes.get("hue") != (len(self.states), HUE_BINS)
+                or shapes.get("saturation") != (SV_BINS,)
+                or shapes.get("intensity") != (SV_BINS,)
+            ):
+                raise ModelError(
+                    f"model {path}: expected hue ({len(self.states)}, {HUE_BINS}), "
+                    f"saturation and intensity ({SV_BINS},); got {shapes}"
+                )
             if self.params["red_prior"]:
                 hue = model.arrays["hue"].copy()
                 red, yellow = self.states.index("red"), self.states.index("yellow")
@@ -162,8 +234,9 @@ class HsiBackprojection(Classifier):
         """The circular filter's diameter in pixels for ``candidate``."""
         meta = frame.metadata
         if meta.get("focal_px") and meta.get("distance_m"):
-            return expected_diameter(self.params["lens_size_m"], float(meta["focal_px"]),
-                                     float(meta["distance_m"]))
+            return expected_diameter(
+                self.params["lens_size_m"], float(meta["focal_px"]), float(meta["distance_m"])
+            )
         if housing:
             x0, y0, x1, y1 = candidate.bbox
             return 2 * self.params["lens_fraction"] * min(x1 - x0, y1 - y0)
@@ -174,78 +247,104 @@ class HsiBackprojection(Classifier):
         pixels of value >= ``clip`` weighted 0 unless that leaves every probability 0 (see
         :func:`unclipped`)."""
         housing = is_housing(candidate, self.params["region"], self.params["elongation"])
-        bbox = candidate.bbox if housing else (candidate.x - candidate.radius,
-                                               candidate.y - candidate.radius,
-                                               candidate.x + candidate.radius,
-                                               candidate.y + candidate.radius)
+        bbox = (
+            candidate.bbox
+            if housing
+            else (
+                candidate.x - candidate.radius,
+                candidate.y - candidate.radius,
+                candidate.x + candidate.radius,
+                candidate.y + candidate.radius,
+            )
+        )
         x0, y0, x1, y1 = clip_box(bbox, frame.width, frame.height)
         hsv = cv2.cvtColor(frame.image[y0:y1, x0:x1], cv2.COLOR_BGR2HSV)
         arrays = self.model.arrays
         kernel = disk_kernel(self.filter_diameter(frame, candidate, housing) / 2)
         clip = self.params["clip"]
-        for cut in ((clip, SV_BINS) if clip < SV_BINS else (SV_BINS,)):
+        for cut in (clip, SV_BINS) if clip < SV_BINS else (SV_BINS,):
             intensity = arrays["intensity"].copy()
             intensity[cut:] = 0  # clipped pixels out, unless nothing else is lit
             maps = back_project(hsv, arrays["hue"], arrays["saturation"], intensity)
-            probs = np.array([cv2.filter2D(m, -1, kernel, borderType=cv2.BORDER_CONSTANT).max()
-                              for m in maps])
+            probs = np.array(
+                [cv2.filter2D(m, -1, kernel, borderType=cv2.BORDER_CONSTANT).max() for m in maps]
+            )
             if probs.any():
                 break
         return probs
 
-    def smoothed(self, frame: Frame, candidates: Sequence[Candidate],
-                 current: list[np.ndarray]) -> list[np.ndarray]:
+    def smoothed(
+        self, frame: Frame, candidates: Sequence[Candidate], current: list[np.ndarray]
+    ) -> list[np.ndarray]:
         """Apply the low-pass filter against the previous frame of the same source."""
         weight = self.params["lowpass"]
         previous = self._previous
         self._previous = (frame.source, frame.index, list(zip(candidates, current)))
-        if not weight or previous is None or previous[0] != frame.source or \
-                previous[1] != frame.index - 1:
+        if (
+            not weight
+            or previous is None
+            or previous[0] != frame.source
+            or previous[1] != frame.index - 1
+        ):
             return current
         out = []
         for candidate, probs in zip(candidates, current):
-            near = [(np.hypot(c.x - candidate.x, c.y - candidate.y), p) for c, p in previous[2]
-                    if np.hypot(c.x - candidate.x, c.y - candidate.y) <= 2 * candidate.radius]
-            out.append(low_pass(min(near, key=lambda n: n[0])[1], probs, weight) if near
-                       else probs)
+            near = [
+                (np.hypot(c.x - candidate.x, c.y - candidate.y), p)
+                for c, p in previous[2]
+                if np.hypot(c.x - candidate.x, c.y - candidate.y) <= 2 * candidate.radius
+            ]
+            out.append(low_pass(min(near, key=lambda n: n[0])[1], probs, weight) if near else probs)
         self._previous = (frame.source, frame.index, list(zip(candidates, out)))
         return out
 
     def classify(self, frame: Frame, candidates: Sequence[Candidate]) -> list[Detection]:
-        probs = self.smoothed(frame, candidates,
-                              [self.probabilities(frame, c) for c in candidates])
+        probs = self.smoothed(frame, candidates, [self.probabilities(frame, c) for c in candidates])
         threshold = self.params["threshold"]
         scores = [dict(zip(self.states, map(float, p))) for p in probs]
         states = [best_state(s) if max(s.values()) >= threshold else UNKNOWN for s in scores]
         if self.params["fuse"]:
-            fused = fuse_lights([(st, max(s.values())) for st, s in zip(states, scores)],
-                                threshold)
+            fused = fuse_lights([(st, max(s.values())) for st, s in zip(states, scores)], threshold)
             states = [fused] * len(states)
         return [Detection(c, st, s) for c, st, s in zip(candidates, states, scores)]
 
     def fit(self, samples: Iterable[Sample], *, detector: Detector | None = None) -> Model:
         """Hue histograms per state and shared S and I histograms from an equal number of lit
         pixels per labelled lens (Lee 5.3.3); deterministic."""
-        taken = [(state, lit_pixels(frame.image, lens))
-                 for state, frame, lens in labelled_lenses(samples, self.states, self.params)]
+        taken = [
+            (state, lit_pixels(frame.image, lens))
+            for state, frame, lens in labelled_lenses(samples, self.states, self.params)
+        ]
         if not taken:
-            raise ValueError("hsi-backprojection: no training samples with a red, yellow or "
-                             "green label")
+            raise ValueError(
+                "hsi-backprojection: no training samples with a red, yellow or green label"
+            )
         count = self.params["pixels_per_sample"] or min(len(p) for _, p in taken)
         kept = [(st, unclipped(p, self.params["clip"])[:count]) for st, p in taken]
-        pixels = {s: np.concatenate([p for st, p in kept if st == s] or
-                                    [np.zeros((0, 3), np.uint8)]) for s in self.states}
+        pixels = {
+            s: np.concatenate([p for st, p in kept if st == s] or [np.zeros((0, 3), np.uint8)])
+            for s in self.states
+        }
         missing = [s for s in self.states if not len(pixels[s])]
         if missing:
             raise ValueError(f"hsi-backprojection: no training samples for {', '.join(missing)}")
         every = np.concatenate(list(pixels.values()))
-        hue = [smooth_hue(scaled_histogram(pixels[s][:, 0], HUE_BINS), self.params["hue_smooth"])
-               for s in self.states]
-        return Model(arrays={"hue": np.stack(hue),
-                             "saturation": scaled_histogram(every[:, 1], SV_BINS),
-                             "intensity": scaled_histogram(every[:, 2], SV_BINS)},
-                     info={"states": list(self.states), "pixels_per_sample": int(count),
-                           "samples": len(taken)})
+        hue = [
+            smooth_hue(scaled_histogram(pixels[s][:, 0], HUE_BINS), self.params["hue_smooth"])
+            for s in self.states
+        ]
+        return Model(
+            arrays={
+                "hue": np.stack(hue),
+                "saturation": scaled_histogram(every[:, 1], SV_BINS),
+                "intensity": scaled_histogram(every[:, 2], SV_BINS),
+            },
+            info={
+                "states": list(self.states),
+                "pixels_per_sample": int(count),
+                "samples": len(taken),
+            },
+        )
 
 
 @hookimpl

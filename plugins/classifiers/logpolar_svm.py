@@ -8,6 +8,7 @@ Lee 2017, section 3.4.
 Not ``skops.io``: the model stays plain arrays + JSON (``tsrkit.models``), readable whatever the
 scikit-learn version; the one-vs-one decision is a few lines, tested equal to ``SVC.predict``.
 """
+
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping, Sequence
@@ -16,8 +17,7 @@ from typing import Any
 import cv2
 import numpy as np
 from sklearn.decomposition import PCA
-from sklearn.metrics.pairwise import (linear_kernel, polynomial_kernel, rbf_kernel,
-                                      sigmoid_kernel)
+from sklearn.metrics.pairwise import linear_kernel, polynomial_kernel, rbf_kernel, sigmoid_kernel
 from sklearn.svm import SVC
 
 from tsrkit.errors import TsrkitError
@@ -61,12 +61,14 @@ def log_polar(gray: np.ndarray, n_rho: int, n_theta: int) -> np.ndarray:
     """
     h, w = gray.shape
     centre = ((w - 1) / 2, (h - 1) / 2)
-    return cv2.warpPolar(gray, (n_rho, n_theta), centre, min(w, h) / 2,
-                         cv2.INTER_LINEAR | cv2.WARP_POLAR_LOG)
+    return cv2.warpPolar(
+        gray, (n_rho, n_theta), centre, min(w, h) / 2, cv2.INTER_LINEAR | cv2.WARP_POLAR_LOG
+    )
 
 
-def sign_vector(image: np.ndarray, bbox: Sequence[float],
-                settings: Mapping[str, Any]) -> np.ndarray:
+def sign_vector(
+    image: np.ndarray, bbox: Sequence[float], settings: Mapping[str, Any]
+) -> np.ndarray:
     """The feature vector of one box: ``n_rho * n_theta`` log-polar samples, or the raw crop."""
     gray = normalise_intensity(crop_gray(image, bbox, settings["crop_size"]))
     if settings["transform"] == "log-polar":
@@ -82,13 +84,15 @@ def kernel_matrix(x: np.ndarray, vectors: np.ndarray, info: Mapping[str, Any]) -
     if kind == "rbf":
         return rbf_kernel(x, vectors, gamma=info["gamma"])
     if kind == "poly":
-        return polynomial_kernel(x, vectors, degree=info["degree"], gamma=info["gamma"],
-                                 coef0=info["coef0"])
+        return polynomial_kernel(
+            x, vectors, degree=info["degree"], gamma=info["gamma"], coef0=info["coef0"]
+        )
     return sigmoid_kernel(x, vectors, gamma=info["gamma"], coef0=info["coef0"])
 
 
-def one_vs_one_votes(kernel: np.ndarray, dual_coef: np.ndarray, intercept: np.ndarray,
-                     n_support: np.ndarray) -> np.ndarray:
+def one_vs_one_votes(
+    kernel: np.ndarray, dual_coef: np.ndarray, intercept: np.ndarray, n_support: np.ndarray
+) -> np.ndarray:
     """Votes per class of libsvm's one-vs-one SVM, shape ``(n_samples, n_classes)``.
 
     For classes ``i < j`` the decision is ``sum_{s in i} a[j-1, s] K + sum_{s in j} a[i, s] K
@@ -105,8 +109,11 @@ def one_vs_one_votes(kernel: np.ndarray, dual_coef: np.ndarray, intercept: np.nd
         si = slice(starts[i], starts[i + 1])
         for j in range(i + 1, n_classes):
             sj = slice(starts[j], starts[j + 1])
-            decision = (kernel[:, si] @ dual_coef[j - 1, si] + kernel[:, sj] @ dual_coef[i, sj]
-                        + intercept[pair])
+            decision = (
+                kernel[:, si] @ dual_coef[j - 1, si]
+                + kernel[:, sj] @ dual_coef[i, sj]
+                + intercept[pair]
+            )
             votes[:, i] += decision > 0
             votes[:, j] += decision <= 0
             pair += 1
@@ -122,17 +129,28 @@ class LogPolarSVM(Classifier):
     states = ()
     params = (
         Param("model", "path", None, help="trained model (tsrkit train logpolar-svm ...)"),
-        Param("transform", "str", "log-polar", choices=("log-polar", "none"),
-              help="resample the crop log-polar (Lee) or use its pixels (baseline)"),
+        Param(
+            "transform",
+            "str",
+            "log-polar",
+            choices=("log-polar", "none"),
+            help="resample the crop log-polar (Lee) or use its pixels (baseline)",
+        ),
         Param("crop_size", "int", 64, min=8, max=512, help="crops are resized to this square"),
         Param("n_rho", "int", 32, min=2, max=256, help="log-radius samples", section="3.4"),
         Param("n_theta", "int", 32, min=2, max=256, help="angle samples", section="3.4"),
         Param("n_components", "int", 10, min=1, help="principal components", section="3.4"),
-        Param("kernel", "str", "rbf", choices=("linear", "rbf", "poly", "sigmoid"),
-              help="SVM kernel"),
+        Param(
+            "kernel", "str", "rbf", choices=("linear", "rbf", "poly", "sigmoid"), help="SVM kernel"
+        ),
         Param("C", "float", 10.0, min=0.0001, help="SVM regularisation"),
-        Param("gamma", "float", None, min=0,
-              help="kernel gamma; default 1 / (n_components * variance of the projections)"),
+        Param(
+            "gamma",
+            "float",
+            None,
+            min=0,
+            help="kernel gamma; default 1 / (n_components * variance of the projections)",
+        ),
         Param("degree", "int", 3, min=1, max=10, help="poly kernel degree"),
         Param("coef0", "float", 0.0, help="poly / sigmoid kernel constant"),
     )
@@ -141,8 +159,9 @@ class LogPolarSVM(Classifier):
         super().__init__(**params)
         self._model: Model | None = None
 
-    def _vectors(self, pairs: Iterable[tuple[np.ndarray, Sequence[float]]],
-                 settings: Mapping[str, Any]) -> np.ndarray:
+    def _vectors(
+        self, pairs: Iterable[tuple[np.ndarray, Sequence[float]]], settings: Mapping[str, Any]
+    ) -> np.ndarray:
         rows = [sign_vector(image, bbox, settings) for image, bbox in pairs]
         return np.array(rows, np.float64).reshape(len(rows), -1)
 
@@ -163,25 +182,39 @@ class LogPolarSVM(Classifier):
                 labels.append(ann.state)
         classes = sorted(set(labels))
         if len(classes) < 2 or len(labels) < p["n_components"]:
-            raise ValueError(f"logpolar-svm needs two classes and at least n_components="
-                             f"{p['n_components']} boxes; got {len(classes)} classes, "
-                             f"{len(labels)} boxes")
+            raise ValueError(
+                f"logpolar-svm needs two classes and at least n_components="
+                f"{p['n_components']} boxes; got {len(classes)} classes, "
+                f"{len(labels)} boxes"
+            )
         x = self._vectors(pairs, p)
         pca = PCA(n_components=p["n_components"], svd_solver="full").fit(x)
         projected = pca.transform(x)
-        gamma = p["gamma"] if p["gamma"] is not None else \
-            1.0 / (projected.shape[1] * projected.var())
+        gamma = (
+            p["gamma"] if p["gamma"] is not None else 1.0 / (projected.shape[1] * projected.var())
+        )
         y = np.searchsorted(classes, labels)
-        svm = SVC(kernel=p["kernel"], C=p["C"], gamma=gamma, degree=p["degree"],
-                  coef0=p["coef0"]).fit(projected, y)
-        arrays = {"pca_mean": pca.mean_, "pca_components": pca.components_,
-                  "explained_variance_ratio": pca.explained_variance_ratio_,
-                  "support_vectors": svm.support_vectors_, "dual_coef": svm.dual_coef_,
-                  "intercept": svm.intercept_, "n_support": svm.n_support_.astype(np.int64)}
-        info = {"classes": classes, "kernel": p["kernel"], "gamma": float(gamma),
-                "degree": p["degree"], "coef0": p["coef0"],
-                "explained_variance": float(pca.explained_variance_ratio_.sum()),
-                **{key: p[key] for key in FEATURE_KEYS}}
+        svm = SVC(
+            kernel=p["kernel"], C=p["C"], gamma=gamma, degree=p["degree"], coef0=p["coef0"]
+        ).fit(projected, y)
+        arrays = {
+            "pca_mean": pca.mean_,
+            "pca_components": pca.components_,
+            "explained_variance_ratio": pca.explained_variance_ratio_,
+            "support_vectors": svm.support_vectors_,
+            "dual_coef": svm.dual_coef_,
+            "intercept": svm.intercept_,
+            "n_support": svm.n_support_.astype(np.int64),
+        }
+        info = {
+            "classes": classes,
+            "kernel": p["kernel"],
+            "gamma": float(gamma),
+            "degree": p["degree"],
+            "coef0": p["coef0"],
+            "explained_variance": float(pca.explained_variance_ratio_.sum()),
+            **{key: p[key] for key in FEATURE_KEYS},
+        }
         return Model(arrays=arrays, info=info)
 
     def use_model(self, model: Model) -> None:
@@ -193,8 +226,10 @@ class LogPolarSVM(Classifier):
         """The model in use, loaded from the ``model`` parameter on first use."""
         if self._model is None:
             if self.params["model"] is None:
-                raise TsrkitError("logpolar-svm needs a model: train one with 'tsrkit train "
-                                  "logpolar-svm --dataset ... --out M' and pass --param model=M")
+                raise TsrkitError(
+                    "logpolar-svm needs a model: train one with 'tsrkit train "
+                    "logpolar-svm --dataset ... --out M' and pass --param model=M"
+                )
             self.use_model(load_model(self.params["model"], plugin=self.name))
         return self._model
 
@@ -217,8 +252,10 @@ class LogPolarSVM(Classifier):
         x = self._vectors(((frame.image, c.bbox) for c in candidates), model.info)
         votes = self.votes(x)
         share = votes / max(len(self.states) - 1, 1)
-        return [Detection(c, self.states[int(np.argmax(v))], dict(zip(self.states, s.tolist())))
-                for c, v, s in zip(candidates, votes, share)]
+        return [
+            Detection(c, self.states[int(np.argmax(v))], dict(zip(self.states, s.tolist())))
+            for c, v, s in zip(candidates, votes, share)
+        ]
 
 
 @hookimpl

@@ -8,6 +8,7 @@ mode away from red, and the red histogram takes over the warm arc between the re
 yellow mode. It has no tuned number: the boundary is the trained yellow mode. It is a deviation
 from Zheng 3.3 and Lee 5.3.3, who use the learned histograms as they are.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -26,8 +27,9 @@ def on_arc(angles: np.ndarray, start: float, end: float, period: float) -> np.nd
     return (offset > 0) & (offset < np.mod(end - start, period))
 
 
-def warm_red(red: np.ndarray, yellow: np.ndarray,
-             angles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def warm_red(
+    red: np.ndarray, yellow: np.ndarray, angles: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """The red and yellow histograms under the warm-red prior.
 
     ``angles`` gives each bin's hue angle in degrees (same shape as the histograms); a mode is

@@ -5,6 +5,7 @@ A housing box (KR, cinTA and MIT sets) is searched along its long axis for the d
 highest mean HSV saturation x value^2 over its non-blue pixels, i.e. the most saturated bright
 disk that is not sky or a blue housing: the lit lens.
 """
+
 from __future__ import annotations
 
 from collections.abc import Iterable, Iterator
@@ -25,13 +26,29 @@ def region_params(lens_fraction: float) -> tuple[Param, ...]:
     """The parameters saying how a classifier reads a candidate's box, with the plugin's own
     default ``lens_fraction`` (each classifier's is chosen by its own cross-validation)."""
     return (
-        Param("region", "str", "auto", choices=REGIONS,
-              help="lens: the candidate is the lit lens; housing: search its box for the lit "
-                   "lens; auto: housing when the box is elongated (see elongation)"),
-        Param("elongation", "float", 1.5, min=1.0,
-              help="auto region: a box whose long/short side ratio reaches this is a housing"),
-        Param("lens_fraction", "float", lens_fraction, min=0.05, max=0.5,
-              help="lens radius in a housing box, as a fraction of the box's short side"),
+        Param(
+            "region",
+            "str",
+            "auto",
+            choices=REGIONS,
+            help="lens: the candidate is the lit lens; housing: search its box for the lit "
+            "lens; auto: housing when the box is elongated (see elongation)",
+        ),
+        Param(
+            "elongation",
+            "float",
+            1.5,
+            min=1.0,
+            help="auto region: a box whose long/short side ratio reaches this is a housing",
+        ),
+        Param(
+            "lens_fraction",
+            "float",
+            lens_fraction,
+            min=0.05,
+            max=0.5,
+            help="lens radius in a housing box, as a fraction of the box's short side",
+        ),
     )
 
 
@@ -80,8 +97,8 @@ def rings(image: np.ndarray, x: float, y: float, radius: float) -> Rings:
     x0, y0, x1, y1 = clip_box((x - outer, y - outer, x + outer, y + outer), w, h)
     yy, xx = np.mgrid[y0:y1, x0:x1]
     dist2 = (xx + 0.5 - x) ** 2 + (yy + 0.5 - y) ** 2
-    disk = dist2 <= radius ** 2
-    annulus = ~disk & (dist2 <= outer ** 2)
+    disk = dist2 <= radius**2
+    annulus = ~disk & (dist2 <= outer**2)
     return Rings(image[y0:y1, x0:x1], disk, annulus)
 
 
@@ -107,8 +124,8 @@ def lit_map(bgr: np.ndarray) -> np.ndarray:
 def disk_kernel(radius: float) -> np.ndarray:
     """A normalised disk (sums to 1) of the given radius, at least one pixel."""
     half = max(int(np.floor(radius)), 0)
-    yy, xx = np.mgrid[-half:half + 1, -half:half + 1]
-    kernel = (xx ** 2 + yy ** 2 <= max(radius, 0.5) ** 2).astype(np.float32)
+    yy, xx = np.mgrid[-half : half + 1, -half : half + 1]
+    kernel = (xx**2 + yy**2 <= max(radius, 0.5) ** 2).astype(np.float32)
     return kernel / kernel.sum()
 
 
@@ -147,8 +164,9 @@ def lens_of(image: np.ndarray, candidate: Candidate, params) -> Candidate:
     return candidate
 
 
-def labelled_lenses(samples: Iterable[Sample], states: tuple[str, ...],
-                    params) -> Iterator[tuple[str, Frame, Candidate]]:
+def labelled_lenses(
+    samples: Iterable[Sample], states: tuple[str, ...], params
+) -> Iterator[tuple[str, Frame, Candidate]]:
     """``(state, frame, lens)`` for every annotation of ``samples`` whose state is in ``states``.
 
     Crop samples have one annotation covering the image; detection samples give one lens per

@@ -9,6 +9,7 @@ blob the colour whose posterior wins. Shipped default: ``models/adaboost_hsv_def
 Not ``skops.io``: the booster is evaluated once over the whole (hue, saturation) plane into Lee's
 lookup table; its stumps as arrays are that table's inputs, so the fitted object is not needed.
 """
+
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
@@ -33,8 +34,13 @@ from tsrkit.types import STATES, Candidate, Frame, Sample
 LEVELS = 256
 STUMP_KEYS = ("feature", "threshold", "left", "right", "alpha")
 #: The colours each ``target`` value trains and detects.
-TARGET_COLOURS = {"lights": ("red", "yellow", "green"), "red": ("red",),
-                  "yellow": ("yellow",), "green": ("green",), "orange": ("orange",)}
+TARGET_COLOURS = {
+    "lights": ("red", "yellow", "green"),
+    "red": ("red",),
+    "yellow": ("yellow",),
+    "green": ("green",),
+    "orange": ("orange",),
+}
 #: Trained with ``tsrkit train adaboost-hsv`` on roboflow_cinta_v2_id (CC BY 4.0); see its JSON.
 DEFAULT_MODEL = Path(__file__).parent / "models" / "adaboost_hsv_default"
 
@@ -58,8 +64,9 @@ def color_features(hue: np.ndarray, sat: np.ndarray) -> np.ndarray:
     lets a few stumps isolate red without a seam at 0 deg.
     """
     angle = np.asarray(hue, np.float64).ravel() * (2 * np.pi / LEVELS)
-    return np.column_stack([np.cos(angle), np.sin(angle),
-                            np.asarray(sat, np.float64).ravel() / (LEVELS - 1)]).astype(np.float32)
+    return np.column_stack(
+        [np.cos(angle), np.sin(angle), np.asarray(sat, np.float64).ravel() / (LEVELS - 1)]
+    ).astype(np.float32)
 
 
 def plane_features() -> np.ndarray:
@@ -103,18 +110,19 @@ def lens_mask(sat: np.ndarray, val: np.ndarray, min_value: int) -> np.ndarray:
     if usable.sum() < 2:
         return np.zeros(sat.shape, bool)
     score = ((sat.astype(np.uint16) * val) // 255).astype(np.uint8)
-    cut, _ = cv2.threshold(score[usable].reshape(-1, 1), 0, 255,
-                           cv2.THRESH_BINARY | cv2.THRESH_OTSU)
+    cut, _ = cv2.threshold(
+        score[usable].reshape(-1, 1), 0, 255, cv2.THRESH_BINARY | cv2.THRESH_OTSU
+    )
     bright = (score > cut) & usable
-    count, labels, stats, _ = cv2.connectedComponentsWithStats(bright.astype(np.uint8),
-                                                               connectivity=8)
+    count, labels, stats, _ = cv2.connectedComponentsWithStats(
+        bright.astype(np.uint8), connectivity=8
+    )
     if count < 2:
         return bright
     return labels == 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
 
 
-def box_target_mask(sat: np.ndarray, val: np.ndarray, labels: str,
-                    min_value: int) -> np.ndarray:
+def box_target_mask(sat: np.ndarray, val: np.ndarray, labels: str, min_value: int) -> np.ndarray:
     """Which pixels of one box are target pixels: all (``box``) or the lit lens (``lens``)."""
     if labels == "box":
         return np.ones(sat.shape, bool)
@@ -123,9 +131,15 @@ def box_target_mask(sat: np.ndarray, val: np.ndarray, labels: str,
     raise ValueError(f"pixel labelling must be 'box' or 'lens', not {labels!r}")
 
 
-def pixel_labels(sat: np.ndarray, val: np.ndarray, annotations, targets: Sequence[str],
-                 labels: str, hard_negatives: bool,
-                 min_value: int) -> list[tuple[np.ndarray, np.ndarray]]:
+def pixel_labels(
+    sat: np.ndarray,
+    val: np.ndarray,
+    annotations,
+    targets: Sequence[str],
+    labels: str,
+    hard_negatives: bool,
+    min_value: int,
+) -> list[tuple[np.ndarray, np.ndarray]]:
     """Target and background masks of one image, one pair per colour in ``targets``.
 
     Target pixels of colour c: the :func:`box_target_mask` pixels of boxes whose state is c.
@@ -156,8 +170,13 @@ def pixel_labels(sat: np.ndarray, val: np.ndarray, annotations, targets: Sequenc
     return out
 
 
-def pixel_histograms(samples: Iterable[Sample], targets: Sequence[str], min_value: int,
-                     labels: str = "lens", hard_negatives: bool = False) -> PixelCounts:
+def pixel_histograms(
+    samples: Iterable[Sample],
+    targets: Sequence[str],
+    min_value: int,
+    labels: str = "lens",
+    hard_negatives: bool = False,
+) -> PixelCounts:
     """Count each colour's target and background pixels over the (hue, saturation) plane.
 
     One pass over ``samples``; the masks come from :func:`pixel_labels`. The histograms have
@@ -171,8 +190,9 @@ def pixel_histograms(samples: Iterable[Sample], targets: Sequence[str], min_valu
     for sample in samples:
         hue, sat, val = hsv_planes(sample.load().image)
         index = hs_index(hue, sat)
-        masks = pixel_labels(sat, val, sample.annotations, targets, labels, hard_negatives,
-                             min_value)
+        masks = pixel_labels(
+            sat, val, sample.annotations, targets, labels, hard_negatives, min_value
+        )
         for t, (pos, neg) in enumerate(masks):
             positive[t] += np.bincount(index[pos], minlength=cells)
             negative[t] += np.bincount(index[neg], minlength=cells)
@@ -187,8 +207,9 @@ def _box_slice(bbox: Sequence[float], shape: tuple[int, int]) -> tuple[slice, sl
     return slice(y0, y1), slice(x0, x1)
 
 
-def fit_stumps(positive: np.ndarray, negative: np.ndarray, n_estimators: int,
-               seed: int) -> dict[str, np.ndarray]:
+def fit_stumps(
+    positive: np.ndarray, negative: np.ndarray, n_estimators: int, seed: int
+) -> dict[str, np.ndarray]:
     """Boost ``n_estimators`` decision stumps on the two pixel histograms, classes balanced.
 
     Every occupied cell of the plane is one training row weighted by its pixel count, each
@@ -200,16 +221,20 @@ def fit_stumps(positive: np.ndarray, negative: np.ndarray, n_estimators: int,
         When either class has no pixels.
     """
     if positive.sum() == 0 or negative.sum() == 0:
-        raise ValueError("training needs target and background pixels; found "
-                         f"{int(positive.sum())} target and {int(negative.sum())} background")
+        raise ValueError(
+            "training needs target and background pixels; found "
+            f"{int(positive.sum())} target and {int(negative.sum())} background"
+        )
     features = plane_features()
     pos_cells, neg_cells = np.flatnonzero(positive), np.flatnonzero(negative)
     x = np.concatenate([features[pos_cells], features[neg_cells]])
     y = np.r_[np.ones(pos_cells.size), np.zeros(neg_cells.size)]
-    weight = np.r_[positive[pos_cells] / (2 * positive.sum()),
-                   negative[neg_cells] / (2 * negative.sum())]
-    booster = AdaBoostClassifier(DecisionTreeClassifier(max_depth=1), n_estimators=n_estimators,
-                                 random_state=seed)
+    weight = np.r_[
+        positive[pos_cells] / (2 * positive.sum()), negative[neg_cells] / (2 * negative.sum())
+    ]
+    booster = AdaBoostClassifier(
+        DecisionTreeClassifier(max_depth=1), n_estimators=n_estimators, random_state=seed
+    )
     booster.fit(x, y, sample_weight=weight)
     return stump_arrays(booster)
 
@@ -222,8 +247,10 @@ def stump_arrays(booster: AdaBoostClassifier) -> dict[str, np.ndarray]:
     discrete-AdaBoost weight for which g(f) below is Friedman et al.'s probability estimate.
     A stump that found no split gets ``threshold = inf`` and votes the same on both sides.
     """
-    rows = [_stump_row(tree, weight / 2)
-            for tree, weight in zip(booster.estimators_, booster.estimator_weights_)]
+    rows = [
+        _stump_row(tree, weight / 2)
+        for tree, weight in zip(booster.estimators_, booster.estimator_weights_)
+    ]
     table = np.array(rows, np.float64).reshape(-1, 5)
     out = {key: table[:, i] for i, key in enumerate(STUMP_KEYS)}
     out["feature"] = out["feature"].astype(np.int64)
@@ -238,8 +265,13 @@ def _stump_row(tree: DecisionTreeClassifier, alpha: float) -> tuple[float, ...]:
 
     if t.node_count == 1:
         return 0, np.inf, vote(0), vote(0), alpha
-    return (int(t.feature[0]), float(t.threshold[0]), vote(t.children_left[0]),
-            vote(t.children_right[0]), alpha)
+    return (
+        int(t.feature[0]),
+        float(t.threshold[0]),
+        vote(t.children_left[0]),
+        vote(t.children_right[0]),
+        alpha,
+    )
 
 
 def boosted_margin(features: np.ndarray, stumps: dict[str, np.ndarray]) -> np.ndarray:
@@ -271,8 +303,9 @@ def posterior(likelihood: np.ndarray, prior: float) -> np.ndarray:
 
 def probability_table(stumps: dict[str, np.ndarray], prior: float) -> np.ndarray:
     """The posterior of every (hue, saturation) cell, float32, shape (65536,)."""
-    return posterior(margin_probability(boosted_margin(plane_features(), stumps)),
-                     prior).astype(np.float32)
+    return posterior(margin_probability(boosted_margin(plane_features(), stumps)), prior).astype(
+        np.float32
+    )
 
 
 def winning_colour(tables: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -283,8 +316,9 @@ def winning_colour(tables: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return tables.max(axis=0).astype(np.float32), tables.argmax(axis=0).astype(np.uint8)
 
 
-def probability_map(image: np.ndarray, table: np.ndarray, colour: np.ndarray,
-                    min_value: int) -> tuple[np.ndarray, np.ndarray]:
+def probability_map(
+    image: np.ndarray, table: np.ndarray, colour: np.ndarray, min_value: int
+) -> tuple[np.ndarray, np.ndarray]:
     """Per-pixel target probability and colour index of a BGR image by table lookup.
 
     Pixels darker than ``min_value`` get probability 0.
@@ -296,22 +330,24 @@ def probability_map(image: np.ndarray, table: np.ndarray, colour: np.ndarray,
     return prob, colour[index]
 
 
-def blob_colours(label_image: np.ndarray, prob: np.ndarray, colour: np.ndarray,
-                 labels: np.ndarray, colours: int) -> tuple[np.ndarray, np.ndarray]:
+def blob_colours(
+    label_image: np.ndarray, prob: np.ndarray, colour: np.ndarray, labels: np.ndarray, colours: int
+) -> tuple[np.ndarray, np.ndarray]:
     """Mean probability and probability-weighted majority colour of the blobs ``labels``."""
     fg = np.flatnonzero(label_image)
     blob = label_image.ravel()[fg]
     weight = prob.ravel()[fg]
     size = int(label_image.max()) + 1
-    means = np.bincount(blob, weights=weight, minlength=size) / \
-        np.maximum(np.bincount(blob, minlength=size), 1)
-    votes = np.bincount(blob * colours + colour.ravel()[fg], weights=weight,
-                        minlength=size * colours).reshape(size, colours)
+    means = np.bincount(blob, weights=weight, minlength=size) / np.maximum(
+        np.bincount(blob, minlength=size), 1
+    )
+    votes = np.bincount(
+        blob * colours + colour.ravel()[fg], weights=weight, minlength=size * colours
+    ).reshape(size, colours)
     return means[labels], votes[labels].argmax(axis=1)
 
 
-def blob_boxes(binary: np.ndarray,
-               min_size: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def blob_boxes(binary: np.ndarray, min_size: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """8-connected blobs whose width or height reaches ``min_size``.
 
     Returns
@@ -321,8 +357,9 @@ def blob_boxes(binary: np.ndarray,
         The blob label of each box in ``label_image``.
     label_image : ndarray of int32, the blob label of every pixel (0: background)
     """
-    count, label_image, stats, _ = cv2.connectedComponentsWithStats(
-        binary.astype(np.uint8), connectivity=8)
+    _count, label_image, stats, _ = cv2.connectedComponentsWithStats(
+        binary.astype(np.uint8), connectivity=8
+    )
     x, y, w, h = (stats[1:, i] for i in range(4))
     keep = np.flatnonzero((w >= min_size) | (h >= min_size))
     boxes = np.column_stack([x, y, x + w, y + h])[keep].astype(np.float64)
@@ -336,7 +373,7 @@ def largest_first_nms(boxes: np.ndarray, overlap: float, limit: int) -> np.ndarr
     for i in np.argsort(-areas, kind="stable"):
         if len(kept) == limit:
             break
-        if not kept or iou_matrix(boxes[i:i + 1], boxes[kept]).max() <= overlap:
+        if not kept or iou_matrix(boxes[i : i + 1], boxes[kept]).max() <= overlap:
             kept.append(int(i))
     return np.array(kept, np.intp)
 
@@ -367,35 +404,96 @@ class AdaBoostHSV(Detector):
     summary = "AdaBoost stumps on hue/saturation per pixel, probability map, largest blobs"
     section = "Lee 2017, 3.2 (Eq. 3.1)"
     params = (
-        Param("model", "path", None, help="trained model (tsrkit train adaboost-hsv ...); "
-              "unset: the shipped red/yellow/green model (trained on roboflow_cinta_v2_id)"),
-        Param("target", "str", "lights", choices=tuple(TARGET_COLOURS),
-              help="colour to train and detect; lights = red, yellow and green, each box "
-              "taking the colour whose posterior wins", section="3.2"),
-        Param("labels", "str", "lens", choices=("lens", "box"),
-              help="training target pixels: the lit lens in each box (Otsu on S*V, largest "
-              "blob) or every pixel of the box (round 1; right for filled signs)"),
-        Param("hard_negatives", "bool", False,
-              help="training: also use the unlit housing pixels of boxes as background"),
-        Param("n_estimators", "int", 50, min=1, max=1000, help="number of weak learners H",
-              section="3.2"),
-        Param("min_value", "int", 50, min=0, max=255,
-              help="pixels darker than this V are background (hue undefined); training too"),
-        Param("prior", "float", None, min=0.001, max=0.999,
-              help="P(sign) of Eq. 3.1 for every colour; default: the share of training "
-              "images holding the colour", section="Eq. 3.1"),
-        Param("threshold", "float", 0.9, min=0, max=1,
-              help="probability threshold (Lee: 0.5)"),
-        Param("min_size", "int", 3, min=1,
-              help="keep blobs whose width or height reaches this many pixels (Lee: 30)",
-              section="3.2"),
-        Param("nms_overlap", "float", 0.3, min=0, max=1,
-              help="a box overlapping a larger kept box by more IoU is dropped"),
-        Param("max_boxes", "int", 3, min=1,
-              help="boxes kept per frame, largest first (Lee: 1, the largest)", section="3.2"),
-        Param("expand_ratio", "float", 0.0, min=0,
-              help="two-colour signs: grow wide blobs to height = ratio * width (0: off)",
-              section="3.2"),
+        Param(
+            "model",
+            "path",
+            None,
+            help="trained model (tsrkit train adaboost-hsv ...); "
+            "unset: the shipped red/yellow/green model (trained on roboflow_cinta_v2_id)",
+        ),
+        Param(
+            "target",
+            "str",
+            "lights",
+            choices=tuple(TARGET_COLOURS),
+            help="colour to train and detect; lights = red, yellow and green, each box "
+            "taking the colour whose posterior wins",
+            section="3.2",
+        ),
+        Param(
+            "labels",
+            "str",
+            "lens",
+            choices=("lens", "box"),
+            help="training target pixels: the lit lens in each box (Otsu on S*V, largest "
+            "blob) or every pixel of the box (round 1; right for filled signs)",
+        ),
+        Param(
+            "hard_negatives",
+            "bool",
+            False,
+            help="training: also use the unlit housing pixels of boxes as background",
+        ),
+        Param(
+            "n_estimators",
+            "int",
+            50,
+            min=1,
+            max=1000,
+            help="number of weak learners H",
+            section="3.2",
+        ),
+        Param(
+            "min_value",
+            "int",
+            50,
+            min=0,
+            max=255,
+            help="pixels darker than this V are background (hue undefined); training too",
+        ),
+        Param(
+            "prior",
+            "float",
+            None,
+            min=0.001,
+            max=0.999,
+            help="P(sign) of Eq. 3.1 for every colour; default: the share of training "
+            "images holding the colour",
+            section="Eq. 3.1",
+        ),
+        Param("threshold", "float", 0.9, min=0, max=1, help="probability threshold (Lee: 0.5)"),
+        Param(
+            "min_size",
+            "int",
+            3,
+            min=1,
+            help="keep blobs whose width or height reaches this many pixels (Lee: 30)",
+            section="3.2",
+        ),
+        Param(
+            "nms_overlap",
+            "float",
+            0.3,
+            min=0,
+            max=1,
+            help="a box overlapping a larger kept box by more IoU is dropped",
+        ),
+        Param(
+            "max_boxes",
+            "int",
+            3,
+            min=1,
+            help="boxes kept per frame, largest first (Lee: 1, the largest)",
+            section="3.2",
+        ),
+        Param(
+            "expand_ratio",
+            "float",
+            0.0,
+            min=0,
+            help="two-colour signs: grow wide blobs to height = ratio * width (0: off)",
+            section="3.2",
+        ),
         Param("seed", "int", 0, help="random state of the booster"),
     )
 
@@ -417,32 +515,49 @@ class AdaBoostHSV(Detector):
         """
         p = self.params
         source = getattr(samples, "info", {})
-        counts = pixel_histograms(samples, self.colours, p["min_value"], p["labels"],
-                                  p["hard_negatives"])
+        counts = pixel_histograms(
+            samples, self.colours, p["min_value"], p["labels"], p["hard_negatives"]
+        )
         arrays = {}
         for t, colour in enumerate(self.colours):
-            stumps = fit_stumps(counts.positive[t], counts.negative[t], p["n_estimators"],
-                                p["seed"])
+            stumps = fit_stumps(
+                counts.positive[t], counts.negative[t], p["n_estimators"], p["seed"]
+            )
             arrays.update({f"{colour}_{key}": value for key, value in stumps.items()})
-        return Model(arrays=arrays, info={
-            "targets": list(self.colours), "labels": p["labels"],
-            "priors": dict(zip(self.colours, counts.image_priors.tolist())),
-            "target_pixels": dict(zip(self.colours, counts.positive.sum(axis=1).tolist())),
-            "background_pixels": dict(zip(self.colours, counts.negative.sum(axis=1).tolist())),
-            "images": counts.images,
-            "target_images": dict(zip(self.colours, counts.target_images.tolist())),
-            "data_licence": source.get("licence"), "data_citation": source.get("citation")})
+        return Model(
+            arrays=arrays,
+            info={
+                "targets": list(self.colours),
+                "labels": p["labels"],
+                "priors": dict(zip(self.colours, counts.image_priors.tolist())),
+                "target_pixels": dict(zip(self.colours, counts.positive.sum(axis=1).tolist())),
+                "background_pixels": dict(zip(self.colours, counts.negative.sum(axis=1).tolist())),
+                "images": counts.images,
+                "target_images": dict(zip(self.colours, counts.target_images.tolist())),
+                "data_licence": source.get("licence"),
+                "data_citation": source.get("citation"),
+            },
+        )
 
     def use_model(self, model: Model) -> None:
         """Build the lookup tables from ``model`` (a fitted or loaded model)."""
         missing = [c for c in self.colours if c not in model.info.get("targets", ())]
         if missing:
-            raise TsrkitError(f"adaboost-hsv: the model detects {model.info.get('targets')} "
-                              f"but target={self.params['target']!r} needs {missing}")
-        tables = np.stack([probability_table(
-            {key: np.asarray(model.arrays[f"{colour}_{key}"]) for key in STUMP_KEYS},
-            self.params["prior"] if self.params["prior"] is not None
-            else float(model.info["priors"][colour])) for colour in self.colours])
+            raise TsrkitError(
+                f"adaboost-hsv: the model detects {model.info.get('targets')} "
+                f"but target={self.params['target']!r} needs {missing}"
+            )
+        tables = np.stack(
+            [
+                probability_table(
+                    {key: np.asarray(model.arrays[f"{colour}_{key}"]) for key in STUMP_KEYS},
+                    self.params["prior"]
+                    if self.params["prior"] is not None
+                    else float(model.info["priors"][colour]),
+                )
+                for colour in self.colours
+            ]
+        )
         self._table, self._colour = winning_colour(tables)
 
     def table(self) -> np.ndarray:
@@ -458,8 +573,7 @@ class AdaBoostHSV(Detector):
         if not len(boxes):
             return []
         kept = largest_first_nms(boxes, p["nms_overlap"], p["max_boxes"])
-        means, winners = blob_colours(label_image, prob, colour, labels[kept],
-                                      len(self.colours))
+        means, winners = blob_colours(label_image, prob, colour, labels[kept], len(self.colours))
         out = []
         for i, mean, winner in zip(kept, means, winners):
             box = boxes[i]

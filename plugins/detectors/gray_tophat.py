@@ -5,6 +5,7 @@ small bright spots; Zheng's localization (3.2.2, ``localization.py``) then extra
 from it exactly as from a conspicuity map. The top-hat has no radius map, so each component's
 DRMShift window keeps the radius of the disk with the component's area.
 """
+
 from __future__ import annotations
 
 import cv2
@@ -14,8 +15,12 @@ from tsrkit.hookspecs import hookimpl
 from tsrkit.params import Param
 from tsrkit.plugin import Detector
 from tsrkit.types import Candidate, Frame
-from tsrkit_plugins.detectors.localization import (LOCALIZATION_PARAMS, ROI_PARAM, localize,
-                                                     region_of_interest)
+from tsrkit_plugins.detectors.localization import (
+    LOCALIZATION_PARAMS,
+    ROI_PARAM,
+    localize,
+    region_of_interest,
+)
 
 
 def white_tophat(image: np.ndarray, se_size: int) -> np.ndarray:
@@ -35,8 +40,15 @@ class GrayTophat(Detector):
     summary = "White top-hat on grayscale + Zheng's localization (GRAY-TOPHAT baseline)"
     section = "Zheng 2016, 5.2.2 (de Charette & Nashashibi) with 3.2.2"
     params = (
-        Param("se_size", "int", 21, min=3, max=201, section="5.2.2 (size not given; ours)",
-              help="structuring-element diameter in pixels; wider than the largest lens"),
+        Param(
+            "se_size",
+            "int",
+            21,
+            min=3,
+            max=201,
+            section="5.2.2 (size not given; ours)",
+            help="structuring-element diameter in pixels; wider than the largest lens",
+        ),
         ROI_PARAM,
     ) + LOCALIZATION_PARAMS
 

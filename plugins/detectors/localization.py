@@ -17,6 +17,7 @@ localization with ``from tsrkit_plugins.detectors.localization import LOCALIZATI
 localize`` (add the params to its schema, call ``localize(saliency, self.params)``), as
 conspicuity and gray-tophat do.
 """
+
 from __future__ import annotations
 
 from collections.abc import Mapping
@@ -32,27 +33,85 @@ from tsrkit.types import Candidate
 
 #: The localization parameters both detectors expose (Table 5-1 defaults where it gives one).
 LOCALIZATION_PARAMS = (
-    Param("h_peak", "float", 0.9, min=0.0, max=1.0, section="Table 5-1, Eq. 3.14",
-          help="threshold on the normalised working map for peak pixels"),
-    Param("n_top", "int", 10, min=1, section="Table 5-1",
-          help="number of top candidates to locate per frame"),
-    Param("n_pi", "int", 20, min=1, section="Table 5-1",
-          help="stop when one iteration brings more new candidates than this"),
-    Param("asp_min", "float", 0.6, min=0.0, max=1.0, section="Table 5-1",
-          help="minimum short/long side ratio of a component's bounding box (step 2.2)"),
-    Param("pd_min", "float", 0.0, min=0.0, max=1.0, section="Table 5-1",
-          help="minimum share of peak pixels in a component's bounding box (step 2.2)"),
-    Param("shift_tol", "float", 0.5, min=0.0, section="Algorithm 3-1 (h_c; no default given)",
-          help="DRMShift stops when the centre moves less than this (pixels)"),
-    Param("shift_iter", "int", 10, min=1, section="Algorithm 3-1 (n_max; no default given)",
-          help="DRMShift iteration limit"),
-    Param("max_iter", "int", 50, min=1, section="Figure 3-10 (a safety bound of ours)",
-          help="limit on localization iterations"),
+    Param(
+        "h_peak",
+        "float",
+        0.9,
+        min=0.0,
+        max=1.0,
+        section="Table 5-1, Eq. 3.14",
+        help="threshold on the normalised working map for peak pixels",
+    ),
+    Param(
+        "n_top",
+        "int",
+        10,
+        min=1,
+        section="Table 5-1",
+        help="number of top candidates to locate per frame",
+    ),
+    Param(
+        "n_pi",
+        "int",
+        20,
+        min=1,
+        section="Table 5-1",
+        help="stop when one iteration brings more new candidates than this",
+    ),
+    Param(
+        "asp_min",
+        "float",
+        0.6,
+        min=0.0,
+        max=1.0,
+        section="Table 5-1",
+        help="minimum short/long side ratio of a component's bounding box (step 2.2)",
+    ),
+    Param(
+        "pd_min",
+        "float",
+        0.0,
+        min=0.0,
+        max=1.0,
+        section="Table 5-1",
+        help="minimum share of peak pixels in a component's bounding box (step 2.2)",
+    ),
+    Param(
+        "shift_tol",
+        "float",
+        0.5,
+        min=0.0,
+        section="Algorithm 3-1 (h_c; no default given)",
+        help="DRMShift stops when the centre moves less than this (pixels)",
+    ),
+    Param(
+        "shift_iter",
+        "int",
+        10,
+        min=1,
+        section="Algorithm 3-1 (n_max; no default given)",
+        help="DRMShift iteration limit",
+    ),
+    Param(
+        "max_iter",
+        "int",
+        50,
+        min=1,
+        section="Figure 3-10 (a safety bound of ours)",
+        help="limit on localization iterations",
+    ),
 )
 
 #: The optional region of interest both detectors expose.
-ROI_PARAM = Param("roi_top", "float", 1.0, min=0.01, max=1.0, section="5.2.1",
-                  help="search only the upper fraction of the frame (the thesis used 0.6)")
+ROI_PARAM = Param(
+    "roi_top",
+    "float",
+    1.0,
+    min=0.01,
+    max=1.0,
+    section="5.2.1",
+    help="search only the upper fraction of the frame (the thesis used 0.6)",
+)
 
 #: Structuring element of Eq. 3.15: the disk of radius 1.
 DISK_1 = cv2.getStructuringElement(cv2.MORPH_CROSS, (3, 3))
@@ -62,7 +121,7 @@ def region_of_interest(image: np.ndarray, top: float) -> np.ndarray:
     """The upper ``top`` fraction of the frame (at least one row), as a view."""
     if not 0 < top <= 1:
         raise ValueError(f"roi_top must be in (0, 1]; got {top}")
-    return image[:max(1, int(round(image.shape[0] * top)))]
+    return image[: max(1, int(round(image.shape[0] * top)))]
 
 
 def normalise(wcm: np.ndarray) -> np.ndarray:
@@ -99,7 +158,8 @@ def components(mask: np.ndarray) -> Components:
     if w == 0:
         return Components(np.zeros((0, 4), np.int64), np.zeros(0, np.int64), np.zeros((0, 2)))
     _, _, stats, centroids = cv2.connectedComponentsWithStats(
-        np.ascontiguousarray(mask[y:y + h, x:x + w]), connectivity=8)
+        np.ascontiguousarray(mask[y : y + h, x : x + w]), connectivity=8
+    )
     boxes = stats[1:, :4] + np.array([x, y, 0, 0])
     return Components(boxes, stats[1:, cv2.CC_STAT_AREA], centroids[1:] + np.array([x, y]))
 
@@ -123,13 +183,18 @@ def nearest_cells(centres: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
 
 @lru_cache(maxsize=8)
 def _window_offsets(reach: int) -> tuple[np.ndarray, np.ndarray]:
-    dy, dx = np.mgrid[-reach:reach + 1, -reach:reach + 1]
+    dy, dx = np.mgrid[-reach : reach + 1, -reach : reach + 1]
     return dy.ravel(), dx.ravel()
 
 
-def drmshift(cm: np.ndarray, starts: np.ndarray, radius_map: np.ndarray | None = None,
-             radii: np.ndarray | None = None, tol: float = 0.5,
-             n_max: int = 10) -> tuple[np.ndarray, np.ndarray]:
+def drmshift(
+    cm: np.ndarray,
+    starts: np.ndarray,
+    radius_map: np.ndarray | None = None,
+    radii: np.ndarray | None = None,
+    tol: float = 0.5,
+    n_max: int = 10,
+) -> tuple[np.ndarray, np.ndarray]:
     """Algorithm 3-1 (dynamic radius mean shift) for many start points at once.
 
     Parameters
@@ -191,8 +256,9 @@ def drmshift(cm: np.ndarray, starts: np.ndarray, radius_map: np.ndarray | None =
     return centres, radius
 
 
-def non_overlapping(centres: np.ndarray, radius: np.ndarray, kept_centres: np.ndarray,
-                    kept_radius: np.ndarray) -> np.ndarray:
+def non_overlapping(
+    centres: np.ndarray, radius: np.ndarray, kept_centres: np.ndarray, kept_radius: np.ndarray
+) -> np.ndarray:
     """Indices of new circles that intersect or touch neither each other nor kept ones.
 
     Larger new circles win; a new circle touching a kept (earlier) one is dropped (3.2.2).
@@ -218,8 +284,9 @@ def too_many(new_count: int, found_count: int, n_pi: int) -> bool:
     return new_count > n_pi or (found_count > 0 and new_count > found_count)
 
 
-def clear_found(wcm: np.ndarray, raw_peaks: np.ndarray, centres: np.ndarray,
-                radius: np.ndarray) -> None:
+def clear_found(
+    wcm: np.ndarray, raw_peaks: np.ndarray, centres: np.ndarray, radius: np.ndarray
+) -> None:
     """Steps 3.1-3.2: zero the raw peak pixels and the new candidate disks in the working map."""
     wcm[raw_peaks > 0] = 0
     disks = np.zeros(wcm.shape, np.uint8)
@@ -228,8 +295,9 @@ def clear_found(wcm: np.ndarray, raw_peaks: np.ndarray, centres: np.ndarray,
     wcm[disks > 0] = 0
 
 
-def localize(cm: np.ndarray, params: Mapping[str, Any],
-             radius_map: np.ndarray | None = None) -> list[Candidate]:
+def localize(
+    cm: np.ndarray, params: Mapping[str, Any], radius_map: np.ndarray | None = None
+) -> list[Candidate]:
     """Figure 3-10: the iterative extraction of candidates from a saliency map.
 
     Parameters
@@ -259,8 +327,9 @@ def localize(cm: np.ndarray, params: Mapping[str, Any],
         keep = shape_filter(blobs, params["asp_min"], params["pd_min"])
         starts = blobs.centroids[keep][:, ::-1]
         sizes = np.maximum(1, np.rint(np.sqrt(blobs.areas[keep] / np.pi))).astype(np.int64)
-        centres, radius = drmshift(wcm, starts, radius_map, sizes, params["shift_tol"],
-                                   params["shift_iter"])
+        centres, radius = drmshift(
+            wcm, starts, radius_map, sizes, params["shift_tol"], params["shift_iter"]
+        )
         chosen = non_overlapping(centres, radius, found_c, found_r)
         if too_many(len(chosen), len(found_r), params["n_pi"]):
             break
@@ -272,11 +341,14 @@ def localize(cm: np.ndarray, params: Mapping[str, Any],
     return best_candidates(cm, found_c, found_r, params["n_top"])
 
 
-def best_candidates(cm: np.ndarray, centres: np.ndarray, radius: np.ndarray,
-                    n_top: int) -> list[Candidate]:
+def best_candidates(
+    cm: np.ndarray, centres: np.ndarray, radius: np.ndarray, n_top: int
+) -> list[Candidate]:
     """Candidates scored by ``cm`` at their rounded centre, the ``n_top`` best first."""
     cells = nearest_cells(centres, cm.shape)
     scores = cm[cells[:, 0], cells[:, 1]]
     order = np.argsort(-scores, kind="stable")[:n_top]
-    return [Candidate.from_circle(centres[i, 1] + 0.5, centres[i, 0] + 0.5, radius[i], scores[i])
-            for i in order]
+    return [
+        Candidate.from_circle(centres[i, 1] + 0.5, centres[i, 0] + 0.5, radius[i], scores[i])
+        for i in order
+    ]

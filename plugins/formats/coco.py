@@ -6,6 +6,7 @@ extra ``"state"`` key when it differs from what the label maps to, and non-label
 ``"attributes"`` (COCO readers ignore unknown keys). Images carry tsrkit's ``split`` and
 ``metadata`` the same way. Category and image ids start at 1.
 """
+
 from __future__ import annotations
 
 from collections import defaultdict
@@ -17,10 +18,21 @@ from tsrkit.geometry import xywh_to_xyxy, xyxy_to_xywh
 from tsrkit.hookspecs import hookimpl
 from tsrkit.plugin import DatasetFormat
 from tsrkit.types import Dataset, Sample
-from tsrkit_plugins.formats.common import (annotation, checked_box, class_names,
-                                           explicit_state, extra_attributes, field, json_safe,
-                                           numbers, raw_label, read_json, relative_source,
-                                           resolve_image, sniff_json)
+from tsrkit_plugins.formats.common import (
+    annotation,
+    checked_box,
+    class_names,
+    explicit_state,
+    extra_attributes,
+    field,
+    json_safe,
+    numbers,
+    raw_label,
+    read_json,
+    relative_source,
+    resolve_image,
+    sniff_json,
+)
 
 
 def _is_coco(data) -> bool:
@@ -44,25 +56,36 @@ class Coco(DatasetFormat):
         categories = {}
         for i, cat in enumerate(data["categories"]):
             categories[field(cat, "id", int, path, f"categories[{i}]")] = str(
-                field(cat, "name", (str, int), path, f"categories[{i}]"))
+                field(cat, "name", (str, int), path, f"categories[{i}]")
+            )
         by_image = defaultdict(list)
         for i, ann in enumerate(data["annotations"]):
             by_image[field(ann, "image_id", int, path, f"annotations[{i}]")].append(
-                _annotation(path, ann, f"annotations[{i}]", categories))
+                _annotation(path, ann, f"annotations[{i}]", categories)
+            )
         samples = []
         for i, image in enumerate(data["images"]):
             where = f"images[{i}]"
             image_id = field(image, "id", int, path, where)
             size = {k: image[k] for k in ("width", "height") if isinstance(image.get(k), int)}
-            samples.append(Sample(
-                resolve_image(path.parent, field(image, "file_name", str, path, where), images),
-                tuple(by_image.pop(image_id, ())), split=image.get("split"),
-                metadata={**(image.get("metadata") or {}), "coco_id": image_id}, **size))
+            samples.append(
+                Sample(
+                    resolve_image(path.parent, field(image, "file_name", str, path, where), images),
+                    tuple(by_image.pop(image_id, ())),
+                    split=image.get("split"),
+                    metadata={**(image.get("metadata") or {}), "coco_id": image_id},
+                    **size,
+                )
+            )
         if by_image:
-            raise DatasetError(path, f"annotations refer to unknown image ids "
-                                     f"{sorted(by_image)[:5]}", "annotations")
-        return Dataset(path.stem, tuple(samples), self.name, str(path.parent),
-                       {"annotation_file": str(path)})
+            raise DatasetError(
+                path,
+                f"annotations refer to unknown image ids {sorted(by_image)[:5]}",
+                "annotations",
+            )
+        return Dataset(
+            path.stem, tuple(samples), self.name, str(path.parent), {"annotation_file": str(path)}
+        )
 
     def write(self, dataset: Dataset, out: Path) -> None:
         out = Path(out)
@@ -70,17 +93,28 @@ class Coco(DatasetFormat):
         ids = {name: i for i, name in enumerate(names, 1)}
         images, annotations = [], []
         for image_id, sample in enumerate(dataset, 1):
-            image = {"id": image_id, "file_name": relative_source(sample.source, out.parent),
-                     "width": sample.width, "height": sample.height, "split": sample.split}
+            image = {
+                "id": image_id,
+                "file_name": relative_source(sample.source, out.parent),
+                "width": sample.width,
+                "height": sample.height,
+                "split": sample.split,
+            }
             metadata = json_safe({k: v for k, v in sample.metadata.items() if k != "coco_id"})
             if metadata:
                 image["metadata"] = metadata
             images.append(image)
             for ann in sample.annotations:
                 annotations.append(_coco_annotation(ann, len(annotations) + 1, image_id, ids))
-        write_json(out, {"info": {"description": dataset.name, "generator": "tsrkit"},
-                         "images": images, "annotations": annotations,
-                         "categories": [{"id": i, "name": n} for n, i in ids.items()]})
+        write_json(
+            out,
+            {
+                "info": {"description": dataset.name, "generator": "tsrkit"},
+                "images": images,
+                "annotations": annotations,
+                "categories": [{"id": i, "name": n} for n, i in ids.items()],
+            },
+        )
 
 
 def _annotation(path: Path, ann, where: str, categories: dict):
@@ -89,16 +123,25 @@ def _annotation(path: Path, ann, where: str, categories: dict):
         raise DatasetError(path, f"unknown category_id {category}", where)
     values = numbers(field(ann, "bbox", list, path, where), 4, path, where)
     bbox = checked_box(xywh_to_xyxy(*values), path, where)
-    return annotation(bbox, categories[category], explicit_state(ann, path, where),
-                      **(ann.get("attributes") or {}))
+    return annotation(
+        bbox,
+        categories[category],
+        explicit_state(ann, path, where),
+        **(ann.get("attributes") or {}),
+    )
 
 
 def _coco_annotation(ann, ann_id: int, image_id: int, ids: dict) -> dict:
     x, y, w, h = xyxy_to_xywh(ann.bbox)
     label = raw_label(ann)
-    record = {"id": ann_id, "image_id": image_id, "category_id": ids[label],
-              "bbox": [round(x, 3), round(y, 3), round(w, 3), round(h, 3)],
-              "area": round(w * h, 3), "iscrowd": 0}
+    record = {
+        "id": ann_id,
+        "image_id": image_id,
+        "category_id": ids[label],
+        "bbox": [round(x, 3), round(y, 3), round(w, 3), round(h, 3)],
+        "area": round(w * h, 3),
+        "iscrowd": 0,
+    }
     if ann.state != to_state(label):
         record["state"] = ann.state
     extra = extra_attributes(ann)

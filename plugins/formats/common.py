@@ -1,4 +1,5 @@
 """Helpers the format plugins share: image paths, raw labels, checked boxes and JSON input."""
+
 from __future__ import annotations
 
 import json
@@ -32,15 +33,17 @@ def relative_source(source: str, folder: Path) -> str:
     return Path(os.path.relpath(Path(source).resolve(), Path(folder).resolve())).as_posix()
 
 
-def annotation(bbox: Sequence[float], label: Any, state: str | None = None,
-               **attributes: Any) -> Annotation:
+def annotation(
+    bbox: Sequence[float], label: Any, state: str | None = None, **attributes: Any
+) -> Annotation:
     """An annotation whose raw ``label`` is kept in ``attributes["label"]``.
 
     ``state`` defaults to :func:`tsrkit.datasets.to_state` of the label.
     """
     label = str(label)
-    return Annotation(tuple(float(v) for v in bbox), state or to_state(label),
-                      {"label": label, **attributes})
+    return Annotation(
+        tuple(float(v) for v in bbox), state or to_state(label), {"label": label, **attributes}
+    )
 
 
 def raw_label(ann: Annotation) -> str:
@@ -105,8 +108,9 @@ def read_json(path: Path) -> Any:
     except FileNotFoundError:
         raise DatasetError(path, "file not found") from None
     except json.JSONDecodeError as exc:
-        raise DatasetError(path, f"not valid JSON ({exc.msg})",
-                           f"line {exc.lineno} column {exc.colno}") from None
+        raise DatasetError(
+            path, f"not valid JSON ({exc.msg})", f"line {exc.lineno} column {exc.colno}"
+        ) from None
 
 
 def field(record: Any, key: str, kind: type | tuple[type, ...], path: Path, where: str) -> Any:

@@ -6,6 +6,7 @@ Layouts read: ``ROOT/labels.csv`` (columns ``file`` and ``label`` required; ``sp
 ``Sample.metadata["lighting"]``), else ``ROOT/<label>/*.png`` or ``ROOT/<split>/<label>/*.png``
 with split one of train, valid, val, test.
 """
+
 from __future__ import annotations
 
 import csv
@@ -36,8 +37,9 @@ def _has_labels_csv(root: Path) -> bool:
 
 
 def _image_files(root: Path) -> list[Path]:
-    return sorted(p for p in root.rglob("*") if p.suffix.lower() in IMAGE_EXTENSIONS
-                  and p.is_file())
+    return sorted(
+        p for p in root.rglob("*") if p.suffix.lower() in IMAGE_EXTENSIONS and p.is_file()
+    )
 
 
 def _looks_like_label_folders(root: Path) -> bool:
@@ -47,11 +49,13 @@ def _looks_like_label_folders(root: Path) -> bool:
     return bool(images) and all(len(p.relative_to(root).parts) in (2, 3) for p in images)
 
 
-def crop_sample(source: str, label: str, width: int, height: int, split: str | None = None,
-                **metadata) -> Sample:
+def crop_sample(
+    source: str, label: str, width: int, height: int, split: str | None = None, **metadata
+) -> Sample:
     """A crop: one annotation ``(0, 0, width, height)`` with the crop's label and state."""
-    return Sample(source, (annotation((0, 0, width, height), label),), width, height, split,
-                  metadata)
+    return Sample(
+        source, (annotation((0, 0, width, height), label),), width, height, split, metadata
+    )
 
 
 class Crops(DatasetFormat):
@@ -76,8 +80,13 @@ class Crops(DatasetFormat):
             raise DatasetError(path, "no such crop folder or labels.csv")
         if not samples:
             raise DatasetError(path, "no crops found")
-        return Dataset(root.name, tuple(samples), self.name, str(root), {"task": "classification",
-                                                                         "box": "crop"})
+        return Dataset(
+            root.name,
+            tuple(samples),
+            self.name,
+            str(root),
+            {"task": "classification", "box": "crop"},
+        )
 
 
 def _from_csv(file: Path, images: Path | None) -> list[Sample]:
@@ -94,8 +103,11 @@ def _from_csv(file: Path, images: Path | None) -> list[Sample]:
             source = resolve_image(file.parent, row["file"], images)
             size = _size(file, row, source, where)
             metadata = {"lighting": row["condition"]} if row.get("condition") else {}
-            samples.append(crop_sample(source, row["label"], *size,
-                                       SPLITS.get(row.get("split") or "", None), **metadata))
+            samples.append(
+                crop_sample(
+                    source, row["label"], *size, SPLITS.get(row.get("split") or ""), **metadata
+                )
+            )
     return samples
 
 
@@ -104,8 +116,11 @@ def _size(file: Path, row: dict, source: str, where: str) -> tuple[int, int]:
         try:
             return int(row["width"]), int(row["height"])
         except ValueError:
-            raise DatasetError(file, f"width/height must be integers, got "
-                                     f"{row['width']!r}, {row['height']!r}", where) from None
+            raise DatasetError(
+                file,
+                f"width/height must be integers, got {row['width']!r}, {row['height']!r}",
+                where,
+            ) from None
     return image_size(source)
 
 

@@ -8,6 +8,7 @@
 still stop; change it per dataset with a ``states:`` entry — and ``unknown`` stays unknown.
 Image paths resolve against the JSON file's folder (or ``--images``).
 """
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -16,17 +17,35 @@ from tsrkit.datasets import DatasetError
 from tsrkit.hookspecs import hookimpl
 from tsrkit.plugin import DatasetFormat
 from tsrkit.types import Dataset, Sample
-from tsrkit_plugins.formats.common import (annotation, checked_box, field, json_safe, numbers,
-                                           read_json, resolve_image, sniff_json)
+from tsrkit_plugins.formats.common import (
+    annotation,
+    checked_box,
+    field,
+    json_safe,
+    numbers,
+    read_json,
+    resolve_image,
+    sniff_json,
+)
 
-STATES = {"red": "red", "yellow": "yellow", "green": "green", "off": "off",
-          "red_yellow": "red_yellow", "unknown": "unknown"}
+STATES = {
+    "red": "red",
+    "yellow": "yellow",
+    "green": "green",
+    "off": "off",
+    "red_yellow": "red_yellow",
+    "unknown": "unknown",
+}
 
 
 def _is_dtld(data) -> bool:
-    return (isinstance(data, dict) and isinstance(data.get("images"), list)
-            and bool(data["images"]) and isinstance(data["images"][0], dict)
-            and "image_path" in data["images"][0])
+    return (
+        isinstance(data, dict)
+        and isinstance(data.get("images"), list)
+        and bool(data["images"])
+        and isinstance(data["images"][0], dict)
+        and "image_path" in data["images"][0]
+    )
 
 
 class Dtld(DatasetFormat):
@@ -41,9 +60,10 @@ class Dtld(DatasetFormat):
         file = Path(path)
         data = read_json(file)
         if not _is_dtld(data):
-            raise DatasetError(file, "expected {\"images\": [{\"image_path\", \"labels\"}]}")
-        samples = tuple(_sample(file, entry, f"images[{i}]", images)
-                        for i, entry in enumerate(data["images"]))
+            raise DatasetError(file, 'expected {"images": [{"image_path", "labels"}]}')
+        samples = tuple(
+            _sample(file, entry, f"images[{i}]", images) for i, entry in enumerate(data["images"])
+        )
         return Dataset(file.stem, samples, self.name, str(file.parent), {"box": "housing"})
 
 
@@ -51,20 +71,25 @@ def _sample(file: Path, entry, where: str, images: Path | None) -> Sample:
     annotations = []
     for j, label in enumerate(field(entry, "labels", list, file, where)):
         at = f"{where}.labels[{j}]"
-        x, y, w, h = numbers([field(label, k, (int, float), file, at) for k in "xywh"], 4,
-                             file, at)
+        x, y, w, h = numbers([field(label, k, (int, float), file, at) for k in "xywh"], 4, file, at)
         bbox = checked_box((x, y, x + w, y + h), file, at)
         attributes = field(label, "attributes", dict, file, at)
         state = field(attributes, "state", str, file, f"{at}.attributes")
         if state not in STATES:
-            raise DatasetError(file, f"unknown state {state!r} (expected one of "
-                                     f"{', '.join(STATES)})", f"{at}.attributes")
+            raise DatasetError(
+                file,
+                f"unknown state {state!r} (expected one of {', '.join(STATES)})",
+                f"{at}.attributes",
+            )
         extra = json_safe({k: v for k, v in attributes.items() if k != "state"})
         ids = {k: label[k] for k in ("unique_id", "track_id") if k in label}
         annotations.append(annotation(bbox, state, STATES[state], **extra, **ids))
     metadata = {"timestamp": entry["time_stamp"]} if "time_stamp" in entry else {}
-    return Sample(resolve_image(file.parent, field(entry, "image_path", str, file, where), images),
-                  tuple(annotations), metadata=metadata)
+    return Sample(
+        resolve_image(file.parent, field(entry, "image_path", str, file, where), images),
+        tuple(annotations),
+        metadata=metadata,
+    )
 
 
 @hookimpl

@@ -11,6 +11,7 @@ Signs are not signal states: ``Annotation.state`` holds the class NAME (from
 ``GTSRB_Class_Names.csv`` beside the file when present, else ``class_name_de``, else the id as
 text) and ``attributes["class_id"]`` the integer class id.
 """
+
 from __future__ import annotations
 
 import csv
@@ -23,8 +24,7 @@ from tsrkit.types import Dataset, Sample
 from tsrkit_plugins.formats.common import annotation, checked_box, resolve_image
 
 GT_COLUMNS = ("Filename", "Width", "Height", "Roi.X1", "Roi.Y1", "Roi.X2", "Roi.Y2", "ClassId")
-SUBSET_COLUMNS = ("file", "class_id", "roi_x1_35px", "roi_y1_35px", "roi_x2_35px",
-                  "roi_y2_35px")
+SUBSET_COLUMNS = ("file", "class_id", "roi_x1_35px", "roi_y1_35px", "roi_x2_35px", "roi_y2_35px")
 SUBSET_FILE = "labels.csv"
 NAMES_FILE = "GTSRB_Class_Names.csv"
 
@@ -35,7 +35,7 @@ def _header(path: Path) -> str:
 
 
 def _is_gt(path: Path) -> bool:
-    return path.is_file() and _header(path).split(";")[:len(GT_COLUMNS)] == list(GT_COLUMNS)
+    return path.is_file() and _header(path).split(";")[: len(GT_COLUMNS)] == list(GT_COLUMNS)
 
 
 def _is_subset(path: Path) -> bool:
@@ -64,8 +64,9 @@ def class_names(folder: Path) -> dict[int, str]:
         if sep and first.strip().isdigit():
             names[int(first)] = name.strip()
         elif sep and number > 2:
-            raise DatasetError(file, f"expected 'class id;name', got {line.strip()!r}",
-                               f"line {number}")
+            raise DatasetError(
+                file, f"expected 'class id;name', got {line.strip()!r}", f"line {number}"
+            )
     return names
 
 
@@ -91,8 +92,13 @@ class Gtsrb(DatasetFormat):
             read = _read_subset if _is_subset(file) else _read_gt
             samples.extend(read(file, images, names))
         root = path if path.is_dir() else path.parent
-        return Dataset(root.name, tuple(samples), self.name, str(root),
-                       {"task": "sign-classification", "box": "roi"})
+        return Dataset(
+            root.name,
+            tuple(samples),
+            self.name,
+            str(root),
+            {"task": "sign-classification", "box": "roi"},
+        )
 
 
 def _rows(file: Path, delimiter: str, columns: tuple[str, ...]):
@@ -107,13 +113,13 @@ def _rows(file: Path, delimiter: str, columns: tuple[str, ...]):
 
 def _class_id(file: Path, value: str, where: str) -> int:
     if not value.strip().isdigit():
-        raise DatasetError(file, f"class id must be a non-negative integer, got {value!r}",
-                           where)
+        raise DatasetError(file, f"class id must be a non-negative integer, got {value!r}", where)
     return int(value)
 
 
-def _sign(file: Path, where: str, source: str, class_id: int, name: str, roi: list[str],
-          size: dict) -> Sample:
+def _sign(
+    file: Path, where: str, source: str, class_id: int, name: str, roi: list[str], size: dict
+) -> Sample:
     bbox = checked_box(roi, file, where)
     return Sample(source, (annotation(bbox, name, name, class_id=class_id),), **size)
 
@@ -126,9 +132,17 @@ def _read_gt(file: Path, images: Path | None, names: dict[int, str]) -> list[Sam
             size = {"width": int(row["Width"]), "height": int(row["Height"])}
         except ValueError:
             raise DatasetError(file, "Width/Height must be integers", where) from None
-        samples.append(_sign(file, where, resolve_image(file.parent, row["Filename"], images),
-                             class_id, names.get(class_id, str(class_id)),
-                             [row[f"Roi.{k}"] for k in ("X1", "Y1", "X2", "Y2")], size))
+        samples.append(
+            _sign(
+                file,
+                where,
+                resolve_image(file.parent, row["Filename"], images),
+                class_id,
+                names.get(class_id, str(class_id)),
+                [row[f"Roi.{k}"] for k in ("X1", "Y1", "X2", "Y2")],
+                size,
+            )
+        )
     return samples
 
 
@@ -138,8 +152,17 @@ def _read_subset(file: Path, images: Path | None, names: dict[int, str]) -> list
         class_id = _class_id(file, row["class_id"], where)
         name = names.get(class_id) or row.get("class_name_de") or str(class_id)
         roi = [row[f"roi_{k}_35px"] for k in ("x1", "y1", "x2", "y2")]
-        samples.append(_sign(file, where, resolve_image(file.parent, row["file"], images),
-                             class_id, name, roi, {"width": 35, "height": 35}))
+        samples.append(
+            _sign(
+                file,
+                where,
+                resolve_image(file.parent, row["file"], images),
+                class_id,
+                name,
+                roi,
+                {"width": 35, "height": 35},
+            )
+        )
     return samples
 
 

@@ -7,6 +7,7 @@ frame form one sample, with ``timestamp`` and ``frame`` in its metadata (frames 
 are not listed in the file). The image is ``image_pattern`` formatted with the frame index,
 relative to the text file's folder (or ``--images``); the sequence is 640x480.
 """
+
 from __future__ import annotations
 
 import shlex
@@ -30,8 +31,12 @@ def _tokens(file: Path, line: str, where: str) -> list[str]:
     except ValueError as exc:
         raise DatasetError(file, f"cannot split line ({exc})", where) from None
     if len(tokens) != FIELDS or tokens[1] != "/":
-        raise DatasetError(file, "expected \"timestamp / frame x1 y1 x2 y2 id 'type' "
-                                 f"'subtype'\" ({FIELDS} fields), got {len(tokens)}", where)
+        raise DatasetError(
+            file,
+            "expected \"timestamp / frame x1 y1 x2 y2 id 'type' "
+            f"'subtype'\" ({FIELDS} fields), got {len(tokens)}",
+            where,
+        )
     return tokens
 
 
@@ -58,8 +63,14 @@ class Lara(DatasetFormat):
     name = "lara"
     summary = "LaRA traffic lights ground-truth txt (go/stop/warning/ambiguous)"
     section = "LaRA TLR benchmark, Mines ParisTech (Lara_UrbanSeq1_GroundTruth_GT.txt)"
-    params = (Param("image_pattern", "str", "Lara3D_UrbanSeq1_JPG/frame_{frame:06d}.jpg",
-                    help="Image path of a frame index, relative to the ground-truth file"),)
+    params = (
+        Param(
+            "image_pattern",
+            "str",
+            "Lara3D_UrbanSeq1_JPG/frame_{frame:06d}.jpg",
+            help="Image path of a frame index, relative to the ground-truth file",
+        ),
+    )
 
     def sniff(self, path: Path) -> bool:
         return _is_lara(Path(path))
@@ -73,23 +84,34 @@ class Lara(DatasetFormat):
             where = f"line {number}"
             tokens = _tokens(file, line, where)
             if tokens[9] not in SUBTYPES:
-                raise DatasetError(file, f"unknown subtype {tokens[9]!r} (expected one of "
-                                         f"{', '.join(SUBTYPES)})", where)
+                raise DatasetError(
+                    file,
+                    f"unknown subtype {tokens[9]!r} (expected one of {', '.join(SUBTYPES)})",
+                    where,
+                )
             try:
                 timestamp, frame, object_id = float(tokens[0]), int(tokens[2]), int(tokens[7])
             except ValueError:
-                raise DatasetError(file, "timestamp, frame and id must be numbers",
-                                   where) from None
+                raise DatasetError(file, "timestamp, frame and id must be numbers", where) from None
             bbox = checked_box(tokens[3:7], file, where)
             record = frames.setdefault(frame, {"timestamp": timestamp, "annotations": []})
-            record["annotations"].append(annotation(bbox, tokens[9], SUBTYPES[tokens[9]],
-                                                    object_id=object_id, type=tokens[8]))
+            record["annotations"].append(
+                annotation(
+                    bbox, tokens[9], SUBTYPES[tokens[9]], object_id=object_id, type=tokens[8]
+                )
+            )
         samples = tuple(
-            Sample(resolve_image(file.parent, self.params["image_pattern"].format(frame=frame),
-                                 images),
-                   tuple(record["annotations"]), WIDTH, HEIGHT,
-                   metadata={"timestamp": record["timestamp"], "frame": frame})
-            for frame, record in frames.items())
+            Sample(
+                resolve_image(
+                    file.parent, self.params["image_pattern"].format(frame=frame), images
+                ),
+                tuple(record["annotations"]),
+                WIDTH,
+                HEIGHT,
+                metadata={"timestamp": record["timestamp"], "frame": frame},
+            )
+            for frame, record in frames.items()
+        )
         return Dataset(file.stem, samples, self.name, str(file.parent), {"box": "housing"})
 
 

@@ -9,6 +9,7 @@ these files). Tags map to states: ``stop*`` red, ``warning*`` yellow, ``go*`` gr
 given, else ``Filename`` as written, relative to the CSV's folder. A folder is read through every
 ``frameAnnotations<KIND>.csv`` below it (``kind`` parameter: BOX or BULB).
 """
+
 from __future__ import annotations
 
 import csv
@@ -21,8 +22,14 @@ from tsrkit.plugin import DatasetFormat
 from tsrkit.types import Dataset, Sample
 from tsrkit_plugins.formats.common import absolute, annotation, checked_box
 
-COLUMNS = ("Filename", "Annotation tag", "Upper left corner X", "Upper left corner Y",
-           "Lower right corner X", "Lower right corner Y")
+COLUMNS = (
+    "Filename",
+    "Annotation tag",
+    "Upper left corner X",
+    "Upper left corner Y",
+    "Lower right corner X",
+    "Lower right corner Y",
+)
 HEADER = "Filename;Annotation tag"
 BOXES = {"BOX": "housing", "BULB": "lens"}
 
@@ -38,16 +45,24 @@ class Lisa(DatasetFormat):
     name = "lisa"
     summary = "LISA traffic light CSV (semicolon; frameAnnotationsBOX / BULB files)"
     section = "Jensen et al., IEEE T-ITS 2016 (LISA Traffic Light Dataset)"
-    params = (Param("kind", "str", "BOX", choices=("BOX", "BULB"),
-                    help="Which annotation files a folder is read through"),)
+    params = (
+        Param(
+            "kind",
+            "str",
+            "BOX",
+            choices=("BOX", "BULB"),
+            help="Which annotation files a folder is read through",
+        ),
+    )
 
     def sniff(self, path: Path) -> bool:
         path = Path(path)
         return _is_lisa(path) or (path.is_dir() and bool(self._files(path)))
 
     def _files(self, folder: Path) -> list[Path]:
-        return sorted(p for p in folder.rglob(f"frameAnnotations{self.params['kind']}.csv")
-                      if _is_lisa(p))
+        return sorted(
+            p for p in folder.rglob(f"frameAnnotations{self.params['kind']}.csv") if _is_lisa(p)
+        )
 
     def read(self, path: Path, images: Path | None = None) -> Dataset:
         path = Path(path)
@@ -74,14 +89,23 @@ def _rows(file: Path, images: Path | None):
         for row in reader:
             where = f"line {reader.line_num}"
             if any(row.get(c) in (None, "") for c in COLUMNS):
-                raise DatasetError(file, "empty or missing fields (expected ';'-separated "
-                                         f"{len(COLUMNS)}+ columns)", where)
+                raise DatasetError(
+                    file,
+                    f"empty or missing fields (expected ';'-separated {len(COLUMNS)}+ columns)",
+                    where,
+                )
             bbox = checked_box([row[c] for c in COLUMNS[2:]], file, where)
             name = row["Filename"]
             image = images / Path(name).name if images is not None else file.parent / name
-            extra = {k: row[c] for k, c in (("origin_file", "Origin file"),
-                                            ("origin_frame", "Origin frame number"),
-                                            ("track", "Origin track")) if row.get(c)}
+            extra = {
+                k: row[c]
+                for k, c in (
+                    ("origin_file", "Origin file"),
+                    ("origin_frame", "Origin frame number"),
+                    ("track", "Origin track"),
+                )
+                if row.get(c)
+            }
             yield absolute(image), annotation(bbox, row["Annotation tag"], **extra)
 
 

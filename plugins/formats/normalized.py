@@ -5,6 +5,7 @@ A list of ``{"file", "split", "width", "height", "boxes": [{"label", "x_min", "y
 optional keys that round-trip what the base format cannot hold: per box ``"state"`` (when it is
 not what the label maps to) and ``"attributes"``; per record ``"metadata"`` (e.g. ``lighting``).
 """
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -14,10 +15,19 @@ from tsrkit.datasets import DatasetError, to_state
 from tsrkit.hookspecs import hookimpl
 from tsrkit.plugin import DatasetFormat
 from tsrkit.types import Dataset, Sample
-from tsrkit_plugins.formats.common import (annotation, checked_box, explicit_state,
-                                           extra_attributes, field,
-                                           json_safe, raw_label, read_json, relative_source,
-                                           resolve_image, sniff_json)
+from tsrkit_plugins.formats.common import (
+    annotation,
+    checked_box,
+    explicit_state,
+    extra_attributes,
+    field,
+    json_safe,
+    raw_label,
+    read_json,
+    relative_source,
+    resolve_image,
+    sniff_json,
+)
 
 FILE_NAME = "annotations.json"
 COORDS = ("x_min", "y_min", "x_max", "y_max")
@@ -25,7 +35,8 @@ COORDS = ("x_min", "y_min", "x_max", "y_max")
 
 def _is_normalized(data) -> bool:
     return isinstance(data, list) and all(
-        isinstance(r, dict) and "file" in r and "boxes" in r for r in data[:5])
+        isinstance(r, dict) and "file" in r and "boxes" in r for r in data[:5]
+    )
 
 
 def annotation_file(path: Path) -> Path:
@@ -47,10 +58,12 @@ class Normalized(DatasetFormat):
         data = read_json(file)
         if not isinstance(data, list):
             raise DatasetError(file, "expected a list of image records")
-        samples = tuple(_sample(file, record, f"entry {i}", images)
-                        for i, record in enumerate(data))
-        return Dataset(file.parent.name, samples, self.name, str(file.parent),
-                       {"annotation_file": str(file)})
+        samples = tuple(
+            _sample(file, record, f"entry {i}", images) for i, record in enumerate(data)
+        )
+        return Dataset(
+            file.parent.name, samples, self.name, str(file.parent), {"annotation_file": str(file)}
+        )
 
     def write(self, dataset: Dataset, out: Path) -> None:
         out = Path(out)
@@ -65,12 +78,17 @@ def _sample(file: Path, record, where: str, images: Path | None) -> Sample:
         at = f"{where} box {j}"
         label = str(field(box, "label", (str, int), file, at))
         bbox = checked_box([field(box, k, (int, float), file, at) for k in COORDS], file, at)
-        annotations.append(annotation(bbox, label, explicit_state(box, file, at),
-                                      **(box.get("attributes") or {})))
+        annotations.append(
+            annotation(bbox, label, explicit_state(box, file, at), **(box.get("attributes") or {}))
+        )
     size = {k: record[k] for k in ("width", "height") if isinstance(record.get(k), int)}
-    return Sample(resolve_image(file.parent, name, images), tuple(annotations),
-                  split=record.get("split"), metadata=dict(record.get("metadata") or {}),
-                  **size)
+    return Sample(
+        resolve_image(file.parent, name, images),
+        tuple(annotations),
+        split=record.get("split"),
+        metadata=dict(record.get("metadata") or {}),
+        **size,
+    )
 
 
 def _record(sample: Sample, folder: Path) -> dict:
@@ -84,8 +102,13 @@ def _record(sample: Sample, folder: Path) -> dict:
         if extra:
             box["attributes"] = extra
         boxes.append(box)
-    record = {"file": relative_source(sample.source, folder), "split": sample.split,
-              "width": sample.width, "height": sample.height, "boxes": boxes}
+    record = {
+        "file": relative_source(sample.source, folder),
+        "split": sample.split,
+        "width": sample.width,
+        "height": sample.height,
+        "boxes": boxes,
+    }
     metadata = json_safe(sample.metadata)
     if metadata:
         record["metadata"] = metadata

@@ -8,6 +8,7 @@ else the filename beside the XML, else in ``../JPEGImages``. The writer stores `
 relative to the XML folder and adds a ``<state>`` element when the state is not what the
 ``<name>`` label maps to; VOC readers ignore unknown elements.
 """
+
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
@@ -21,8 +22,15 @@ from tsrkit.datasets import DatasetError, to_state
 from tsrkit.hookspecs import hookimpl
 from tsrkit.plugin import DatasetFormat
 from tsrkit.types import Dataset, Sample
-from tsrkit_plugins.formats.common import (absolute, annotation, checked_box, explicit_state,
-                                           raw_label, relative_source, unique_path)
+from tsrkit_plugins.formats.common import (
+    absolute,
+    annotation,
+    checked_box,
+    explicit_state,
+    raw_label,
+    relative_source,
+    unique_path,
+)
 
 ANNOTATIONS = "Annotations"
 SETS = Path("ImageSets") / "Main"
@@ -93,8 +101,11 @@ def _splits(root: Path) -> dict[str, str]:
     for split_file, split in SPLIT_FILES.items():
         listed = sets / f"{split_file}.txt"
         if listed.is_file():
-            out.update((line.split()[0], split) for line in
-                       listed.read_text(encoding="utf-8").splitlines() if line.strip())
+            out.update(
+                (line.split()[0], split)
+                for line in listed.read_text(encoding="utf-8").splitlines()
+                if line.strip()
+            )
     return out
 
 
@@ -102,13 +113,15 @@ def _parse(file: Path) -> ET.Element:
     try:
         root = SafeET.parse(file).getroot()
     except DefusedXmlException as exc:  # entities and DTDs are refused (billion laughs...)
-        raise DatasetError(file, f"XML with a forbidden construct ({type(exc).__name__})",
-                           "document") from None
+        raise DatasetError(
+            file, f"XML with a forbidden construct ({type(exc).__name__})", "document"
+        ) from None
     except ET.ParseError as exc:
         line, column = exc.position
         reason = str(exc).split(":")[0]
-        raise DatasetError(file, f"not well-formed XML ({reason})",
-                           f"line {line} column {column}") from None
+        raise DatasetError(
+            file, f"not well-formed XML ({reason})", f"line {line} column {column}"
+        ) from None
     if root.tag != "annotation":
         raise DatasetError(file, f"root element is <{root.tag}>, expected <annotation>")
     return root
@@ -127,7 +140,9 @@ def _image(file: Path, root: ET.Element, images: Path | None) -> str:
         return absolute(images / filename)
     written = (root.findtext("path") or "").strip()
     candidates = ([file.parent / written] if written else []) + [
-        file.parent / filename, file.parent.parent / "JPEGImages" / filename]
+        file.parent / filename,
+        file.parent.parent / "JPEGImages" / filename,
+    ]
     chosen = next((c for c in candidates if c.is_file()), file.parent / filename)
     return absolute(chosen)
 
@@ -143,11 +158,15 @@ def _sample(file: Path, images: Path | None, split: str | None) -> Sample:
             raise DatasetError(file, "missing <bndbox>", where)
         bbox = checked_box([_text(box, k, file, where) for k in COORDS], file, where)
         flags = {k: int(obj.findtext(k)) for k in FLAGS if (obj.findtext(k) or "").isdigit()}
-        state = explicit_state({"state": obj.findtext("state")} if obj.find("state") is not None
-                               else {}, file, where)
+        state = explicit_state(
+            {"state": obj.findtext("state")} if obj.find("state") is not None else {}, file, where
+        )
         annotations.append(annotation(bbox, label, state, **flags))
-    size = {k: int(root.findtext(f"size/{k}")) for k in ("width", "height")
-            if (root.findtext(f"size/{k}") or "").strip().isdigit()}
+    size = {
+        k: int(root.findtext(f"size/{k}"))
+        for k in ("width", "height")
+        if (root.findtext(f"size/{k}") or "").strip().isdigit()
+    }
     return Sample(_image(file, root, images), tuple(annotations), split=split, **size)
 
 

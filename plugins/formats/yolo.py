@@ -8,6 +8,7 @@ replaced by ``labels``), one object per line in coordinates normalised to [0, 1]
 export (real exports mix both; the box is the min/max of the points). The image size, needed to
 turn these into pixels, is read from the file header only when the label file has lines.
 """
+
 from __future__ import annotations
 
 import os
@@ -24,8 +25,14 @@ from tsrkit.hookspecs import hookimpl
 from tsrkit.inputs import IMAGE_EXTENSIONS
 from tsrkit.plugin import DatasetFormat
 from tsrkit.types import Dataset, Sample
-from tsrkit_plugins.formats.common import (absolute, annotation, class_names, numbers,
-                                           raw_label, unique_path)
+from tsrkit_plugins.formats.common import (
+    absolute,
+    annotation,
+    class_names,
+    numbers,
+    raw_label,
+    unique_path,
+)
 
 DATA_YAML = "data.yaml"
 SPLIT_KEYS = {"train": "train", "val": "valid", "test": "test"}
@@ -64,8 +71,12 @@ def yolo_box(values: tuple[float, ...], width: int, height: int) -> tuple[float,
     """Pixels ``(x_min, y_min, x_max, y_max)`` of a normalised box or polygon line."""
     if len(values) == 4:
         cx, cy, w, h = values
-        return ((cx - w / 2) * width, (cy - h / 2) * height,
-                (cx + w / 2) * width, (cy + h / 2) * height)
+        return (
+            (cx - w / 2) * width,
+            (cy - h / 2) * height,
+            (cx + w / 2) * width,
+            (cy + h / 2) * height,
+        )
     xs, ys = values[0::2], values[1::2]
     return min(xs) * width, min(ys) * height, max(xs) * width, max(ys) * height
 
@@ -116,14 +127,19 @@ class Yolo(DatasetFormat):
             splits.add(split)
             image = unique_path(out / split / "images" / Path(sample.source).name, used)
             _place_image(Path(sample.source), image)
-            size = ((sample.width, sample.height) if sample.width and sample.height
-                    else image_size(sample.source))
+            size = (
+                (sample.width, sample.height)
+                if sample.width and sample.height
+                else image_size(sample.source)
+            )
             with atomic_open(labels_path(image)) as fh:
-                fh.writelines(_label_line(ids[raw_label(a)], a.bbox, *size) + "\n"
-                              for a in sample.annotations)
+                fh.writelines(
+                    _label_line(ids[raw_label(a)], a.bbox, *size) + "\n" for a in sample.annotations
+                )
         data = {"names": names, "nc": len(names)}
-        data.update({key: f"{split}/images" for key, split in SPLIT_KEYS.items()
-                     if split in splits})
+        data.update(
+            {key: f"{split}/images" for key, split in SPLIT_KEYS.items() if split in splits}
+        )
         with atomic_open(out / DATA_YAML) as fh:
             yaml.safe_dump(data, fh, sort_keys=False)
 
@@ -137,8 +153,11 @@ def _split_images(base: Path, entry: str, images: Path | None) -> list[Path] | N
         return sorted(p for p in target.iterdir() if p.suffix.lower() in IMAGE_EXTENSIONS)
     if target.is_file():
         root = images if images is not None else target.parent
-        return [Path(absolute(root / line.strip())) for line in
-                target.read_text(encoding="utf-8").splitlines() if line.strip()]
+        return [
+            Path(absolute(root / line.strip()))
+            for line in target.read_text(encoding="utf-8").splitlines()
+            if line.strip()
+        ]
     return None
 
 
@@ -153,31 +172,36 @@ def _sample(image: Path, split: str, classes: dict[int, str], data_file: Path) -
     for number, tokens in rows:
         where = f"line {number}"
         if not tokens[0].isdigit() or int(tokens[0]) not in classes:
-            raise DatasetError(label_file, f"class {tokens[0]!r} is not an id of "
-                                           f"{data_file.name} names", where)
+            raise DatasetError(
+                label_file, f"class {tokens[0]!r} is not an id of {data_file.name} names", where
+            )
         count = len(tokens) - 1
         if count != 4 and (count < 6 or count % 2):
-            raise DatasetError(label_file, f"expected 4 box values or an even number >= 6 of "
-                                           f"polygon values, got {count}", where)
+            raise DatasetError(
+                label_file,
+                f"expected 4 box values or an even number >= 6 of polygon values, got {count}",
+                where,
+            )
         values = numbers(tokens[1:], count, label_file, where)
         shape = "box" if count == 4 else "polygon"
-        annotations.append(annotation(yolo_box(values, width, height), classes[int(tokens[0])],
-                                      yolo_shape=shape))
+        annotations.append(
+            annotation(yolo_box(values, width, height), classes[int(tokens[0])], yolo_shape=shape)
+        )
     return Sample(absolute(image), tuple(annotations), width, height, split)
 
 
 def _label_line(class_id: int, bbox, width: int, height: int) -> str:
     x0, y0, x1, y1 = bbox
-    values = ((x0 + x1) / 2 / width, (y0 + y1) / 2 / height, (x1 - x0) / width,
-              (y1 - y0) / height)
+    values = ((x0 + x1) / 2 / width, (y0 + y1) / 2 / height, (x1 - x0) / width, (y1 - y0) / height)
     return " ".join([str(class_id), *(f"{v:.8f}" for v in values)])
 
 
 def _place_image(source: Path, target: Path) -> None:
     """A relative symlink to ``source`` at ``target`` (a copy where links are not allowed)."""
     if not source.is_file():
-        raise DatasetError(source, "image not found; YOLO output needs the image beside its "
-                                   "label file")
+        raise DatasetError(
+            source, "image not found; YOLO output needs the image beside its label file"
+        )
     target.parent.mkdir(parents=True, exist_ok=True)
     if target.is_symlink() or target.exists():
         target.unlink()

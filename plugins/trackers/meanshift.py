@@ -5,6 +5,7 @@ weighted by an Epanechnikov profile times a colour mask. Each later frame moves 
 mean shift at five growing kernel scales and keeps the scale with the best Bhattacharyya
 coefficient. Lee 2017, section 3.3 (Eq. 3.2-3.4) and the start condition of 3.6.2.
 """
+
 from __future__ import annotations
 
 from collections.abc import Sequence
@@ -54,8 +55,9 @@ class ColourPlanes:
     y0: int
 
 
-def colour_planes(image: np.ndarray, region: tuple[int, int, int, int], n_bins: Sequence[int],
-                  min_saturation: int) -> ColourPlanes:
+def colour_planes(
+    image: np.ndarray, region: tuple[int, int, int, int], n_bins: Sequence[int], min_saturation: int
+) -> ColourPlanes:
     """Quantise hue and saturation of ``image[y0:y1, x0:x1]`` into ``n_h x n_s`` bins (3.3).
 
     The bin of a pixel is ``n_s * j + k`` for hue bin ``j`` and saturation bin ``k`` (Eq. 3.2,
@@ -83,7 +85,7 @@ def window_pixels(planes: ColourPlanes, window: Window):
     xb = min(int(np.ceil(window.cx + window.ax)) + 1 - planes.x0, w)
     ya = max(int(np.floor(window.cy - window.ay)) - planes.y0, 0)
     yb = min(int(np.ceil(window.cy + window.ay)) + 1 - planes.y0, h)
-    ys, xs = np.mgrid[ya:max(yb, ya), xa:max(xb, xa)]
+    ys, xs = np.mgrid[ya : max(yb, ya), xa : max(xb, xa)]
     xs, ys = (xs + planes.x0).ravel(), (ys + planes.y0).ravel()
     dist2 = ((xs - window.cx) / window.ax) ** 2 + ((ys - window.cy) / window.ay) ** 2
     inside = dist2 <= 1.0
@@ -112,8 +114,9 @@ def pixel_weights(target: np.ndarray, candidate: np.ndarray, bins: np.ndarray) -
     return np.sqrt(ratio)[bins]
 
 
-def mean_shift_step(xs: np.ndarray, ys: np.ndarray, weights: np.ndarray,
-                    mask: np.ndarray) -> tuple[float, float] | None:
+def mean_shift_step(
+    xs: np.ndarray, ys: np.ndarray, weights: np.ndarray, mask: np.ndarray
+) -> tuple[float, float] | None:
     """Lee Eq. 3.4: ``z_new = sum p_i w_i mask_i / sum w_i mask_i`` (None when the sum is 0).
 
     With the Epanechnikov profile the kernel derivative is constant inside the window, so the
@@ -133,8 +136,9 @@ def candidate_model(planes: ColourPlanes, window: Window, n_bins: int):
     return hist, (xs, ys, bins, mask)
 
 
-def track_scale(planes: ColourPlanes, target: np.ndarray, window: Window, max_iter: int,
-                epsilon: float) -> tuple[Window, float]:
+def track_scale(
+    planes: ColourPlanes, target: np.ndarray, window: Window, max_iter: int, epsilon: float
+) -> tuple[Window, float]:
     """Mean-shift ``window`` until it moves less than ``epsilon`` px or ``max_iter`` steps."""
     for _ in range(max_iter):
         hist, (xs, ys, bins, mask) = candidate_model(planes, window, target.size)
@@ -155,22 +159,67 @@ class MeanShift(Tracker):
     summary = "Kernel mean shift on 20x20 hue-saturation histograms, five kernel scales"
     section = "Lee 2017, 3.3 (Eq. 3.2-3.4), 3.6.2"
     params = (
-        Param("bins", "ints", (20, 20), min=2, max=256, length=2,
-              help="hue and saturation bins n_h, n_s", section="3.3"),
-        Param("scales", "floats", (0, 2, 5, 7, 10), min=-50, max=100,
-              help="kernel size increases tried each frame, percent", section="3.3"),
+        Param(
+            "bins",
+            "ints",
+            (20, 20),
+            min=2,
+            max=256,
+            length=2,
+            help="hue and saturation bins n_h, n_s",
+            section="3.3",
+        ),
+        Param(
+            "scales",
+            "floats",
+            (0, 2, 5, 7, 10),
+            min=-50,
+            max=100,
+            help="kernel size increases tried each frame, percent",
+            section="3.3",
+        ),
         Param("max_iter", "int", 20, min=1, help="mean-shift iteration cap", section="3.3"),
-        Param("epsilon", "float", 0.5, min=0, help="stop when the shift is below this, px",
-              section="3.3"),
-        Param("min_saturation", "int", 50, min=0, max=255,
-              help="colour mask: pixels at least this saturated (0-255)"),
-        Param("min_similarity", "float", 0.6, min=0, max=1,
-              help="the track ends when the best Bhattacharyya coefficient drops below this"),
-        Param("min_size", "float", 10, min=1,
-              help="start condition: the box's width and height reach this, px",
-              section="3.6.2"),
-        Param("aspect", "floats", (0.5, 2.0), min=0, length=2,
-              help="start condition: width / height within this range", section="3.6.2"),
+        Param(
+            "epsilon",
+            "float",
+            0.5,
+            min=0,
+            help="stop when the shift is below this, px",
+            section="3.3",
+        ),
+        Param(
+            "min_saturation",
+            "int",
+            50,
+            min=0,
+            max=255,
+            help="colour mask: pixels at least this saturated (0-255)",
+        ),
+        Param(
+            "min_similarity",
+            "float",
+            0.6,
+            min=0,
+            max=1,
+            help="the track ends when the best Bhattacharyya coefficient drops below this",
+        ),
+        Param(
+            "min_size",
+            "float",
+            10,
+            min=1,
+            help="start condition: the box's width and height reach this, px",
+            section="3.6.2",
+        ),
+        Param(
+            "aspect",
+            "floats",
+            (0.5, 2.0),
+            min=0,
+            length=2,
+            help="start condition: width / height within this range",
+            section="3.6.2",
+        ),
     )
 
     def __init__(self, **params):
@@ -195,10 +244,15 @@ class MeanShift(Tracker):
 
     def _planes(self, frame: Frame, window: Window, reach: float) -> ColourPlanes:
         x0, y0, x1, y1 = window.scaled(reach).bbox
-        region = (max(int(x0), 0), max(int(y0), 0),
-                  min(int(np.ceil(x1)) + 1, frame.width), min(int(np.ceil(y1)) + 1, frame.height))
-        return colour_planes(frame.image, region, self.params["bins"],
-                             self.params["min_saturation"])
+        region = (
+            max(int(x0), 0),
+            max(int(y0), 0),
+            min(int(np.ceil(x1)) + 1, frame.width),
+            min(int(np.ceil(y1)) + 1, frame.height),
+        )
+        return colour_planes(
+            frame.image, region, self.params["bins"], self.params["min_saturation"]
+        )
 
     def _start(self, frame: Frame, detection: Detection) -> bool:
         window = Window.from_box(detection.candidate.bbox)
@@ -217,8 +271,9 @@ class MeanShift(Tracker):
         best, score = None, -1.0
         for percent in self.params["scales"]:
             window = self._window.scaled(1 + percent / 100)
-            window, similarity = track_scale(planes, self._target, window,
-                                             self.params["max_iter"], self.params["epsilon"])
+            window, similarity = track_scale(
+                planes, self._target, window, self.params["max_iter"], self.params["epsilon"]
+            )
             if similarity > score:
                 best, score = window, similarity
         inside = 0 <= best.cx < frame.width and 0 <= best.cy < frame.height
@@ -227,9 +282,11 @@ class MeanShift(Tracker):
             return None
         self._window = best
         start = self._detection
-        return replace(start, candidate=Candidate.from_box(best.bbox, score,
-                                                           start.candidate.state),
-                       origin="tracked")
+        return replace(
+            start,
+            candidate=Candidate.from_box(best.bbox, score, start.candidate.state),
+            origin="tracked",
+        )
 
     def update(self, frame: Frame, detections: Sequence[Detection]) -> list[Detection]:
         """Start a track from the first detection passing :meth:`starts`, else follow it."""

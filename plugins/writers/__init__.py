@@ -1,1 +1,1 @@
-"""Built-in report writers: each writes files of a benchmark's output folder from the finished run."""
+"""Built-in report writers: each writes files of a benchmark's output folder from the run."""

@@ -3,6 +3,7 @@
 ``ground_truth.coco.json`` and ``detections.coco.json`` are the dictionaries the ``coco-ap``
 metric gave pycocotools, with the evaluated box (``report.json``'s ``evaluated_box``).
 """
+
 from __future__ import annotations
 
 from pathlib import Path

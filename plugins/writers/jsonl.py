@@ -1,5 +1,6 @@
 """Report writer ``jsonl``: ``detections.jsonl``, one ``tsrkit detect`` record per evaluated frame
 (plus its lighting), in dataset order."""
+
 from __future__ import annotations
 
 import json

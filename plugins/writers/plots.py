@@ -1,9 +1,10 @@
-"""Report writer ``plots``: PNG plots (matplotlib, Agg): Figure 5-1 bubbles, bars, PR curve, confusion.
+"""Report writer ``plots``: PNG plots (matplotlib Agg): Fig. 5-1 bubbles, bars, PR curve, confusion.
 
 ``bubble_plot`` follows Zheng 2016 Figure 5-1: one panel per lighting x max-radius category,
 recall against FPR = 1 - precision, circle area proportional to the share of the category's
 frames, bluer towards (FPR 0, recall 1) and redder away from it, ``N = frames`` in grey.
 """
+
 from __future__ import annotations
 
 import math
@@ -12,10 +13,10 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402  (the backend must be chosen first)
+import matplotlib.pyplot as plt
 
-from tsrkit import ReportWriter, RunResult, hookimpl  # noqa: E402
-from tsrkit.atomic import atomic_open  # noqa: E402
+from tsrkit import ReportWriter, RunResult, hookimpl
+from tsrkit.atomic import atomic_open
 
 
 def _save(fig, path: Path) -> str:
@@ -30,22 +31,40 @@ def bubble_plot(rows: list[dict], path: Path) -> str:
     panels = [r for r in rows if r["max_radius"] is not None] or rows
     cols = min(4, max(1, len(panels)))
     nrows = max(1, math.ceil(len(panels) / cols))
-    fig, axes = plt.subplots(nrows, cols, figsize=(3 * cols, 3 * nrows), squeeze=False,
-                             sharex=True, sharey=True)
+    fig, axes = plt.subplots(
+        nrows, cols, figsize=(3 * cols, 3 * nrows), squeeze=False, sharex=True, sharey=True
+    )
     cmap = plt.get_cmap("coolwarm")
     for ax, row in zip(axes.flat, panels):
         fpr = [b["fpr"] for b in row["bubbles"]]
         recall = [b["recall"] for b in row["bubbles"]]
         share = [b["frames"] / row["frames"] for b in row["bubbles"]]
         badness = [(f + (1 - r)) / 2 for f, r in zip(fpr, recall)]
-        ax.scatter(fpr, recall, s=[2000 * s for s in share], c=badness, cmap=cmap, vmin=0,
-                   vmax=1, alpha=0.7, edgecolors="k", linewidths=0.3)
+        ax.scatter(
+            fpr,
+            recall,
+            s=[2000 * s for s in share],
+            c=badness,
+            cmap=cmap,
+            vmin=0,
+            vmax=1,
+            alpha=0.7,
+            edgecolors="k",
+            linewidths=0.3,
+        )
         ax.set_title(f"{row['lighting']} - r {row['max_radius']}", fontsize=9)
-        ax.text(0.95, 0.05, f"N = {row['frames']}", color="grey", ha="right",
-                transform=ax.transAxes, fontsize=8)
+        ax.text(
+            0.95,
+            0.05,
+            f"N = {row['frames']}",
+            color="grey",
+            ha="right",
+            transform=ax.transAxes,
+            fontsize=8,
+        )
         ax.set_xlim(-0.1, 1.1)
         ax.set_ylim(-0.1, 1.1)
-    for ax in list(axes.flat)[len(panels):]:
+    for ax in list(axes.flat)[len(panels) :]:
         ax.axis("off")
     fig.supxlabel("false positive rate (1 - precision)")
     fig.supylabel("recall")
@@ -55,13 +74,19 @@ def bubble_plot(rows: list[dict], path: Path) -> str:
 
 def category_bars(rows: list[dict], path: Path) -> str:
     """Per-category bars of mean recall, mean precision and hit-frame fraction."""
-    labels = [r["lighting"] if r["max_radius"] is None else f"{r['lighting']}-{r['max_radius']}"
-              for r in rows]
+    labels = [
+        r["lighting"] if r["max_radius"] is None else f"{r['lighting']}-{r['max_radius']}"
+        for r in rows
+    ]
     fig, ax = plt.subplots(figsize=(max(5, 0.6 * len(rows) + 2), 3.5))
     width = 0.27
     for k, key in enumerate(("recall_mean", "precision_mean", "hit_frame_fraction")):
-        ax.bar([i + (k - 1) * width for i in range(len(rows))],
-               [r[key] or 0.0 for r in rows], width, label=key)
+        ax.bar(
+            [i + (k - 1) * width for i in range(len(rows))],
+            [r[key] or 0.0 for r in rows],
+            width,
+            label=key,
+        )
     ax.set_xticks(range(len(rows)), labels, rotation=45, ha="right", fontsize=8)
     ax.set_ylim(0, 1)
     ax.legend(fontsize=8)
@@ -114,11 +139,14 @@ def plot_names(report: dict) -> list[str]:
 def write_plots(folder: Path, report: dict) -> None:
     """Write the plots of :func:`plot_names` into ``folder``."""
     folder.mkdir(parents=True, exist_ok=True)
-    draw = {"recall_fpr_bubbles.png": lambda path: bubble_plot(report["categories"], path),
-            "categories.png": lambda path: category_bars(report["categories"], path),
-            "pr_curve.png": lambda path: pr_curve(report["iou50"].get("pr_curve"),
-                                                  report["iou50"]["ap"], path),
-            "confusion.png": lambda path: confusion_plot(report["state"], path)}
+    draw = {
+        "recall_fpr_bubbles.png": lambda path: bubble_plot(report["categories"], path),
+        "categories.png": lambda path: category_bars(report["categories"], path),
+        "pr_curve.png": lambda path: pr_curve(
+            report["iou50"].get("pr_curve"), report["iou50"]["ap"], path
+        ),
+        "confusion.png": lambda path: confusion_plot(report["state"], path),
+    }
     for name in plot_names(report):
         draw[name](folder / name)
 

@@ -1,4 +1,5 @@
 """Report writer ``json``: the run's ``report.json`` (the report dict, exactly as returned)."""
+
 from __future__ import annotations
 
 from pathlib import Path

@@ -4,6 +4,7 @@ Each window average is a direct correlation of the feature with its mask (disk A
 parts of A1 and A2, annulus A3), borders mirrored like the fast code; Eq. 3.1 is evaluated as
 written, root included, for every radius. Written for clarity, not speed.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -14,7 +15,7 @@ from tsrkit_plugins.detectors.conspicuity import lightness, saturation
 
 def distance_grid(half_side: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Offsets ``dy, dx`` of a square window and their Euclidean distance from its centre."""
-    dy, dx = np.mgrid[-half_side:half_side + 1, -half_side:half_side + 1]
+    dy, dx = np.mgrid[-half_side : half_side + 1, -half_side : half_side + 1]
     return dy, dx, np.hypot(dy, dx)
 
 
@@ -36,8 +37,14 @@ def quadrant_masks(radius: int, margin: int, vertical: int, horizontal: int):
     return quadrant & (dist <= radius), quadrant & (dist > radius)
 
 
-def conspicuity_at_radius(light: np.ndarray, sat: np.ndarray, radius: int, weights,
-                          margin: int = 0, quadrant_rule: str = "max") -> np.ndarray:
+def conspicuity_at_radius(
+    light: np.ndarray,
+    sat: np.ndarray,
+    radius: int,
+    weights,
+    margin: int = 0,
+    quadrant_rule: str = "max",
+) -> np.ndarray:
     """Eq. 3.1 for one radius, each feature by direct correlation with its mask."""
     ld = window_mean(light, disk_mask(radius, radius))
     contrasts = []
@@ -54,22 +61,27 @@ def conspicuity_at_radius(light: np.ndarray, sat: np.ndarray, radius: int, weigh
     annulus = ~disk_mask(radius, 2 * radius) & disk_mask(2 * radius, 2 * radius)
     sa = window_mean(sat, annulus)
     w_l, w_lc, w_s = weights
-    product = ld ** w_l * lc ** w_lc * np.maximum(sd, sa) ** w_s
+    product = ld**w_l * lc**w_lc * np.maximum(sd, sa) ** w_s
     return product ** (1.0 / (w_l + w_lc + w_s))
 
 
-def conspicuity_reference(image: np.ndarray, radii=tuple(range(1, 11)), weights=(1, 1, 1),
-                          margin: int = 0, quadrant_rule: str = "max"):
+def conspicuity_reference(
+    image: np.ndarray,
+    radii=tuple(range(1, 11)),
+    weights=(1, 1, 1),
+    margin: int = 0,
+    quadrant_rule: str = "max",
+):
     """Eq. 3.2: maximum over the radius set; returns (values, arg-max radius, per-radius stack)."""
     light = lightness(image).astype(np.float64) / 255.0
     sat = saturation(image).astype(np.float64) / 255.0
-    stack = np.stack([conspicuity_at_radius(light, sat, r, weights, margin, quadrant_rule)
-                      for r in radii])
+    stack = np.stack(
+        [conspicuity_at_radius(light, sat, r, weights, margin, quadrant_rule) for r in radii]
+    )
     return stack.max(axis=0), np.asarray(radii)[np.argmax(stack, axis=0)], stack
 
 
-def drmshift_reference(cm: np.ndarray, rm: np.ndarray, start, h_c: float = 0.5,
-                       n_max: int = 10):
+def drmshift_reference(cm: np.ndarray, rm: np.ndarray, start, h_c: float = 0.5, n_max: int = 10):
     """Algorithm 3-1 line by line for one start point, with the fast code's reading: the window
     is centred on the rounded centre, pixels outside the image are skipped."""
     height, width = cm.shape

@@ -4,6 +4,7 @@ Pixel by pixel: Sobel gradient from the 3x3 neighbourhood, one vote per affected
 clipped orientation and F_n per pixel, then a direct (non-separable) 2-D Gaussian convolution.
 It mirrors ``tsrkit_plugins.detectors.frst.frst`` in meaning, not in code.
 """
+
 from __future__ import annotations
 
 import math
@@ -36,8 +37,9 @@ def gaussian_2d(n: int) -> np.ndarray:
     return kernel / kernel.sum()
 
 
-def frst_oracle(image, radii=tuple(range(1, 11)), alpha=2.0, beta=0.0, mode="both",
-                orientation_only=False) -> np.ndarray:
+def frst_oracle(
+    image, radii=tuple(range(1, 11)), alpha=2.0, beta=0.0, mode="both", orientation_only=False
+) -> np.ndarray:
     """The transform S = sum over n of F_n * A_n, computed the long way."""
     image = np.asarray(image, dtype=np.float32)
     height, width = image.shape

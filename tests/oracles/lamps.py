@@ -1,4 +1,5 @@
 """Synthetic lamps for the state-classifier tests: lit disks on a dark housing, as samples."""
+
 from __future__ import annotations
 
 import cv2
@@ -28,8 +29,13 @@ def housing(colour, lit: int, lights: int = 3, width: int = 20, vertical: bool =
     image = np.full((width * lights, width, 3), 60, np.uint8)
     for i in range(lights):
         fill = colour if i == lit else (25, 25, 25)
-        cv2.circle(image, (width // 2, width * i + width // 2), width * 4 // 10,
-                   tuple(int(c) for c in fill), -1)
+        cv2.circle(
+            image,
+            (width // 2, width * i + width // 2),
+            width * 4 // 10,
+            tuple(int(c) for c in fill),
+            -1,
+        )
     return image if vertical else np.ascontiguousarray(image.transpose(1, 0, 2))
 
 
@@ -45,6 +51,7 @@ def training_set(per_state: int = 4, radii=(5, 7, 9)) -> list[Sample]:
     for state, colour in COLOURS.items():
         for i in range(per_state):
             r = radii[i % len(radii)]
-            samples.append(crop_sample(lamp(colour, size=2 * r, radius=r, seed=i), state,
-                                       f"{state}{i}"))
+            samples.append(
+                crop_sample(lamp(colour, size=2 * r, radius=r, seed=i), state, f"{state}{i}")
+            )
     return samples

@@ -4,6 +4,7 @@ Both run :func:`tsrkit.benchmarking.benchmark` / :func:`tsrkit.comparison.compar
 table on stdout and let the report writers fill ``--out``. Bare ``tsrkit`` runs
 ``run_default``: the three built-in detectors compared on the bundled synthetic sample.
 """
+
 from __future__ import annotations
 
 import os
@@ -23,12 +24,25 @@ DEFAULT_COMPARE = ("conspicuity", "gray-tophat", "lab-frst")
 def dataset_options(func):
     """``--dataset``, ``--format``, ``--images`` and ``--split``."""
     options = [
-        click.option("--dataset", "dataset_ref", default="sample", show_default=True,
-                     help="Registry name, path, or 'sample' (the bundled synthetic sample)."),
-        click.option("--format", "format_name", default=None,
-                     help="Dataset format when the path is ambiguous."),
-        click.option("--images", default=None, type=click.Path(file_okay=False),
-                     help="Root that image paths inside the annotation file resolve against."),
+        click.option(
+            "--dataset",
+            "dataset_ref",
+            default="sample",
+            show_default=True,
+            help="Registry name, path, or 'sample' (the bundled synthetic sample).",
+        ),
+        click.option(
+            "--format",
+            "format_name",
+            default=None,
+            help="Dataset format when the path is ambiguous.",
+        ),
+        click.option(
+            "--images",
+            default=None,
+            type=click.Path(file_okay=False),
+            help="Root that image paths inside the annotation file resolve against.",
+        ),
         click.option("--split", default=None, help="Use only this split (e.g. test)."),
     ]
     for option in reversed(options):
@@ -40,25 +54,56 @@ def run_options(func):
     """``--workers``, ``--engine``, ``--scheduler``, ``--out``, ``--no-cache``, ``--iou``,
     ``--quiet``, ``--eval-box``, ``--writer``."""
     options = [
-        click.option("--workers", "-w", type=click.IntRange(min=1), default=None,
-                     help="Worker processes (default: all cores)."),
-        click.option("--engine", type=click.Choice(["local", "dask"]), default="local",
-                     show_default=True, help="Process pool on this machine, or Dask."),
-        click.option("--scheduler", default=None,
-                     help="Dask scheduler address (default: a LocalCluster)."),
-        click.option("--out", "-o", type=click.Path(file_okay=False), default=DEFAULT_OUT,
-                     show_default=True, help="Output folder."),
+        click.option(
+            "--workers",
+            "-w",
+            type=click.IntRange(min=1),
+            default=None,
+            help="Worker processes (default: all cores).",
+        ),
+        click.option(
+            "--engine",
+            type=click.Choice(["local", "dask"]),
+            default="local",
+            show_default=True,
+            help="Process pool on this machine, or Dask.",
+        ),
+        click.option(
+            "--scheduler", default=None, help="Dask scheduler address (default: a LocalCluster)."
+        ),
+        click.option(
+            "--out",
+            "-o",
+            type=click.Path(file_okay=False),
+            default=DEFAULT_OUT,
+            show_default=True,
+            help="Output folder.",
+        ),
         click.option("--no-cache", is_flag=True, help="Recompute every frame."),
-        click.option("--iou", "iou_threshold", type=click.FloatRange(0, 1, max_open=True),
-                     default=0.5, show_default=True,
-                     help="IoU threshold of the report's 'iou' section (Lee 3.6.2)."),
+        click.option(
+            "--iou",
+            "iou_threshold",
+            type=click.FloatRange(0, 1, max_open=True),
+            default=0.5,
+            show_default=True,
+            help="IoU threshold of the report's 'iou' section (Lee 3.6.2).",
+        ),
         click.option("--quiet", "-q", is_flag=True, help="No progress bar."),
-        click.option("--eval-box", type=click.Choice(BOX_OPTIONS), default="auto",
-                     show_default=True,
-                     help="Box evaluated: the lens box, the housing (bbox), or auto (lens on "
-                          "lens-boxed datasets, else housing)."),
-        click.option("--writer", "writers", multiple=True, metavar="NAME",
-                     help="Report writer to run (repeatable; default: every default writer)."),
+        click.option(
+            "--eval-box",
+            type=click.Choice(BOX_OPTIONS),
+            default="auto",
+            show_default=True,
+            help="Box evaluated: the lens box, the housing (bbox), or auto (lens on "
+            "lens-boxed datasets, else housing).",
+        ),
+        click.option(
+            "--writer",
+            "writers",
+            multiple=True,
+            metavar="NAME",
+            help="Report writer to run (repeatable; default: every default writer).",
+        ),
     ]
     for option in reversed(options):
         func = option(func)
@@ -77,20 +122,46 @@ def load_dataset(ref: str, format_name: str | None, images: str | None, split: s
     return dataset
 
 
-def _run_kwargs(workers, engine, scheduler, no_cache, iou_threshold, quiet, eval_box,
-                writers) -> dict:
-    return {"workers": workers or os.cpu_count() or 1, "engine": engine,
-            "scheduler": scheduler, "cache": not no_cache, "iou_threshold": iou_threshold,
-            "progress": not quiet, "box": eval_box, "writers": list(writers) or None}
+def _run_kwargs(
+    workers, engine, scheduler, no_cache, iou_threshold, quiet, eval_box, writers
+) -> dict:
+    return {
+        "workers": workers or os.cpu_count() or 1,
+        "engine": engine,
+        "scheduler": scheduler,
+        "cache": not no_cache,
+        "iou_threshold": iou_threshold,
+        "progress": not quiet,
+        "box": eval_box,
+        "writers": list(writers) or None,
+    }
 
 
 @click.command("benchmark")
 @dataset_options
 @plugin_options
 @run_options
-def benchmark_command(dataset_ref, format_name, images, split, detector, verifier, classifier,
-                      tracker, params, config, workers, engine, scheduler, out, no_cache,
-                      iou_threshold, quiet, eval_box, writers) -> None:
+def benchmark_command(
+    dataset_ref,
+    format_name,
+    images,
+    split,
+    detector,
+    verifier,
+    classifier,
+    tracker,
+    params,
+    config,
+    workers,
+    engine,
+    scheduler,
+    out,
+    no_cache,
+    iou_threshold,
+    quiet,
+    eval_box,
+    writers,
+) -> None:
     """Run a detector (and classifier) over a dataset and write an evaluated report.
 
     With --classifier alone, classifies the ground-truth boxes (crop datasets) and reports
@@ -103,40 +174,91 @@ def benchmark_command(dataset_ref, format_name, images, split, detector, verifie
         raise UserError("benchmark evaluates frames independently; --tracker is not supported")
     chosen = build(detector, verifier, classifier, None, params, config, classifier_alone=True)
     dataset = load_dataset(dataset_ref, format_name, images, split)
-    report = benchmark(dataset, chosen.detector, chosen.classifier, out=out,
-                       verifier=chosen.verifier,
-                       **_run_kwargs(workers, engine, scheduler, no_cache, iou_threshold, quiet,
-                                     eval_box, writers))
+    report = benchmark(
+        dataset,
+        chosen.detector,
+        chosen.classifier,
+        out=out,
+        verifier=chosen.verifier,
+        **_run_kwargs(
+            workers, engine, scheduler, no_cache, iou_threshold, quiet, eval_box, writers
+        ),
+    )
     print_table([report])
     click.echo(f"report: {os.path.join(out, 'report.json')}", err=True)
 
 
 @click.command("compare")
 @dataset_options
-@click.option("--detectors", "detector_names", default=",".join(DEFAULT_COMPARE),
-              show_default=True, help="Comma-separated detector plugins.")
+@click.option(
+    "--detectors",
+    "detector_names",
+    default=",".join(DEFAULT_COMPARE),
+    show_default=True,
+    help="Comma-separated detector plugins.",
+)
 @click.option("--verifier", "-V", default=None, help="Verifier plugin for every run.")
 @click.option("--classifier", "-c", default=None, help="Classifier plugin for every run.")
-@click.option("--param", "-p", "params", multiple=True, metavar="NAME.KEY=VALUE",
-              help="Parameter for one detector (prefix with its name), for classifier. or "
-                   "verifier.; unprefixed, for every chosen plugin that declares the key.")
+@click.option(
+    "--param",
+    "-p",
+    "params",
+    multiple=True,
+    metavar="NAME.KEY=VALUE",
+    help="Parameter for one detector (prefix with its name), for classifier. or "
+    "verifier.; unprefixed, for every chosen plugin that declares the key.",
+)
 @run_options
-def compare_command(dataset_ref, format_name, images, split, detector_names, verifier,
-                    classifier, params, workers, engine, scheduler, out, no_cache, iou_threshold,
-                    quiet, eval_box, writers) -> None:
+def compare_command(
+    dataset_ref,
+    format_name,
+    images,
+    split,
+    detector_names,
+    verifier,
+    classifier,
+    params,
+    workers,
+    engine,
+    scheduler,
+    out,
+    no_cache,
+    iou_threshold,
+    quiet,
+    eval_box,
+    writers,
+) -> None:
     """Benchmark several detectors on the same frames; one report side by side.
 
     Writes OUT/<detector>/ for each run plus OUT/compare.json and OUT/compare.md with a paired
     test (Wilcoxon signed-rank on per-frame recall) for every pair.
     """
-    run_compare(dataset_ref, format_name, images, split, detector_names, classifier, params,
-                out, _run_kwargs(workers, engine, scheduler, no_cache, iou_threshold, quiet,
-                                 eval_box, writers), verifier)
+    run_compare(
+        dataset_ref,
+        format_name,
+        images,
+        split,
+        detector_names,
+        classifier,
+        params,
+        out,
+        _run_kwargs(workers, engine, scheduler, no_cache, iou_threshold, quiet, eval_box, writers),
+        verifier,
+    )
 
 
-def run_compare(dataset_ref, format_name, images, split, detector_names: str,
-                classifier: str | None, params: Sequence[str], out: str, options: dict,
-                verifier: str | None = None) -> None:
+def run_compare(
+    dataset_ref,
+    format_name,
+    images,
+    split,
+    detector_names: str,
+    classifier: str | None,
+    params: Sequence[str],
+    out: str,
+    options: dict,
+    verifier: str | None = None,
+) -> None:
     """Build every detector, compare them, print the table and the paired verdicts."""
     from tsrkit.comparison import compare
 
@@ -144,17 +266,29 @@ def run_compare(dataset_ref, format_name, images, split, detector_names: str,
     runs = build_compare(names, classifier, verifier, params)
     dataset = load_dataset(dataset_ref, format_name, images, split)
     detectors = [run.detector for run in runs if run.detector is not None]
-    comparison = compare(dataset, detectors, runs[0].classifier,
-                         out=out, verifier=runs[0].verifier, **options)
+    comparison = compare(
+        dataset, detectors, runs[0].classifier, out=out, verifier=runs[0].verifier, **options
+    )
     print_table(comparison["reports"])
     for test in comparison["paired_tests"]:
-        click.echo(f"{test['a']} vs {test['b']}: {test['verdict']} "
-                   f"(p = {test['p_value']:.3g}, {test['frames']} frames)")
+        click.echo(
+            f"{test['a']} vs {test['b']}: {test['verdict']} "
+            f"(p = {test['p_value']:.3g}, {test['frames']} frames)"
+        )
     click.echo(f"report: {os.path.join(out, 'compare.md')}", err=True)
 
 
 @click.command("default", hidden=True)
 def run_default() -> None:
     """Compare the built-in detectors on the bundled sample, writing to ./tsrkit-out."""
-    run_compare("sample", None, None, None, ",".join(DEFAULT_COMPARE), None, (), DEFAULT_OUT,
-                {"workers": os.cpu_count() or 1, "progress": True})
+    run_compare(
+        "sample",
+        None,
+        None,
+        None,
+        ",".join(DEFAULT_COMPARE),
+        None,
+        (),
+        DEFAULT_OUT,
+        {"workers": os.cpu_count() or 1, "progress": True},
+    )

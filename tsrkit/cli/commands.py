@@ -2,6 +2,7 @@
 
 The registry loads this module as an internal plugin (:data:`tsrkit.registry.INTERNAL`).
 """
+
 from tsrkit.hookspecs import hookimpl
 
 
@@ -13,6 +14,12 @@ def register_commands(cli):
     from tsrkit.cli.plugins_cmd import plugins_command
     from tsrkit.cli.train import train_command
 
-    for command in (plugins_command, detect_command, train_command, datasets_group,
-                    benchmark_command, compare_command):
+    for command in (
+        plugins_command,
+        detect_command,
+        train_command,
+        datasets_group,
+        benchmark_command,
+        compare_command,
+    ):
         cli.add_command(command)

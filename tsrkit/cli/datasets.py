@@ -1,4 +1,5 @@
 """``tsrkit datasets``: the registry in ``datasets.yaml`` — list, info, verify, convert."""
+
 from __future__ import annotations
 
 import json
@@ -9,9 +10,15 @@ import click
 from rich.console import Console
 from rich.table import Table
 
-from tsrkit.datasets import (DatasetError, load_registry, open_dataset, registry_path,
-                             verify_manifest, write_dataset)
 from tsrkit.cli.synth import synth_command
+from tsrkit.datasets import (
+    DatasetError,
+    load_registry,
+    open_dataset,
+    registry_path,
+    verify_manifest,
+    write_dataset,
+)
 from tsrkit.datasets.registry import GENERATED_SAMPLE
 from tsrkit.errors import TsrkitError
 
@@ -35,8 +42,14 @@ def list_command(as_json: bool) -> None:
     for column in ("name", "format", "task", "box", "licence", "present"):
         table.add_column(column)
     for row in rows:
-        table.add_row(row["name"], row["format"], row["task"], row["box"], row["licence"],
-                      row["present"] if row["present"] != "no" else "[red]no[/red]")
+        table.add_row(
+            row["name"],
+            row["format"],
+            row["task"],
+            row["box"],
+            row["licence"],
+            row["present"] if row["present"] != "no" else "[red]no[/red]",
+        )
     Console().print(table)
 
 
@@ -48,18 +61,28 @@ def info_command(name: str, as_json: bool) -> None:
     dataset = open_dataset(name)
     states = Counter(a.state for s in dataset for a in s.annotations)
     labels = Counter(a.attributes.get("label", a.state) for s in dataset for a in s.annotations)
-    facts = {**dataset.info, "name": dataset.name, "format": dataset.format,
-             "samples": len(dataset), "annotations": sum(states.values()),
-             "splits": dict(Counter(s.split or "-" for s in dataset)),
-             "states": dict(states.most_common()), "labels": dict(labels.most_common())}
+    facts = {
+        **dataset.info,
+        "name": dataset.name,
+        "format": dataset.format,
+        "samples": len(dataset),
+        "annotations": sum(states.values()),
+        "splits": dict(Counter(s.split or "-" for s in dataset)),
+        "states": dict(states.most_common()),
+        "labels": dict(labels.most_common()),
+    }
     if as_json:
         click.echo(json.dumps(facts, indent=2, default=str))
         return
     table = Table(title=f"dataset {dataset.name}", show_header=False)
     for key, value in facts.items():
         if value not in (None, "", [], {}):
-            table.add_row(key, ", ".join(f"{k}: {v}" for k, v in value.items())
-                          if isinstance(value, dict) else str(value))
+            table.add_row(
+                key,
+                ", ".join(f"{k}: {v}" for k, v in value.items())
+                if isinstance(value, dict)
+                else str(value),
+            )
     Console().print(table)
 
 
@@ -79,8 +102,10 @@ def verify_command(ctx: click.Context, name: str) -> None:
     for label, files in (("missing", result.missing), ("altered", result.altered)):
         for file in files:
             click.echo(f"{label}: {file}")
-    summary = (f"{name}: {result.checked} files checked, {len(result.missing)} missing, "
-               f"{len(result.altered)} altered, {len(result.unlisted)} not in the manifest")
+    summary = (
+        f"{name}: {result.checked} files checked, {len(result.missing)} missing, "
+        f"{len(result.altered)} altered, {len(result.unlisted)} not in the manifest"
+    )
     click.echo(summary)
     if not result.ok:
         ctx.exit(1)
@@ -89,14 +114,24 @@ def verify_command(ctx: click.Context, name: str) -> None:
 @datasets_group.command("convert")
 @click.argument("src")
 @click.option("--to", "to_format", required=True, help="Format plugin to write.")
-@click.option("--out", required=True, type=click.Path(path_type=Path),
-              help="Output file (coco, normalized) or folder (yolo, voc).")
-@click.option("--format", "src_format", default=None,
-              help="Format of SRC (detected when unambiguous).")
-@click.option("--images", type=click.Path(path_type=Path), default=None,
-              help="Folder that image paths in SRC resolve against.")
-def convert_command(src: str, to_format: str, out: Path, src_format: str | None,
-                    images: Path | None) -> None:
+@click.option(
+    "--out",
+    required=True,
+    type=click.Path(path_type=Path),
+    help="Output file (coco, normalized) or folder (yolo, voc).",
+)
+@click.option(
+    "--format", "src_format", default=None, help="Format of SRC (detected when unambiguous)."
+)
+@click.option(
+    "--images",
+    type=click.Path(path_type=Path),
+    default=None,
+    help="Folder that image paths in SRC resolve against.",
+)
+def convert_command(
+    src: str, to_format: str, out: Path, src_format: str | None, images: Path | None
+) -> None:
     """Read SRC (registry name or path) and write it in another format at --out."""
     dataset = open_dataset(src, format=src_format, images=images)
     write_dataset(dataset, to_format, out)

@@ -1,4 +1,5 @@
 """``tsrkit detect``: run a detector (and classifier, tracker) over images, folders or videos."""
+
 from __future__ import annotations
 
 import json
@@ -20,8 +21,15 @@ from tsrkit.selection import build
 from tsrkit.types import Frame, Skipped
 
 
-def run_detect(pipeline: Pipeline, paths, out, draw: Path | None = None, every: int = 1,
-               start: int = 0, end: int | None = None) -> tuple[int, int, list[Skipped]]:
+def run_detect(
+    pipeline: Pipeline,
+    paths,
+    out,
+    draw: Path | None = None,
+    every: int = 1,
+    start: int = 0,
+    end: int | None = None,
+) -> tuple[int, int, list[Skipped]]:
     """Write one JSON Lines record per frame to the text stream ``out``.
 
     A frame on which a plugin crashes is reported as skipped and the run goes on; a
@@ -76,16 +84,25 @@ def default_inputs() -> list[str]:
 @click.command("detect")
 @click.argument("paths", nargs=-1, type=click.Path())
 @plugin_options
-@click.option("--out", "-o", type=click.Path(dir_okay=False), default=None,
-              help="JSON Lines output file (written atomically); default stdout.")
-@click.option("--draw", type=click.Path(file_okay=False), default=None,
-              help="Folder for overlay images coloured by state.")
+@click.option(
+    "--out",
+    "-o",
+    type=click.Path(dir_okay=False),
+    default=None,
+    help="JSON Lines output file (written atomically); default stdout.",
+)
+@click.option(
+    "--draw",
+    type=click.Path(file_okay=False),
+    default=None,
+    help="Folder for overlay images coloured by state.",
+)
 @click.option("--every", type=click.IntRange(min=1), default=1, help="Keep every N-th frame.")
 @click.option("--start", type=click.IntRange(min=0), default=0, help="First video frame.")
-@click.option("--end", type=click.IntRange(min=0), default=None,
-              help="Video frame to stop before.")
-def detect_command(paths, detector, verifier, classifier, tracker, params, config, out, draw, every,
-                   start, end) -> None:
+@click.option("--end", type=click.IntRange(min=0), default=None, help="Video frame to stop before.")
+def detect_command(
+    paths, detector, verifier, classifier, tracker, params, config, out, draw, every, start, end
+) -> None:
     """Detect lit signal lenses in images, folders (recursive) or videos.
 
     Writes one JSON record per frame: source, frame, width, height, ms and detections (x, y,
@@ -98,11 +115,11 @@ def detect_command(paths, detector, verifier, classifier, tracker, params, confi
         draw_dir.mkdir(parents=True, exist_ok=True)
     sink = atomic_open(out) if out else nullcontext(sys.stdout)
     with sink as stream:
-        frames, found, skipped = run_detect(pipeline, inputs, stream, draw_dir, every, start,
-                                            end)
+        frames, found, skipped = run_detect(pipeline, inputs, stream, draw_dir, every, start, end)
     console = Console(stderr=True)
-    console.print(f"[bold]{frames}[/bold] frames, [bold]{found}[/bold] detections, "
-                  f"[bold]{len(skipped)}[/bold] skipped" + (f" -> {out}" if out else ""))
+    console.print(
+        f"[bold]{frames}[/bold] frames, [bold]{found}[/bold] detections, "
+        f"[bold]{len(skipped)}[/bold] skipped" + (f" -> {out}" if out else "")
+    )
     for item in skipped:
         console.print(f"  skipped {item.source}: {item.reason}", markup=False)
-

@@ -1,4 +1,5 @@
 """The ``tsrkit`` click group; every verb, built-in or not, is added via ``register_commands``."""
+
 from __future__ import annotations
 
 import click
@@ -18,8 +19,11 @@ class TsrkitGroup(click.Group):
             raise UserError(str(exc)) from None
 
 
-@click.group(cls=TsrkitGroup, invoke_without_command=True,
-             context_settings={"help_option_names": ["-h", "--help"]})
+@click.group(
+    cls=TsrkitGroup,
+    invoke_without_command=True,
+    context_settings={"help_option_names": ["-h", "--help"]},
+)
 @click.version_option(package_name="tsrkit")
 @click.pass_context
 def cli(ctx: click.Context) -> None:
@@ -40,8 +44,11 @@ def _add_commands() -> None:
         try:
             impl.function(cli=cli)
         except Exception as exc:  # one broken plugin must not break the command line
-            registry.failures.append(PluginFailure(
-                impl.plugin_name, "?", f"register_commands: {type(exc).__name__}: {exc}"))
+            registry.failures.append(
+                PluginFailure(
+                    impl.plugin_name, "?", f"register_commands: {type(exc).__name__}: {exc}"
+                )
+            )
             if impl.plugin_name in INTERNAL:  # the core's own verbs must not fail silently
                 raise
 

@@ -1,4 +1,5 @@
 """``tsrkit plugins``: what is installed, and what failed to load."""
+
 from __future__ import annotations
 
 import json
@@ -13,8 +14,9 @@ from tsrkit.registry import KINDS
 
 @click.command("plugins")
 @click.option("--json", "as_json", is_flag=True, help="Print JSON (with parameter schemas).")
-@click.option("--kind", type=click.Choice(list(KINDS)),
-              default=None, help="Only plugins of this kind.")
+@click.option(
+    "--kind", type=click.Choice(list(KINDS)), default=None, help="Only plugins of this kind."
+)
 def plugins_command(as_json: bool, kind: str | None) -> None:
     """List installed plugins: name, kind, package, version and summary."""
     found = tsrkit.plugins(kind)
@@ -26,9 +28,15 @@ def plugins_command(as_json: bool, kind: str | None) -> None:
         table.add_column(column)
     for item in found:
         if item["kind"] == "failed":
-            table.add_row(item["name"], "[red]failed[/red]", item["package"], "",
-                          f"[red]{item['error']}[/red]")
+            table.add_row(
+                item["name"],
+                "[red]failed[/red]",
+                item["package"],
+                "",
+                f"[red]{item['error']}[/red]",
+            )
         else:
-            table.add_row(item["name"], item["kind"], item["package"], item["version"],
-                          item["summary"])
+            table.add_row(
+                item["name"], item["kind"], item["package"], item["version"], item["summary"]
+            )
     Console().print(table)

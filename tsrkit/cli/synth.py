@@ -1,4 +1,5 @@
 """``tsrkit datasets synth``: render a deterministic synthetic dataset (images + COCO + JSON)."""
+
 from __future__ import annotations
 
 from collections import Counter
@@ -6,23 +7,33 @@ from pathlib import Path
 
 import click
 
-from tsrkit.synth import LIGHTINGS, generate
 from tsrkit.errors import TsrkitError
+from tsrkit.synth import LIGHTINGS, generate
 
 
 @click.command("synth")
-@click.option("--out", required=True, type=click.Path(file_okay=False, path_type=Path),
-              help="Output folder (images/, annotations.json, coco.json).")
-@click.option("--frames", default=48, show_default=True, type=click.IntRange(min=1),
-              help="Number of frames.")
+@click.option(
+    "--out",
+    required=True,
+    type=click.Path(file_okay=False, path_type=Path),
+    help="Output folder (images/, annotations.json, coco.json).",
+)
+@click.option(
+    "--frames", default=48, show_default=True, type=click.IntRange(min=1), help="Number of frames."
+)
 @click.option("--seed", default=0, show_default=True, type=int, help="Scene seed.")
 @click.option("--width", default=480, show_default=True, type=click.IntRange(64, 8192))
 @click.option("--height", default=356, show_default=True, type=click.IntRange(64, 8192))
-@click.option("--lighting", default=",".join(LIGHTINGS), show_default=True,
-              help="Comma-separated lighting conditions, assigned to frames in turn.")
+@click.option(
+    "--lighting",
+    default=",".join(LIGHTINGS),
+    show_default=True,
+    help="Comma-separated lighting conditions, assigned to frames in turn.",
+)
 @click.option("--overwrite", is_flag=True, help="Replace an existing folder with other data.")
-def synth_command(out: Path, frames: int, seed: int, width: int, height: int, lighting: str,
-                  overwrite: bool) -> None:
+def synth_command(
+    out: Path, frames: int, seed: int, width: int, height: int, lighting: str, overwrite: bool
+) -> None:
     """Render FRAMES road scenes with lit signal lenses of known centre, radius and state.
 
     Same arguments give byte-identical files. Frames alternate day / dusk / night (or the
@@ -30,10 +41,13 @@ def synth_command(out: Path, frames: int, seed: int, width: int, height: int, li
     """
     conditions = tuple(c.strip() for c in lighting.split(",") if c.strip())
     try:
-        dataset = generate(out, frames, seed, width, height, overwrite=overwrite,
-                           lighting=conditions)
+        dataset = generate(
+            out, frames, seed, width, height, overwrite=overwrite, lighting=conditions
+        )
     except ValueError as exc:  # bad option values: one line, like every TsrkitError
         raise TsrkitError(str(exc)) from None
     states = Counter(a.state for s in dataset for a in s.annotations)
-    click.echo(f"wrote {len(dataset)} frames, {sum(states.values())} lit lenses "
-               f"({', '.join(f'{k} {v}' for k, v in sorted(states.items()))}) to {out}")
+    click.echo(
+        f"wrote {len(dataset)} frames, {sum(states.values())} lit lenses "
+        f"({', '.join(f'{k} {v}' for k, v in sorted(states.items()))}) to {out}"
+    )

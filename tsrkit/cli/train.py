@@ -1,4 +1,5 @@
 """``tsrkit train``: fit a trainable plugin on a dataset and save its model."""
+
 from __future__ import annotations
 
 import click
@@ -11,29 +12,49 @@ from tsrkit.training import train
 
 @click.command("train")
 @click.argument("plugin")
-@click.option("--dataset", "dataset_ref", required=True,
-              help="Registry name or path of the training data.")
-@click.option("--format", "format_name", default=None, help="Dataset format when a path is "
-              "ambiguous.")
-@click.option("--images", default=None, type=click.Path(file_okay=False),
-              help="Root that image paths inside the annotation file resolve against.")
+@click.option(
+    "--dataset", "dataset_ref", required=True, help="Registry name or path of the training data."
+)
+@click.option(
+    "--format", "format_name", default=None, help="Dataset format when a path is ambiguous."
+)
+@click.option(
+    "--images",
+    default=None,
+    type=click.Path(file_okay=False),
+    help="Root that image paths inside the annotation file resolve against.",
+)
 @click.option("--split", default=None, help="Use only this split (e.g. train).")
-@click.option("--param", "-p", "params", multiple=True, metavar="KEY=VALUE",
-              help="Plugin parameter; repeatable.")
-@click.option("--out", required=True, type=click.Path(dir_okay=False),
-              help="Model path (writes MODEL.npz and MODEL.json).")
-@click.option("--detector", "-d", default=None,
-              help="Detector whose candidates a trainable verifier learns on (its parameters: "
-                   "-p detector.KEY=VALUE).")
-def train_command(plugin, dataset_ref, format_name, images, split, params, out,
-                  detector) -> None:
+@click.option(
+    "--param",
+    "-p",
+    "params",
+    multiple=True,
+    metavar="KEY=VALUE",
+    help="Plugin parameter; repeatable.",
+)
+@click.option(
+    "--out",
+    required=True,
+    type=click.Path(dir_okay=False),
+    help="Model path (writes MODEL.npz and MODEL.json).",
+)
+@click.option(
+    "--detector",
+    "-d",
+    default=None,
+    help="Detector whose candidates a trainable verifier learns on (its parameters: "
+    "-p detector.KEY=VALUE).",
+)
+def train_command(plugin, dataset_ref, format_name, images, split, params, out, detector) -> None:
     """Fit PLUGIN (a trainable detector, verifier or classifier) and save the model for
     --param model=."""
     from tsrkit.datasets import open_dataset
 
     assignments = parse_assignments(params)
-    detector_params = {k.removeprefix("detector."): v for k, v in assignments.items()
-                       if k.startswith("detector.")}
+    detector_params = {
+        k.removeprefix("detector."): v for k, v in assignments.items() if k.startswith("detector.")
+    }
     own = {k: v for k, v in assignments.items() if not k.startswith("detector.")}
     if detector_params and not detector:
         raise click.UsageError("detector.KEY=VALUE parameters need --detector")
@@ -42,5 +63,6 @@ def train_command(plugin, dataset_ref, format_name, images, split, params, out,
     if split:
         dataset = dataset.split(split)
     path = train(plugin, dataset, out, own, det)
-    Console(stderr=True).print(f"trained {plugin} on {len(dataset)} samples of "
-                               f"{dataset.name} -> {path}")
+    Console(stderr=True).print(
+        f"trained {plugin} on {len(dataset)} samples of {dataset.name} -> {path}"
+    )

@@ -4,13 +4,33 @@
 >>> ds = open_dataset("roboflow_traffic_light_kr")          # doctest: +SKIP
 >>> ds = open_dataset("path/to/coco.json", format="coco")   # doctest: +SKIP
 """
+
 from tsrkit.datasets.errors import DatasetError
 from tsrkit.datasets.manifest import Verification, verify_manifest
-from tsrkit.datasets.opening import (SAMPLE, detect_format, open_dataset, read_dataset, relabel,
-                                     write_dataset)
+from tsrkit.datasets.opening import (
+    SAMPLE,
+    detect_format,
+    open_dataset,
+    read_dataset,
+    relabel,
+    write_dataset,
+)
 from tsrkit.datasets.registry import DatasetEntry, data_dir, load_registry, registry_path
 from tsrkit.datasets.states import to_state
 
-__all__ = ["DatasetError", "DatasetEntry", "SAMPLE", "Verification", "data_dir",
-           "detect_format", "load_registry", "open_dataset", "read_dataset", "registry_path",
-           "relabel", "to_state", "verify_manifest", "write_dataset"]
+__all__ = [
+    "SAMPLE",
+    "DatasetEntry",
+    "DatasetError",
+    "Verification",
+    "data_dir",
+    "detect_format",
+    "load_registry",
+    "open_dataset",
+    "read_dataset",
+    "registry_path",
+    "relabel",
+    "to_state",
+    "verify_manifest",
+    "write_dataset",
+]

@@ -2,6 +2,7 @@
 
 Also the YAML reading that registry and format readers share, so its errors read alike.
 """
+
 from __future__ import annotations
 
 import os
@@ -54,5 +55,8 @@ def read_yaml(path: str | os.PathLike, missing: str = "file not found") -> Any:
         raise DatasetError(path, missing) from None
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
-        raise DatasetError(path, f"not valid YAML ({getattr(exc, 'problem', None) or exc})",
-                           f"line {mark.line + 1}" if mark else "") from None
+        raise DatasetError(
+            path,
+            f"not valid YAML ({getattr(exc, 'problem', None) or exc})",
+            f"line {mark.line + 1}" if mark else "",
+        ) from None

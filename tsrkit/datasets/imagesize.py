@@ -1,4 +1,5 @@
 """Image width and height from the file header, without decoding the pixels."""
+
 from __future__ import annotations
 
 import os

@@ -1,4 +1,5 @@
 """Checking a dataset folder against its ``sha256sum``-style manifest."""
+
 from __future__ import annotations
 
 import hashlib
@@ -74,6 +75,9 @@ def verify_manifest(root: Path, manifest: Path) -> Verification:
         elif sha256_file(target) != digest:
             altered.append(name)
     listed = set(entries) | {str(Path(manifest).resolve().relative_to(root.resolve()))}
-    unlisted = sorted(str(p.relative_to(root)) for p in root.rglob("*")
-                      if p.is_file() and str(p.relative_to(root)) not in listed)
+    unlisted = sorted(
+        str(p.relative_to(root))
+        for p in root.rglob("*")
+        if p.is_file() and str(p.relative_to(root)) not in listed
+    )
     return Verification(len(entries), tuple(missing), tuple(altered), tuple(unlisted))

@@ -3,6 +3,7 @@
 The format comes from the registry entry, from the caller, or from the format plugins'
 ``sniff`` when exactly one of them recognises the path.
 """
+
 from __future__ import annotations
 
 import dataclasses
@@ -19,9 +20,12 @@ from tsrkit.types import Annotation, Dataset
 SAMPLE = "sample"
 
 
-def open_dataset(ref: str | os.PathLike, format: str | None = None,
-                 images: str | os.PathLike | None = None,
-                 states: Mapping[str, str] | None = None) -> Dataset:
+def open_dataset(
+    ref: str | os.PathLike,
+    format: str | None = None,
+    images: str | os.PathLike | None = None,
+    states: Mapping[str, str] | None = None,
+) -> Dataset:
     """Read a dataset: a registry name, ``"sample"``, or a path to a file or folder.
 
     Parameters
@@ -59,8 +63,9 @@ def open_dataset(ref: str | os.PathLike, format: str | None = None,
             dataset = dataclasses.replace(dataset, name=SAMPLE)
     else:
         dataset = read_dataset(entry.annotation_path(), format or entry.format, images)
-        dataset = dataclasses.replace(dataset, name=entry.name,
-                                      info={**dataset.info, **entry.to_info()})
+        dataset = dataclasses.replace(
+            dataset, name=entry.name, info={**dataset.info, **entry.to_info()}
+        )
         states = {**entry.states, **(states or {})}
     return relabel(dataset, check_mapping(states, "states")) if states else dataset
 
@@ -79,28 +84,37 @@ def detect_format(path: Path) -> str:
     TsrkitError
         When none or several match, naming them and asking for ``--format``.
     """
-    matched = [info.name for info in get_registry().plugins("format")
-               if get_registry().create("format", info.name).sniff(Path(path))]
+    matched = [
+        info.name
+        for info in get_registry().plugins("format")
+        if get_registry().create("format", info.name).sniff(Path(path))
+    ]
     if len(matched) == 1:
         return matched[0]
     every = ", ".join(info.name for info in get_registry().plugins("format"))
     if matched:
-        raise TsrkitError(f"{path}: several formats match ({', '.join(matched)}); "
-                          f"pass --format (format=...) to choose")
-    raise TsrkitError(f"{path}: no format recognises it; pass --format (format=...), "
-                      f"one of: {every}")
+        raise TsrkitError(
+            f"{path}: several formats match ({', '.join(matched)}); "
+            f"pass --format (format=...) to choose"
+        )
+    raise TsrkitError(
+        f"{path}: no format recognises it; pass --format (format=...), one of: {every}"
+    )
 
 
 def relabel(dataset: Dataset, states: Mapping[str, str]) -> Dataset:
     """Re-map every annotation whose raw ``attributes["label"]`` is a key of ``states``."""
+
     def remap(ann: Annotation) -> Annotation:
         label = ann.attributes.get("label")
         if label is None or label not in states:
             return ann
         return dataclasses.replace(ann, state=to_state(label, states))
 
-    samples = tuple(dataclasses.replace(s, annotations=tuple(map(remap, s.annotations)))
-                    for s in dataset.samples)
+    samples = tuple(
+        dataclasses.replace(s, annotations=tuple(map(remap, s.annotations)))
+        for s in dataset.samples
+    )
     return dataclasses.replace(dataset, samples=samples)
 
 
@@ -108,7 +122,9 @@ def write_dataset(dataset: Dataset, format: str, out: str | os.PathLike) -> Path
     """Write ``dataset`` with the format plugin ``format`` at ``out`` (file or folder)."""
     writer = get_registry().create("format", format)
     if not writer.writable:
-        writable = ", ".join(i.name for i in get_registry().plugins("format") if getattr(i.cls, "writable", False))
+        writable = ", ".join(
+            i.name for i in get_registry().plugins("format") if getattr(i.cls, "writable", False)
+        )
         raise TsrkitError(f"format '{format}' has no writer (writable: {writable})")
     writer.write(dataset, Path(out))
     return Path(out)

@@ -5,6 +5,7 @@ The file is ``$TSRKIT_DATASETS_YAML`` when set, else the ``datasets.yaml`` insta
 root, so a wheel or ``pip install .`` carries a copy). A relative ``root`` resolves against
 ``$TSRKIT_DATA_DIR``; when that is unset, against ``<repo>/../shared/datasets``.
 """
+
 from __future__ import annotations
 
 import os
@@ -12,7 +13,6 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
-
 
 from tsrkit.datasets.errors import DatasetError, read_yaml
 from tsrkit.datasets.states import check_mapping
@@ -66,20 +66,34 @@ class DatasetEntry:
         """What the format reader opens; a clear error when the data folder is missing."""
         root = self.root_path()
         if not root.exists():
-            hint = (f"${DATA_DIR_ENV} is {os.environ[DATA_DIR_ENV]!r}"
-                    if DATA_DIR_ENV in os.environ
-                    else f"${DATA_DIR_ENV} is unset, so the default {data_dir()} was used")
-            raise DatasetError(root, f"dataset '{self.name}' not found ({hint}); set "
-                                     f"{DATA_DIR_ENV} to the folder that holds it")
+            hint = (
+                f"${DATA_DIR_ENV} is {os.environ[DATA_DIR_ENV]!r}"
+                if DATA_DIR_ENV in os.environ
+                else f"${DATA_DIR_ENV} is unset, so the default {data_dir()} was used"
+            )
+            raise DatasetError(
+                root,
+                f"dataset '{self.name}' not found ({hint}); set "
+                f"{DATA_DIR_ENV} to the folder that holds it",
+            )
         return (root / self.path).resolve() if self.path != "." else root
 
     def to_info(self) -> dict[str, Any]:
         """The facts a :class:`tsrkit.types.Dataset` carries in ``info``."""
-        info = {"name": self.name, "format": self.format, "root": str(self.root_path()),
-                "path": self.path, "licence": self.licence, "citation": self.citation,
-                "task": self.task, "box": self.box, "manifest": self.manifest,
-                "splits": list(self.splits), "states": dict(self.states),
-                "description": self.description}
+        info = {
+            "name": self.name,
+            "format": self.format,
+            "root": str(self.root_path()),
+            "path": self.path,
+            "licence": self.licence,
+            "citation": self.citation,
+            "task": self.task,
+            "box": self.box,
+            "manifest": self.manifest,
+            "splits": list(self.splits),
+            "states": dict(self.states),
+            "description": self.description,
+        }
         info.update(self.extra)
         return info
 
@@ -116,8 +130,7 @@ def _yaml_off(mapping: Any) -> Any:
     """YAML 1.1 loads an unquoted ``off`` as False; in a ``states`` mapping it means "off"."""
     if not isinstance(mapping, Mapping):
         return mapping
-    return {("off" if k is False else k): ("off" if v is False else v)
-            for k, v in mapping.items()}
+    return {("off" if k is False else k): ("off" if v is False else v) for k, v in mapping.items()}
 
 
 def _entry(path: Path, name: str, fields: Any) -> DatasetEntry:
@@ -128,17 +141,26 @@ def _entry(path: Path, name: str, fields: Any) -> DatasetEntry:
     if missing:
         raise DatasetError(path, f"missing {', '.join(missing)}", where)
     if fields["box"] not in BOXES:
-        raise DatasetError(path, f"box must be one of {', '.join(BOXES)}, "
-                                 f"got {fields['box']!r}", where)
+        raise DatasetError(
+            path, f"box must be one of {', '.join(BOXES)}, got {fields['box']!r}", where
+        )
     try:
         states = check_mapping(_yaml_off(fields.get("states") or {}), where)
     except ValueError as exc:
         raise DatasetError(path, str(exc)) from None
     known = set(REQUIRED) | {"path", "manifest", "splits", "states", "description"}
     return DatasetEntry(
-        name=name, format=str(fields["format"]), root=str(fields["root"]),
-        licence=str(fields["licence"]), citation=str(fields["citation"]).strip(),
-        task=str(fields["task"]), box=str(fields["box"]), path=str(fields.get("path", ".")),
-        manifest=fields.get("manifest"), splits=tuple(fields.get("splits") or ()),
-        states=states, description=str(fields.get("description", "")).strip(),
-        extra={k: v for k, v in fields.items() if k not in known})
+        name=name,
+        format=str(fields["format"]),
+        root=str(fields["root"]),
+        licence=str(fields["licence"]),
+        citation=str(fields["citation"]).strip(),
+        task=str(fields["task"]),
+        box=str(fields["box"]),
+        path=str(fields.get("path", ".")),
+        manifest=fields.get("manifest"),
+        splits=tuple(fields.get("splits") or ()),
+        states=states,
+        description=str(fields.get("description", "")).strip(),
+        extra={k: v for k, v in fields.items() if k not in known},
+    )

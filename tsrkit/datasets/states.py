@@ -4,6 +4,7 @@ Readers keep the raw label in ``Annotation.attributes["label"]`` and set ``state
 :func:`to_state`. A registry entry (``states:`` in ``datasets.yaml``) or a caller may give an
 explicit ``{raw label: state}`` mapping that overrides the default rules below.
 """
+
 from __future__ import annotations
 
 from collections.abc import Mapping
@@ -14,10 +15,21 @@ from tsrkit.types import STATES
 #: matching maps e.g. Bosch ``RedLeft`` to red, LISA ``goLeft`` to green, ``warningLeft`` to
 #: yellow. ``left`` alone (the Korean Roboflow arrow) is NOT here: its colour is a dataset fact
 #: and belongs in that dataset's registry entry.
-PREFIXES = (("red_yellow", "red_yellow"), ("redyellow", "red_yellow"), ("red-yellow", "red_yellow"),
-            ("red", "red"), ("stop", "red"), ("yellow", "yellow"), ("amber", "yellow"),
-            ("warning", "yellow"), ("green", "green"), ("go", "green"), ("off", "off"),
-            ("dark", "off"), ("black", "off"))
+PREFIXES = (
+    ("red_yellow", "red_yellow"),
+    ("redyellow", "red_yellow"),
+    ("red-yellow", "red_yellow"),
+    ("red", "red"),
+    ("stop", "red"),
+    ("yellow", "yellow"),
+    ("amber", "yellow"),
+    ("warning", "yellow"),
+    ("green", "green"),
+    ("go", "green"),
+    ("off", "off"),
+    ("dark", "off"),
+    ("black", "off"),
+)
 
 
 def to_state(label: str, mapping: Mapping[str, str] | None = None) -> str:

@@ -3,6 +3,7 @@
 The registry loads this module as an internal plugin (always, whatever ``TSRKIT_LOAD_PLUGINS``
 says), so every report has the sections DESIGN.md promises.
 """
+
 from tsrkit.eval.categories import LightingBySize
 from tsrkit.eval.coco import CocoAP
 from tsrkit.eval.overlap import OverlapPR

@@ -3,6 +3,7 @@
 Each ground-truth frame falls into one lighting condition (labelled, or Mascetti 3.2's mean V)
 and one maximum target radius; a row counts its frames by recall label and precision bound.
 """
+
 from __future__ import annotations
 
 import math
@@ -39,11 +40,15 @@ def _row(lighting: str, radius: int | None, members: Sequence[FrameScore]) -> di
     summary = summarise(members)
     recall_counts = Counter(recall_label(s) for s in members)
     precision_counts = Counter(precision_bound(s) for s in members)
-    bubbles = Counter((round(s.recall or 0.0, 6), round(1 - (s.precision or 0.0), 6))
-                      for s in members)
+    bubbles = Counter(
+        (round(s.recall or 0.0, 6), round(1 - (s.precision or 0.0), 6)) for s in members
+    )
     return {
-        "lighting": lighting, "max_radius": radius, "frames": len(members),
-        "recall_mean": summary["recall_mean"], "precision_mean": summary["precision_mean"],
+        "lighting": lighting,
+        "max_radius": radius,
+        "frames": len(members),
+        "recall_mean": summary["recall_mean"],
+        "precision_mean": summary["precision_mean"],
         "hit_frame_fraction": summary["hit_frame_fraction"],
         "recall_counts": dict(sorted(recall_counts.items(), key=lambda kv: recall_sort_key(kv[0]))),
         "precision_counts": {f"{b}%": precision_counts[b] for b in sorted(precision_counts)},

@@ -5,6 +5,7 @@ where lit lenses are, not their state. ``coco_ap`` returns pycocotools' AP at Io
 averaged over IoU 0.5:0.05:0.95, computed on exactly the dictionaries the COCO writer puts on
 disk (:func:`coco_frame` builds both). Image ids are the dataset positions plus one.
 """
+
 from __future__ import annotations
 
 import contextlib
@@ -21,29 +22,51 @@ from tsrkit.types import Sample
 CATEGORY = {"id": 1, "name": "traffic_light", "supercategory": "traffic_signal"}
 
 
-def coco_frame(sample: Sample, record: FrameRecord, first_id: int,
-               box: str) -> tuple[dict, list[dict], list[dict]]:
+def coco_frame(
+    sample: Sample, record: FrameRecord, first_id: int, box: str
+) -> tuple[dict, list[dict], list[dict]]:
     """One frame's COCO ``images`` entry, ground-truth ``annotations`` and ``results``.
 
     ``first_id`` numbers the annotations; ``box`` is the evaluated record box (``lens`` or
     ``housing``).
     """
     image_id = record.index + 1
-    image = {"id": image_id, "file_name": record.source, "width": int(record.width),
-             "height": int(record.height)}
+    image = {
+        "id": image_id,
+        "file_name": record.source,
+        "width": int(record.width),
+        "height": int(record.height),
+    }
     annotations = []
     for offset, ann in enumerate(sample.annotations):
         xywh = xyxy_to_xywh(ann.bbox)
-        annotations.append({"id": first_id + offset, "image_id": image_id, "category_id": 1,
-                            "bbox": xywh, "area": xywh[2] * xywh[3], "iscrowd": 0,
-                            "state": ann.state})
-    results = [{"image_id": image_id, "category_id": 1, "bbox": xyxy_to_xywh(d.box(box)),
-                "score": float(d.score), "state": d.state} for d in record.detections]
+        annotations.append(
+            {
+                "id": first_id + offset,
+                "image_id": image_id,
+                "category_id": 1,
+                "bbox": xywh,
+                "area": xywh[2] * xywh[3],
+                "iscrowd": 0,
+                "state": ann.state,
+            }
+        )
+    results = [
+        {
+            "image_id": image_id,
+            "category_id": 1,
+            "bbox": xyxy_to_xywh(d.box(box)),
+            "score": float(d.score),
+            "state": d.state,
+        }
+        for d in record.detections
+    ]
     return image, annotations, results
 
 
-def coco_run(name: str, pairs: Iterable[tuple[Sample, FrameRecord]],
-             box: str) -> tuple[dict[str, Any], list[dict[str, Any]]]:
+def coco_run(
+    name: str, pairs: Iterable[tuple[Sample, FrameRecord]], box: str
+) -> tuple[dict[str, Any], list[dict[str, Any]]]:
     """The COCO ground-truth dictionary and the results list of evaluated frames."""
     images: list[dict] = []
     annotations: list[dict] = []
@@ -58,8 +81,12 @@ def coco_run(name: str, pairs: Iterable[tuple[Sample, FrameRecord]],
 
 def coco_dataset(images: list[dict], annotations: list[dict], name: str) -> dict[str, Any]:
     """A COCO ground-truth dictionary."""
-    return {"info": {"description": f"tsrkit ground truth of {name}"}, "images": images,
-            "annotations": annotations, "categories": [CATEGORY]}
+    return {
+        "info": {"description": f"tsrkit ground truth of {name}"},
+        "images": images,
+        "annotations": annotations,
+        "categories": [CATEGORY],
+    }
 
 
 def coco_ap(ground_truth: Mapping[str, Any], results: list[dict[str, Any]]) -> dict[str, Any]:
@@ -85,8 +112,10 @@ def coco_ap(ground_truth: Mapping[str, Any], results: list[dict[str, Any]]) -> d
         evaluator.evaluate()
         evaluator.accumulate()
         evaluator.summarize()
-    curve = {"recall": evaluator.params.recThrs.tolist(),
-             "precision": evaluator.eval["precision"][0, :, 0, 0, -1].tolist()}
+    curve = {
+        "recall": evaluator.params.recThrs.tolist(),
+        "precision": evaluator.eval["precision"][0, :, 0, 0, -1].tolist(),
+    }
     return {"ap50": float(evaluator.stats[1]), "ap": float(evaluator.stats[0]), "curve": curve}
 
 
@@ -104,8 +133,7 @@ class CocoAP(Metric):
         self.results: list[dict] = []
 
     def update(self, sample: Sample, record: FrameRecord) -> None:
-        image, anns, dets = coco_frame(sample, record, len(self.annotations) + 1,
-                                       self.settings.box)
+        image, anns, dets = coco_frame(sample, record, len(self.annotations) + 1, self.settings.box)
         self.images.append(image)
         self.annotations += anns
         self.results += dets
@@ -113,8 +141,9 @@ class CocoAP(Metric):
     def compute(self) -> dict:
         if not self.settings.detection:
             return {}
-        ap = coco_ap(coco_dataset(self.images, self.annotations, self.settings.dataset),
-                     self.results)
+        ap = coco_ap(
+            coco_dataset(self.images, self.annotations, self.settings.dataset), self.results
+        )
         if not self.settings.exhaustive:
             ap = {"ap50": None, "ap": None, "curve": None}
         return {"iou50": {"ap": ap["ap50"], "ap_50_95": ap["ap"], "pr_curve": ap["curve"]}}

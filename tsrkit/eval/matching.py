@@ -5,6 +5,7 @@ in the minimum enclosing circle of a ground-truth box of the same frame); ``gree
 :func:`tsrkit.geometry.iou_matrix` implements the overlap test of Lee 3.6.2 (PASCAL,
 ``tau < area(o & g) / area(o | g)``). Box geometry lives in :mod:`tsrkit.geometry`.
 """
+
 from __future__ import annotations
 
 import numpy as np

@@ -5,6 +5,7 @@ A detection box ``o`` matches a ground-truth box ``g`` of the same frame when
 Besides the counting precision and recall, Lee's area precision ``area(o & g) / area(o)`` and
 area recall ``area(o & g) / area(g)`` are averaged over the matched pairs.
 """
+
 from __future__ import annotations
 
 from collections.abc import Sequence
@@ -59,7 +60,9 @@ def summarise_overlap(scores: Sequence[OverlapScore], threshold: float) -> dict:
         "threshold": threshold,
         "precision": matched / n_det if n_det else None,
         "recall": matched / n_gt if n_gt else None,
-        "true_positives": matched, "detections": n_det, "ground_truth": n_gt,
+        "true_positives": matched,
+        "detections": n_det,
+        "ground_truth": n_gt,
         "area_precision": sum(s.area_precision_sum for s in scores) / matched if matched else None,
         "area_recall": sum(s.area_recall_sum for s in scores) / matched if matched else None,
     }
@@ -90,8 +93,10 @@ class OverlapPR(Metric):
     def compute(self) -> dict:
         if not self.settings.detection:
             return {"iou50": NOT_DETECTION, "iou": NOT_DETECTION}
-        out = {"iou50": summarise_overlap(self.at50, 0.5),
-               "iou": summarise_overlap(self.at_threshold, self.settings.iou_threshold)}
+        out = {
+            "iou50": summarise_overlap(self.at50, 0.5),
+            "iou": summarise_overlap(self.at_threshold, self.settings.iou_threshold),
+        }
         for section in out.values():
             section["precision"] = self.settings.false_positive_figure(section["precision"])
         return out

@@ -6,14 +6,16 @@ of the present traffic signals in a given frame can be correctly detected" and "
 objects are reported among all detections"): recall = boxes whose circle holds at least one
 candidate centre / boxes; precision = candidates inside some circle / candidates.
 Summary definitions follow DESIGN.md; false positives on frames without ground truth are counted
-separately and do not enter ``precision_mean``. The Table 5-2 grouping is :mod:`tsrkit.eval.categories`.
+separately and do not enter ``precision_mean``.
+The Table 5-2 grouping is :mod:`tsrkit.eval.categories`.
 """
+
 from __future__ import annotations
 
 import math
-from typing import Any
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -57,9 +59,14 @@ def score_frame(points, boxes, lighting: str = "unknown") -> FrameScore:
     (0.5, 0.5)
     """
     hits = centre_hits(points, boxes)
-    return FrameScore(n_gt=hits.shape[1], n_det=hits.shape[0],
-                      gt_hit=int(hits.any(axis=0).sum()), det_tp=int(hits.any(axis=1).sum()),
-                      lighting=lighting, max_radius=max_target_radius(boxes))
+    return FrameScore(
+        n_gt=hits.shape[1],
+        n_det=hits.shape[0],
+        gt_hit=int(hits.any(axis=0).sum()),
+        det_tp=int(hits.any(axis=1).sum()),
+        lighting=lighting,
+        max_radius=max_target_radius(boxes),
+    )
 
 
 def max_target_radius(boxes) -> int:
@@ -104,8 +111,11 @@ def _mean(values: Iterable[float]) -> float | None:
 
 def frame_score(sample: Sample, record: FrameRecord) -> FrameScore:
     """One evaluated frame's :class:`FrameScore`: detection centres against its ground truth."""
-    return score_frame([(d.x, d.y) for d in record.detections],
-                       [a.bbox for a in sample.annotations], record.lighting or "unknown")
+    return score_frame(
+        [(d.x, d.y) for d in record.detections],
+        [a.bbox for a in sample.annotations],
+        record.lighting or "unknown",
+    )
 
 
 def headline_intervals(scores: Sequence[FrameScore]) -> dict[str, list[float] | None]:
@@ -147,5 +157,6 @@ class ZhengPerFrame(FrameScoreMetric):
         intervals: dict[str, Any] = headline_intervals(self.scores)
         for figures in (summary, intervals):
             figures["precision_mean"] = self.settings.false_positive_figure(
-                figures["precision_mean"])
+                figures["precision_mean"]
+            )
         return {"per_frame": summary, "intervals": intervals}

@@ -3,6 +3,7 @@
 ``resolve_box`` turns the ``box`` option (``auto | housing | lens``) into the box the metrics
 read from each record; ``auto`` follows the dataset's registry ``box`` convention.
 """
+
 from __future__ import annotations
 
 from collections.abc import Mapping
@@ -54,8 +55,7 @@ def resolve_box(option: str, info: Mapping[str, Any]) -> str:
     ('lens', 'housing')
     """
     if option not in BOX_OPTIONS:
-        raise TsrkitError(f"evaluation box must be one of {', '.join(BOX_OPTIONS)}; "
-                          f"got '{option}'")
+        raise TsrkitError(f"evaluation box must be one of {', '.join(BOX_OPTIONS)}; got '{option}'")
     if option != "auto":
         return option
     convention = info.get("box") or info.get("box_convention")
@@ -64,11 +64,14 @@ def resolve_box(option: str, info: Mapping[str, Any]) -> str:
 
 def not_exhaustive_note(dataset: str) -> str:
     """The report's note for a dataset whose registry entry says ``exhaustive: false``."""
-    return (f"dataset '{dataset}' is not exhaustively labelled (registry: exhaustive: false): "
-            "false-positive-based figures (precision, AP) are not meaningful and are left out "
-            "(null)")
+    return (
+        f"dataset '{dataset}' is not exhaustively labelled (registry: exhaustive: false): "
+        "false-positive-based figures (precision, AP) are not meaningful and are left out "
+        "(null)"
+    )
 
 
 #: What replaces a detection section in a classifier-only (crop) report.
-NOT_DETECTION = {"note": "classifier alone on the ground-truth boxes: detection metrics do not "
-                         "apply"}
+NOT_DETECTION = {
+    "note": "classifier alone on the ground-truth boxes: detection metrics do not apply"
+}

@@ -1,9 +1,10 @@
-"""State (colour) evaluation: accuracy, per-class figures, confusion, R-Y errors, discriminative ratio.
+"""State (colour) evaluation: accuracy, per-class figures, confusion, R-Y errors, discrimination.
 
 Pairs are (ground-truth state, predicted state, the prediction's state scores) of matched
 detections. Red/yellow confusions are counted separately as Mascetti et al. 5.1's "R-Y errors";
 the discriminative ratio is Zheng 2016, 5.3: ``1 - min confidence / max confidence``.
 """
+
 from __future__ import annotations
 
 from collections import Counter
@@ -36,8 +37,11 @@ def discriminative_ratio(scores: Mapping[str, float]) -> float | None:
     return 1.0 - min(values) / max(values)
 
 
-def state_metrics(truth: Sequence[str], predicted: Sequence[str],
-                  scores: Sequence[Mapping[str, float]] | None = None) -> dict:
+def state_metrics(
+    truth: Sequence[str],
+    predicted: Sequence[str],
+    scores: Sequence[Mapping[str, float]] | None = None,
+) -> dict:
     """Accuracy, per-class precision/recall, confusion matrix, R-Y errors and ratio figures.
 
     Parameters
@@ -51,8 +55,11 @@ def state_metrics(truth: Sequence[str], predicted: Sequence[str],
     if len(truth) != len(predicted):
         raise ValueError(f"{len(truth)} true states but {len(predicted)} predictions")
     labels = label_order(set(truth) | set(predicted))
-    matrix = (confusion_matrix(truth, predicted, labels=labels) if len(truth)
-              else np.zeros((len(labels), len(labels)), dtype=int))
+    matrix = (
+        confusion_matrix(truth, predicted, labels=labels)
+        if len(truth)
+        else np.zeros((len(labels), len(labels)), dtype=int)
+    )
     return {
         "pairs": len(truth),
         "accuracy": float(np.trace(matrix) / matrix.sum()) if matrix.sum() else None,
@@ -76,8 +83,9 @@ def label_order(seen: set[str]) -> list[str]:
     return list(STATES) if seen <= set(STATES) else sorted(seen)
 
 
-def per_class(truth: Sequence[str], predicted: Sequence[str],
-              labels: Sequence[str]) -> dict[str, dict]:
+def per_class(
+    truth: Sequence[str], predicted: Sequence[str], labels: Sequence[str]
+) -> dict[str, dict]:
     """Precision, recall and support of every state that occurs (``sklearn.metrics``).
 
     Examples
@@ -89,12 +97,18 @@ def per_class(truth: Sequence[str], predicted: Sequence[str],
     if not len(truth):
         return {}
     precision, recall, _, support = precision_recall_fscore_support(
-        truth, predicted, labels=list(labels), zero_division=np.nan)
+        truth, predicted, labels=list(labels), zero_division=np.nan
+    )
     predicted_counts = Counter(predicted)
-    return {label: {"precision": None if np.isnan(p) else float(p),
-                    "recall": None if np.isnan(r) else float(r), "support": int(n)}
-            for label, p, r, n in zip(labels, precision, recall, support)
-            if n or predicted_counts[label]}
+    return {
+        label: {
+            "precision": None if np.isnan(p) else float(p),
+            "recall": None if np.isnan(r) else float(r),
+            "support": int(n),
+        }
+        for label, p, r, n in zip(labels, precision, recall, support)
+        if n or predicted_counts[label]
+    }
 
 
 def red_yellow_errors(matrix: np.ndarray, labels: Sequence[str]) -> dict[str, int]:
@@ -106,12 +120,16 @@ def red_yellow_errors(matrix: np.ndarray, labels: Sequence[str]) -> dict[str, in
         return {}
     r, y = labels.index("red"), labels.index("yellow")
     red_as_yellow, yellow_as_red = int(matrix[r, y]), int(matrix[y, r])
-    return {"red_as_yellow": red_as_yellow, "yellow_as_red": yellow_as_red,
-            "total": red_as_yellow + yellow_as_red}
+    return {
+        "red_as_yellow": red_as_yellow,
+        "yellow_as_red": yellow_as_red,
+        "total": red_as_yellow + yellow_as_red,
+    }
 
 
-def ratio_figures(truth: Sequence[str], predicted: Sequence[str],
-                  scores: Sequence[Mapping[str, float]]) -> dict:
+def ratio_figures(
+    truth: Sequence[str], predicted: Sequence[str], scores: Sequence[Mapping[str, float]]
+) -> dict:
     """Mean discriminative ratio and the misclassification rate per ratio bin (Zheng 5.3)."""
     ratios, wrong = [], []
     for t, p, s in zip(truth, predicted, scores):
@@ -123,9 +141,16 @@ def ratio_figures(truth: Sequence[str], predicted: Sequence[str],
         return {"mean": None, "bins": []}
     ratios_a, wrong_a = np.asarray(ratios), np.asarray(wrong)
     index = np.clip(np.digitize(ratios_a, RATIO_EDGES[1:-1]), 0, len(RATIO_EDGES) - 2)
-    bins = [{"from": RATIO_EDGES[k], "to": RATIO_EDGES[k + 1], "pairs": int((index == k).sum()),
-             "misclassification_rate": float(wrong_a[index == k].mean())}
-            for k in range(len(RATIO_EDGES) - 1) if (index == k).any()]
+    bins = [
+        {
+            "from": RATIO_EDGES[k],
+            "to": RATIO_EDGES[k + 1],
+            "pairs": int((index == k).sum()),
+            "misclassification_rate": float(wrong_a[index == k].mean()),
+        }
+        for k in range(len(RATIO_EDGES) - 1)
+        if (index == k).any()
+    ]
     return {"mean": float(ratios_a.mean()), "bins": bins}
 
 
@@ -156,6 +181,10 @@ class StateMetric(Metric):
 
     def compute(self) -> dict:
         if all(p == "unknown" for p in self.predicted):
-            return {"state": {**state_metrics([], []), "note": "the method predicts no state "
-                              "(every detection is 'unknown')"}}
+            return {
+                "state": {
+                    **state_metrics([], []),
+                    "note": "the method predicts no state (every detection is 'unknown')",
+                }
+            }
         return {"state": state_metrics(self.truth, self.predicted, self.scores)}

@@ -4,6 +4,7 @@ Frames are the resampling unit. ``bootstrap_interval`` uses SciPy's percentile b
 ``paired_test`` runs the Wilcoxon signed-rank test on per-frame differences of two methods
 evaluated on the same frames.
 """
+
 from __future__ import annotations
 
 from collections.abc import Sequence
@@ -14,8 +15,9 @@ from scipy import stats
 ALPHA = 0.05
 
 
-def bootstrap_interval(values: Sequence[float], resamples: int = 1000,
-                       seed: int = 0) -> list[float] | None:
+def bootstrap_interval(
+    values: Sequence[float], resamples: int = 1000, seed: int = 0
+) -> list[float] | None:
     """95 % percentile-bootstrap interval of the mean of ``values``; None for fewer than 2.
 
     Examples
@@ -28,13 +30,20 @@ def bootstrap_interval(values: Sequence[float], resamples: int = 1000,
         return None
     if np.all(data == data[0]):
         return [float(data[0])] * 2
-    result = stats.bootstrap((data,), np.mean, n_resamples=resamples, method="percentile",
-                             confidence_level=1 - ALPHA, random_state=seed)
+    result = stats.bootstrap(
+        (data,),
+        np.mean,
+        n_resamples=resamples,
+        method="percentile",
+        confidence_level=1 - ALPHA,
+        random_state=seed,
+    )
     return [float(result.confidence_interval.low), float(result.confidence_interval.high)]
 
 
-def paired_test(a: Sequence[float], b: Sequence[float], name_a: str = "A",
-                name_b: str = "B") -> dict:
+def paired_test(
+    a: Sequence[float], b: Sequence[float], name_a: str = "A", name_b: str = "B"
+) -> dict:
     """Does method A beat method B on the same frames? Wilcoxon signed-rank, two-sided.
 
     Returns the frame count, the mean difference ``a - b``, the p-value and a verdict naming
@@ -44,14 +53,16 @@ def paired_test(a: Sequence[float], b: Sequence[float], name_a: str = "A",
     if x.shape != y.shape:
         raise ValueError(f"paired values differ in length: {x.size} and {y.size}")
     diff = x - y
-    if not np.any(diff):
-        p_value = 1.0
-    else:
-        p_value = float(stats.wilcoxon(x, y, zero_method="wilcox").pvalue)
+    p_value = 1.0 if not np.any(diff) else float(stats.wilcoxon(x, y, zero_method="wilcox").pvalue)
     mean = float(diff.mean()) if diff.size else 0.0
     if p_value < ALPHA:
         verdict = f"{name_a} better" if mean > 0 else f"{name_b} better"
     else:
         verdict = "no significant difference"
-    return {"frames": int(diff.size), "mean_difference": mean, "p_value": p_value,
-            "test": "wilcoxon signed-rank", "verdict": verdict}
+    return {
+        "frames": int(diff.size),
+        "mean_difference": mean,
+        "p_value": p_value,
+        "test": "wilcoxon signed-rank",
+        "verdict": verdict,
+    }

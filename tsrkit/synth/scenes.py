@@ -32,6 +32,7 @@ a lens centred at ``(x, y)`` lies over pixel ``(floor(x), floor(y))``. Annotatio
 lens boxes ``(x-r, y-r, x+r, y+r)``; ``attributes["radius"]`` holds ``r`` exactly. "Off"
 housings (no lit lens) are drawn but not annotated.
 """
+
 from __future__ import annotations
 
 import functools
@@ -89,8 +90,9 @@ class SynthOptions:
         object.__setattr__(self, "lighting", lighting)
         unknown = [c for c in lighting if c not in LIGHTINGS]
         if not lighting or unknown:
-            raise ValueError(f"lighting must be a non-empty selection of {LIGHTINGS}; "
-                             f"got {self.lighting!r}")
+            raise ValueError(
+                f"lighting must be a non-empty selection of {LIGHTINGS}; got {self.lighting!r}"
+            )
         if not 1 <= int(self.quality) <= 100:
             raise ValueError(f"quality must be in 1..100; got {self.quality!r}")
         if not 0.0 <= float(self.off_fraction) < 1.0:
@@ -121,18 +123,45 @@ class Lighting:
 
 
 LIGHTING = {
-    "day": Lighting("day", ambient=1.0, sky_top=(0.82, 0.56, 0.30),
-                    sky_horizon=(0.96, 0.90, 0.84), lens_core=(0.95, 1.25),
-                    lens_halo=(0.10, 0.22), washout=0.45, noise=0.010, lamps_on=0.0,
-                    windows_lit=0.0, wet_road=0.0),
-    "dusk": Lighting("dusk", ambient=0.42, sky_top=(0.40, 0.22, 0.18),
-                     sky_horizon=(0.40, 0.62, 0.95), lens_core=(1.6, 3.0),
-                     lens_halo=(0.30, 0.55), washout=0.0, noise=0.018, lamps_on=0.7,
-                     windows_lit=0.25, wet_road=0.3),
-    "night": Lighting("night", ambient=0.10, sky_top=(0.07, 0.035, 0.02),
-                      sky_horizon=(0.16, 0.13, 0.11), lens_core=(5.0, 12.0),
-                      lens_halo=(0.65, 1.1), washout=0.0, noise=0.028, lamps_on=1.0,
-                      windows_lit=0.35, wet_road=0.5),
+    "day": Lighting(
+        "day",
+        ambient=1.0,
+        sky_top=(0.82, 0.56, 0.30),
+        sky_horizon=(0.96, 0.90, 0.84),
+        lens_core=(0.95, 1.25),
+        lens_halo=(0.10, 0.22),
+        washout=0.45,
+        noise=0.010,
+        lamps_on=0.0,
+        windows_lit=0.0,
+        wet_road=0.0,
+    ),
+    "dusk": Lighting(
+        "dusk",
+        ambient=0.42,
+        sky_top=(0.40, 0.22, 0.18),
+        sky_horizon=(0.40, 0.62, 0.95),
+        lens_core=(1.6, 3.0),
+        lens_halo=(0.30, 0.55),
+        washout=0.0,
+        noise=0.018,
+        lamps_on=0.7,
+        windows_lit=0.25,
+        wet_road=0.3,
+    ),
+    "night": Lighting(
+        "night",
+        ambient=0.10,
+        sky_top=(0.07, 0.035, 0.02),
+        sky_horizon=(0.16, 0.13, 0.11),
+        lens_core=(5.0, 12.0),
+        lens_halo=(0.65, 1.1),
+        washout=0.0,
+        noise=0.028,
+        lamps_on=1.0,
+        windows_lit=0.35,
+        wet_road=0.5,
+    ),
 }
 
 
@@ -157,14 +186,26 @@ class Canvas:
     def free(self, box, margin: float = 0.0) -> bool:
         """True when ``box`` (grown by ``margin``) overlaps no signal housing."""
         x0, y0, x1, y1 = box
-        return all(x1 + margin < a or x0 - margin > c or y1 + margin < b or y0 - margin > d
-                   for a, b, c, d in self.keep_out)
+        return all(
+            x1 + margin < a or x0 - margin > c or y1 + margin < b or y0 - margin > d
+            for a, b, c, d in self.keep_out
+        )
 
 
 # --------------------------------------------------------------------------- light sources
 
-def add_glow(light: np.ndarray, x: float, y: float, color, core_radius: float, core: float,
-             halo_sigma: float, halo: float, stretch: float = 1.0) -> None:
+
+def add_glow(
+    light: np.ndarray,
+    x: float,
+    y: float,
+    color,
+    core_radius: float,
+    core: float,
+    halo_sigma: float,
+    halo: float,
+    stretch: float = 1.0,
+) -> None:
     """Add an emitting disk with a Gaussian halo to ``light`` (in place).
 
     The disk is anti-aliased (coverage ``clip(r + 0.5 - d, 0, 1)`` per pixel, pixel centres at
@@ -183,14 +224,21 @@ def add_glow(light: np.ndarray, x: float, y: float, color, core_radius: float, c
     dist = np.sqrt(dx * dx + dy * dy)
     weight = core * np.clip(core_radius + 0.5 - dist, 0.0, 1.0)
     if halo > 0 and halo_sigma > 0:
-        weight += halo * np.exp(-(dx * dx + (dy / stretch) ** 2) / (2.0 * halo_sigma ** 2))
+        weight += halo * np.exp(-(dx * dx + (dy / stretch) ** 2) / (2.0 * halo_sigma**2))
     light[y0:y1, x0:x1] += weight[..., None] * np.asarray(color, np.float32)
 
 
 def _disk(image: np.ndarray, x: float, y: float, r: float, color) -> None:
     """Fill an anti-aliased disk with sub-pixel centre (OpenCV fixed-point, 4 fractional bits)."""
-    cv2.circle(image, (int(round(x * 16 - 8)), int(round(y * 16 - 8))),
-               max(int(round(r * 16)), 1), tuple(float(c) for c in color), -1, cv2.LINE_AA, 4)
+    cv2.circle(
+        image,
+        (int(round(x * 16 - 8)), int(round(y * 16 - 8))),
+        max(int(round(r * 16)), 1),
+        tuple(float(c) for c in color),
+        -1,
+        cv2.LINE_AA,
+        4,
+    )
 
 
 def _rect(image: np.ndarray, box, color) -> None:
@@ -201,11 +249,18 @@ def _rect(image: np.ndarray, box, color) -> None:
 
 def _line(image: np.ndarray, p, q, color, thickness: float) -> None:
     """An anti-aliased line from ``p`` to ``q``, at least one pixel thick."""
-    cv2.line(image, (int(round(p[0])), int(round(p[1]))), (int(round(q[0])), int(round(q[1]))),
-             tuple(float(c) for c in color), max(int(round(thickness)), 1), cv2.LINE_AA)
+    cv2.line(
+        image,
+        (int(round(p[0])), int(round(p[1]))),
+        (int(round(q[0])), int(round(q[1]))),
+        tuple(float(c) for c in color),
+        max(int(round(thickness)), 1),
+        cv2.LINE_AA,
+    )
 
 
 # --------------------------------------------------------------------------- background
+
 
 def draw_sky(canvas: Canvas, rng: np.random.Generator, lit: Lighting) -> None:
     """Vertical gradient from ``sky_top`` to ``sky_horizon``, plus clouds or a sun glare."""
@@ -220,8 +275,17 @@ def draw_sky(canvas: Canvas, rng: np.random.Generator, lit: Lighting) -> None:
         x, y = rng.uniform(0, canvas.width), rng.uniform(0, canvas.horizon * 0.7)
         s = rng.uniform(15, 50) * canvas.scale
         if canvas.free((x - 2 * s, y - s, x + 2 * s, y + s), 6 * canvas.scale):
-            cv2.ellipse(canvas.base, (int(x), int(y)), (int(2 * s), int(s * 0.6)), 0, 0, 360,
-                        (0.97, 0.97, 0.97), -1, cv2.LINE_AA)
+            cv2.ellipse(
+                canvas.base,
+                (int(x), int(y)),
+                (int(2 * s), int(s * 0.6)),
+                0,
+                0,
+                360,
+                (0.97, 0.97, 0.97),
+                -1,
+                cv2.LINE_AA,
+            )
     if lit.name == "dusk" or (lit.name == "day" and rng.random() < 0.25):
         _sun(canvas, rng, lit)
 
@@ -266,25 +330,30 @@ def _windows(canvas: Canvas, rng: np.random.Generator, lit: Lighting, box) -> No
     for (i, wy), (j, wx) in itertools.product(enumerate(ys), enumerate(xs)):
         cell = (wx, wy, wx + size, wy + int(size * 1.3))
         if lit_now[i, j] and canvas.free(cell, 2 * canvas.scale):
-            cv2.rectangle(canvas.light, cell[:2], (cell[2] - 1, cell[3] - 1),
-                          lamp[i, j].tolist(), -1)
+            cv2.rectangle(
+                canvas.light, cell[:2], (cell[2] - 1, cell[3] - 1), lamp[i, j].tolist(), -1
+            )
         else:
-            cv2.rectangle(canvas.base, cell[:2], (cell[2] - 1, cell[3] - 1),
-                          glass[i, j].tolist(), -1)
+            cv2.rectangle(
+                canvas.base, cell[:2], (cell[2] - 1, cell[3] - 1), glass[i, j].tolist(), -1
+            )
 
 
 def draw_road(canvas: Canvas, rng: np.random.Generator, lit: Lighting) -> float:
     """Ground, asphalt trapezoid towards a vanishing point, lane markings; returns its x."""
     h, w, hz = canvas.height, canvas.width, canvas.horizon
     ground = np.array((0.35, 0.45, 0.42)) * rng.uniform(0.8, 1.1) * lit.ambient
-    canvas.base[int(hz):] = ground
+    canvas.base[int(hz) :] = ground
     vx = w * rng.uniform(0.35, 0.65)
     left, right = vx - w * rng.uniform(0.7, 1.1), vx + w * rng.uniform(0.7, 1.1)
     asphalt = np.array((0.36, 0.36, 0.37)) * rng.uniform(0.75, 1.15) * lit.ambient
-    poly = np.array([[vx - 3 * canvas.scale, hz], [vx + 3 * canvas.scale, hz], [right, h],
-                     [left, h]], np.float32)
-    cv2.fillPoly(canvas.base, [np.round(poly * 16).astype(np.int32)], asphalt.tolist(),
-                 cv2.LINE_AA, 4)
+    poly = np.array(
+        [[vx - 3 * canvas.scale, hz], [vx + 3 * canvas.scale, hz], [right, h], [left, h]],
+        np.float32,
+    )
+    cv2.fillPoly(
+        canvas.base, [np.round(poly * 16).astype(np.int32)], asphalt.tolist(), cv2.LINE_AA, 4
+    )
     paint = np.array((0.85, 0.85, 0.85)) * lit.ambient
     for frac in np.linspace(0.0, 1.0, rng.integers(3, 6))[1:-1]:
         _dashes(canvas, vx, left + (right - left) * frac, paint)
@@ -312,16 +381,27 @@ def draw_trees(canvas: Canvas, rng: np.random.Generator, lit: Lighting) -> None:
         top = base_y - size * 2.2
         if not canvas.free((x - size, top - size, x + size, base_y)):
             continue
-        _line(canvas.base, (x, base_y), (x, top), np.array((0.12, 0.18, 0.25)) * lit.ambient,
-              size * 0.15)
+        _line(
+            canvas.base,
+            (x, base_y),
+            (x, top),
+            np.array((0.12, 0.18, 0.25)) * lit.ambient,
+            size * 0.15,
+        )
         green = np.array((rng.uniform(0.05, 0.45), rng.uniform(0.4, 0.7), rng.uniform(0.05, 0.3)))
         for _ in range(12):
             cx, cy = x + rng.normal(0, size * 0.4), top + rng.normal(0, size * 0.4)
-            _disk(canvas.base, cx, cy, size * rng.uniform(0.3, 0.6),
-                  green * rng.uniform(0.5, 1.1) * lit.ambient)
+            _disk(
+                canvas.base,
+                cx,
+                cy,
+                size * rng.uniform(0.3, 0.6),
+                green * rng.uniform(0.5, 1.1) * lit.ambient,
+            )
 
 
 # --------------------------------------------------------------------------- distractors
+
 
 def draw_cars(canvas: Canvas, rng: np.random.Generator, lit: Lighting, vx: float) -> None:
     """Cars ahead (red tail or brake light pairs) and, at dusk and night, oncoming headlights."""
@@ -336,17 +416,37 @@ def draw_cars(canvas: Canvas, rng: np.random.Generator, lit: Lighting, vx: float
         grey = rng.uniform(0.05, 0.8)
         body = (grey + (rng.uniform(0.05, 0.8, 3) - grey) * 0.5) * lit.ambient
         _rect(canvas.base, (cx - cw / 2, y - ch, cx + cw / 2, y), body)
-        _rect(canvas.base, (cx - cw * 0.4, y - ch * 0.95, cx + cw * 0.4, y - ch * 0.6),
-              np.array((0.2, 0.15, 0.12)) * lit.ambient)
+        _rect(
+            canvas.base,
+            (cx - cw * 0.4, y - ch * 0.95, cx + cw * 0.4, y - ch * 0.6),
+            np.array((0.2, 0.15, 0.12)) * lit.ambient,
+        )
         braking = rng.random() < 0.4
         power = 1.6 if lit.lamps_on else (0.9 if braking else 0.25)
         for side in (-1, 1):
             lx, ly = cx + side * cw * 0.38, y - ch * 0.45
-            add_glow(canvas.light, lx, ly, (0.15, 0.1, 1.0), max(cw * 0.06, 0.8),
-                     power, max(cw * 0.08, 0.8), power * 0.35)
+            add_glow(
+                canvas.light,
+                lx,
+                ly,
+                (0.15, 0.1, 1.0),
+                max(cw * 0.06, 0.8),
+                power,
+                max(cw * 0.08, 0.8),
+                power * 0.35,
+            )
             if lit.lamps_on and rng.random() < lit.wet_road:
-                add_glow(canvas.light, lx, y + ch * 0.4, (0.15, 0.1, 1.0), 0, 0,
-                         max(cw * 0.05, 0.8), 0.25, stretch=4.0)
+                add_glow(
+                    canvas.light,
+                    lx,
+                    y + ch * 0.4,
+                    (0.15, 0.1, 1.0),
+                    0,
+                    0,
+                    max(cw * 0.05, 0.8),
+                    0.25,
+                    stretch=4.0,
+                )
         if lit.lamps_on and rng.random() < 0.5:
             _headlights(canvas, 2 * vx - cx, y * 0.98 + hz * 0.02, cw)
     if lit.name == "day":
@@ -356,8 +456,16 @@ def draw_cars(canvas: Canvas, rng: np.random.Generator, lit: Lighting, vx: float
 def _headlights(canvas: Canvas, x: float, y: float, width: float) -> None:
     """The overexposed white pair of an oncoming car of ``width`` pixels."""
     for side in (-1, 1):
-        add_glow(canvas.light, x + side * width * 0.35, y - width * 0.25, (0.9, 0.95, 1.0),
-                 max(width * 0.05, 0.7), 4.0, max(width * 0.1, 0.8), 0.8)
+        add_glow(
+            canvas.light,
+            x + side * width * 0.35,
+            y - width * 0.25,
+            (0.9, 0.95, 1.0),
+            max(width * 0.05, 0.7),
+            4.0,
+            max(width * 0.1, 0.8),
+            0.8,
+        )
 
 
 def _glints(canvas: Canvas, rng: np.random.Generator) -> None:
@@ -366,8 +474,16 @@ def _glints(canvas: Canvas, rng: np.random.Generator) -> None:
         x = rng.uniform(0, canvas.width)
         y = rng.uniform(canvas.horizon, canvas.height)
         if canvas.free((x, y, x, y), 6 * canvas.scale):
-            add_glow(canvas.light, x, y, (1.0, 1.0, 1.0), rng.uniform(0.8, 2.0) * canvas.scale,
-                     1.5, 1.5 * canvas.scale, 0.4)
+            add_glow(
+                canvas.light,
+                x,
+                y,
+                (1.0, 1.0, 1.0),
+                rng.uniform(0.8, 2.0) * canvas.scale,
+                1.5,
+                1.5 * canvas.scale,
+                0.4,
+            )
 
 
 def draw_lamps(canvas: Canvas, rng: np.random.Generator, lit: Lighting, vx: float) -> None:
@@ -392,8 +508,15 @@ def draw_lamps(canvas: Canvas, rng: np.random.Generator, lit: Lighting, vx: floa
             _lamp_head(canvas, rng, lit, head_x, head_y + 2 * t * canvas.scale, size, sodium)
 
 
-def _lamp_head(canvas: Canvas, rng: np.random.Generator, lit: Lighting, x: float, y: float,
-               size: float, sodium: bool) -> None:
+def _lamp_head(
+    canvas: Canvas,
+    rng: np.random.Generator,
+    lit: Lighting,
+    x: float,
+    y: float,
+    size: float,
+    sodium: bool,
+) -> None:
     if rng.random() >= lit.lamps_on:
         _disk(canvas.base, x, y, size, np.array((0.6, 0.6, 0.6)) * lit.ambient)
         return
@@ -417,14 +540,20 @@ def draw_sign(canvas: Canvas, rng: np.random.Generator, lit: Lighting) -> None:
     y = rng.uniform(0.35, 0.9) * canvas.horizon
     if not canvas.free((x - r, y - r, x + r, canvas.horizon), 4 * canvas.scale):
         return
-    _line(canvas.base, (x, y), (x, canvas.horizon + 10 * canvas.scale),
-          np.array((0.4, 0.4, 0.4)) * lit.ambient, max(r * 0.2, 1))
+    _line(
+        canvas.base,
+        (x, y),
+        (x, canvas.horizon + 10 * canvas.scale),
+        np.array((0.4, 0.4, 0.4)) * lit.ambient,
+        max(r * 0.2, 1),
+    )
     gain = retroreflection(lit)
     _disk(canvas.base, x, y, r, np.array((0.1, 0.1, 0.85)) * gain)
     _disk(canvas.base, x, y, r * 0.72, np.array((0.92, 0.92, 0.92)) * gain)
 
 
 # --------------------------------------------------------------------------- signals
+
 
 def lens_radius(rng: np.random.Generator, scale: float) -> float:
     """A lens radius in pixels: 1.5-9 px at 356 rows (Zheng 4.2), smaller ones more frequent."""
@@ -458,13 +587,18 @@ class Housing:
         x, y = self.centres[LENS_ORDER.index(self.state)]
         r = self.radius
         return Annotation(
-            (round(x - r, 3), round(y - r, 3), round(x + r, 3), round(y + r, 3)), self.state,
-            {"radius": r, "orientation": "vertical" if self.vertical else "horizontal",
-             "mount": self.mount, "housing": [round(v, 3) for v in self.box]})
+            (round(x - r, 3), round(y - r, 3), round(x + r, 3), round(y + r, 3)),
+            self.state,
+            {
+                "radius": r,
+                "orientation": "vertical" if self.vertical else "horizontal",
+                "mount": self.mount,
+                "housing": [round(v, 3) for v in self.box],
+            },
+        )
 
 
-def place_signals(canvas: Canvas, rng: np.random.Generator,
-                  options: SynthOptions) -> list[Housing]:
+def place_signals(canvas: Canvas, rng: np.random.Generator, options: SynthOptions) -> list[Housing]:
     """Choose 1-4 non-overlapping housings and reserve their boxes from the distractors."""
     state = LENS_ORDER[rng.integers(0, 3)]
     vertical = bool(rng.random() < 0.6)
@@ -484,8 +618,9 @@ def place_signals(canvas: Canvas, rng: np.random.Generator,
     return housings
 
 
-def draw_signals(canvas: Canvas, rng: np.random.Generator, lit: Lighting,
-                 housings: list[Housing]) -> list[Annotation]:
+def draw_signals(
+    canvas: Canvas, rng: np.random.Generator, lit: Lighting, housings: list[Housing]
+) -> list[Annotation]:
     """Draw the mounts, then the housings over them; return the lit lenses' annotations."""
     for housing in housings:
         _draw_mount(canvas, rng, lit, housing)
@@ -502,14 +637,18 @@ def _place_housing(canvas: Canvas, rng: np.random.Generator, vertical: bool):
         x = round(rng.uniform(0.05, 0.95) * canvas.width, 2)
         y = round(max(canvas.horizon - height_px, 3 * r + 2), 2)
         box, centres = housing_layout(x, y, r, vertical)
-        if (box[0] >= 1 and box[1] >= 1 and box[2] <= canvas.width - 1
-                and box[3] <= canvas.horizon + r and canvas.free(box, 2 * r + 3)):
+        if (
+            box[0] >= 1
+            and box[1] >= 1
+            and box[2] <= canvas.width - 1
+            and box[3] <= canvas.horizon + r
+            and canvas.free(box, 2 * r + 3)
+        ):
             return box, centres, r
     return None
 
 
-def _draw_mount(canvas: Canvas, rng: np.random.Generator, lit: Lighting,
-                housing: Housing) -> None:
+def _draw_mount(canvas: Canvas, rng: np.random.Generator, lit: Lighting, housing: Housing) -> None:
     """A mast arm reaching from a roadside pole, or a pole under the housing."""
     x0, y0, x1, y1 = housing.box
     radius, mount = housing.radius, housing.mount
@@ -527,18 +666,25 @@ def _draw_mount(canvas: Canvas, rng: np.random.Generator, lit: Lighting,
         _line(canvas.base, (cx, y1), (cx, canvas.horizon + 8 * canvas.scale), color, thick * 1.5)
 
 
-def _draw_housing(canvas: Canvas, rng: np.random.Generator, lit: Lighting,
-                  housing: Housing) -> None:
+def _draw_housing(
+    canvas: Canvas, rng: np.random.Generator, lit: Lighting, housing: Housing
+) -> None:
     """Dark housing, dim unlit lenses and the lit lens (overexposed at night, Zheng 4.2)."""
     box, r = housing.box, housing.radius
     dark = rng.uniform(0.03, 0.12)
     if r > 3.5 * canvas.scale and rng.random() < 0.3:  # backplate with a light border
         x0, y0, x1, y1 = box
         grow = r * 0.9
-        _rect(canvas.base, (x0 - grow, y0 - grow, x1 + grow, y1 + grow),
-              np.array((0.1, 0.75, 0.85)) * retroreflection(lit))
-        _rect(canvas.base, (x0 - grow + 1, y0 - grow + 1, x1 + grow - 1, y1 + grow - 1),
-              (dark, dark, dark))
+        _rect(
+            canvas.base,
+            (x0 - grow, y0 - grow, x1 + grow, y1 + grow),
+            np.array((0.1, 0.75, 0.85)) * retroreflection(lit),
+        )
+        _rect(
+            canvas.base,
+            (x0 - grow + 1, y0 - grow + 1, x1 + grow - 1, y1 + grow - 1),
+            (dark, dark, dark),
+        )
     _rect(canvas.base, box, np.array((dark, dark, dark * 1.1)))
     for colour_name, (x, y) in zip(LENS_ORDER, housing.centres):
         tint = np.asarray(LENS_BGR[colour_name]) * 0.06 + 0.02
@@ -547,8 +693,9 @@ def _draw_housing(canvas: Canvas, rng: np.random.Generator, lit: Lighting,
             _lit_lens(canvas, rng, lit, x, y, r, LENS_BGR[colour_name])
 
 
-def _lit_lens(canvas: Canvas, rng: np.random.Generator, lit: Lighting, x: float, y: float,
-              r: float, color) -> None:
+def _lit_lens(
+    canvas: Canvas, rng: np.random.Generator, lit: Lighting, x: float, y: float, r: float, color
+) -> None:
     """The emitted light of a lit lens: a disk plus halo; at day possibly washed out to white."""
     color = np.asarray(color, np.float32)
     if lit.washout and rng.random() < 0.5:
@@ -560,6 +707,7 @@ def _lit_lens(canvas: Canvas, rng: np.random.Generator, lit: Lighting, x: float,
 
 
 # --------------------------------------------------------------------------- camera
+
 
 def expose(canvas: Canvas, rng: np.random.Generator, lit: Lighting) -> np.ndarray:
     """Camera: white balance, vignetting, optical blur, sensor clipping and noise -> BGR uint8."""
@@ -598,7 +746,7 @@ def noise_field(shape: tuple[int, ...], offset: int) -> np.ndarray:
     at a random offset of one cached field is as noisy and deterministic.
     """
     size = int(np.prod(shape))
-    return _noise_bank(size)[offset:offset + size].reshape(shape)
+    return _noise_bank(size)[offset : offset + size].reshape(shape)
 
 
 def encode_jpeg(image: np.ndarray, quality: int) -> np.ndarray:
@@ -619,6 +767,7 @@ def compress(image: np.ndarray, quality: int) -> np.ndarray:
 
 # --------------------------------------------------------------------------- frames
 
+
 def frame_lighting(index: int, options: SynthOptions) -> str:
     """Lighting of frame ``index``: the options' conditions in turn (balanced)."""
     return options.lighting[index % len(options.lighting)]
@@ -629,8 +778,9 @@ def frame_split(index: int, options: SynthOptions) -> str:
     return ("train", "test")[(index // len(options.lighting)) % 2]
 
 
-def render_frame(index: int, seed: int, width: int, height: int,
-                 options: SynthOptions) -> tuple[np.ndarray, list[Annotation], str]:
+def render_frame(
+    index: int, seed: int, width: int, height: int, options: SynthOptions
+) -> tuple[np.ndarray, list[Annotation], str]:
     """Render frame ``index`` of the scene sequence ``seed``: image, lit lenses, lighting.
 
     Each frame draws from its own generator seeded by ``(seed, index)``, so a frame does not
@@ -641,8 +791,13 @@ def render_frame(index: int, seed: int, width: int, height: int,
     lit = LIGHTING[condition]
     scale = height / _BASE_HEIGHT
     horizon = height * rng.uniform(0.42, 0.6)
-    canvas = Canvas(np.zeros((height, width, 3), np.float32),
-                    np.zeros((height, width, 3), np.float32), horizon, scale, [])
+    canvas = Canvas(
+        np.zeros((height, width, 3), np.float32),
+        np.zeros((height, width, 3), np.float32),
+        horizon,
+        scale,
+        [],
+    )
     housings = place_signals(canvas, rng, options)
     draw_sky(canvas, rng, lit)
     draw_buildings(canvas, rng, lit)
@@ -659,6 +814,7 @@ def render_frame(index: int, seed: int, width: int, height: int,
 
 # --------------------------------------------------------------------------- datasets on disk
 
+
 def _check_size(frames: int, width: int, height: int) -> None:
     if int(frames) < 1:
         raise ValueError(f"frames must be at least 1; got {frames!r}")
@@ -667,10 +823,15 @@ def _check_size(frames: int, width: int, height: int) -> None:
 
 
 def _stamp(frames: int, seed: int, width: int, height: int, options: SynthOptions) -> dict:
-    return {"generator": "tsrkit.synth", "version": GENERATOR_VERSION,
-            "frames": int(frames), "seed": int(seed), "width": int(width),
-            "height": int(height), "options": {**asdict(options),
-                                               "lighting": list(options.lighting)}}
+    return {
+        "generator": "tsrkit.synth",
+        "version": GENERATOR_VERSION,
+        "frames": int(frames),
+        "seed": int(seed),
+        "width": int(width),
+        "height": int(height),
+        "options": {**asdict(options), "lighting": list(options.lighting)},
+    }
 
 
 def _read_stamp(folder: Path) -> dict | None:
@@ -680,8 +841,9 @@ def _read_stamp(folder: Path) -> dict | None:
         return None
 
 
-def render_dataset(folder: Path, frames: int, seed: int, width: int, height: int,
-                   options: SynthOptions) -> Dataset:
+def render_dataset(
+    folder: Path, frames: int, seed: int, width: int, height: int, options: SynthOptions
+) -> Dataset:
     """Render every frame into ``folder/images`` and return the dataset (paths in ``folder``)."""
     images = folder / "images"
     images.mkdir(parents=True, exist_ok=True)
@@ -690,11 +852,22 @@ def render_dataset(folder: Path, frames: int, seed: int, width: int, height: int
         image, annotations, condition = render_frame(index, seed, width, height, options)
         path = images / f"{index:06d}.jpg"
         path.write_bytes(encode_jpeg(image, options.quality).tobytes())
-        samples.append(Sample(str(path), tuple(annotations), width, height,
-                              frame_split(index, options),
-                              {"lighting": condition, "seed": int(seed), "frame": index}))
-    info = {"box_convention": "lens", "licence": "generated by tsrkit (MIT, as the code)",
-            "generator_version": GENERATOR_VERSION, "seed": int(seed)}
+        samples.append(
+            Sample(
+                str(path),
+                tuple(annotations),
+                width,
+                height,
+                frame_split(index, options),
+                {"lighting": condition, "seed": int(seed), "frame": index},
+            )
+        )
+    info = {
+        "box_convention": "lens",
+        "licence": "generated by tsrkit (MIT, as the code)",
+        "generator_version": GENERATOR_VERSION,
+        "seed": int(seed),
+    }
     return Dataset(f"synth-{seed}", tuple(samples), "normalized", str(folder), info)
 
 
@@ -709,8 +882,9 @@ def write_annotations(dataset: Dataset, folder: Path) -> None:
 
 def _relocate(dataset: Dataset, old: Path, new: Path) -> Dataset:
     """The same dataset with image paths moved from folder ``old`` to folder ``new``."""
-    samples = tuple(replace(s, source=str(new / Path(s.source).relative_to(old)))
-                    for s in dataset.samples)
+    samples = tuple(
+        replace(s, source=str(new / Path(s.source).relative_to(old))) for s in dataset.samples
+    )
     info = {**dataset.info, "annotation_file": str(new / "annotations.json")}
     return replace(dataset, samples=samples, root=str(new), info=info)
 
@@ -724,8 +898,10 @@ def _open_permissions(folder: Path) -> None:
 
 
 def _occupied(out: Path) -> TsrkitError:
-    return TsrkitError(f"{out} already exists and holds other data; choose another folder "
-                       "or pass overwrite=True (--overwrite)")
+    return TsrkitError(
+        f"{out} already exists and holds other data; choose another folder "
+        "or pass overwrite=True (--overwrite)"
+    )
 
 
 def _publish(tmp: Path, out: Path, stamp: dict, overwrite: bool) -> None:
@@ -748,8 +924,15 @@ def _publish(tmp: Path, out: Path, stamp: dict, overwrite: bool) -> None:
     shutil.rmtree(trash, ignore_errors=True)
 
 
-def generate(out, frames: int, seed: int, width: int = 480, height: int = 356,
-             overwrite: bool = False, **options) -> Dataset:
+def generate(
+    out,
+    frames: int,
+    seed: int,
+    width: int = 480,
+    height: int = 356,
+    overwrite: bool = False,
+    **options,
+) -> Dataset:
     """Render a synthetic dataset into the folder ``out`` and return it.
 
     Writes ``out/images/NNNNNN.jpg``, ``out/annotations.json`` (normalised JSON),

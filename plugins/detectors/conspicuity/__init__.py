@@ -4,8 +4,13 @@
 compiled window sums; the localization of 3.2.2 is shared with gray-tophat
 (:mod:`tsrkit_plugins.detectors.localization`).
 """
-from tsrkit_plugins.detectors.conspicuity.conspicuity import (Conspicuity, conspicuity_map,
-                                                              lightness, register_detectors,
-                                                              saturation)
+
+from tsrkit_plugins.detectors.conspicuity.conspicuity import (
+    Conspicuity,
+    conspicuity_map,
+    lightness,
+    register_detectors,
+    saturation,
+)
 
 __all__ = ["Conspicuity", "conspicuity_map", "lightness", "register_detectors", "saturation"]

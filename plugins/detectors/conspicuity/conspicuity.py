@@ -29,12 +29,13 @@ its four quarters, saturation disks are shared between radii, and the root of Eq
 once after the maximum of Eq. 3.2 (the root is monotonic, so the arg-max is unchanged).
 ``tests/oracles/conspicuity_oracle.py`` is the direct reference these are tested against.
 """
+
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cache, lru_cache
 
 import cv2
 import numpy as np
@@ -43,10 +44,18 @@ from tsrkit.hookspecs import hookimpl
 from tsrkit.params import Param, ParamError
 from tsrkit.plugin import Detector
 from tsrkit.types import Candidate, Frame
-from tsrkit_plugins.detectors.conspicuity.conspicuity_kernel import (LIGHT_PREFIX, SAT_PREFIX, best_products,
-                                                           prefix_tables)
-from tsrkit_plugins.detectors.localization import (LOCALIZATION_PARAMS, ROI_PARAM, localize,
-                                                     region_of_interest)
+from tsrkit_plugins.detectors.conspicuity.conspicuity_kernel import (
+    LIGHT_PREFIX,
+    SAT_PREFIX,
+    best_products,
+    prefix_tables,
+)
+from tsrkit_plugins.detectors.localization import (
+    LOCALIZATION_PARAMS,
+    ROI_PARAM,
+    localize,
+    region_of_interest,
+)
 
 #: Quadrant directions as (vertical sign, horizontal sign): up-right, up-left, down-left,
 #: down-right (Figure 3-7).
@@ -63,7 +72,7 @@ def saturation(image: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(cv2.cvtColor(image, cv2.COLOR_BGR2HSV)[:, :, 1])
 
 
-@lru_cache(maxsize=None)
+@cache
 def half_widths(radius: int) -> tuple[int, ...]:
     """Half-width of the digital disk on each row ``dy = 0..radius`` (Eq. 3.4: ``|d| <= r``)."""
     return tuple(math.isqrt(radius * radius - dy * dy) for dy in range(radius + 1))
@@ -85,8 +94,9 @@ def mirror(channel: np.ndarray, pad: int) -> np.ndarray:
     return cv2.copyMakeBorder(channel, pad, pad, pad, pad, cv2.BORDER_REFLECT_101)
 
 
-def compile_terms(runs: Sequence[tuple[int, int, int]],
-                  columns: Sequence[tuple[int, int, int, int]] = ()):
+def compile_terms(
+    runs: Sequence[tuple[int, int, int]], columns: Sequence[tuple[int, int, int, int]] = ()
+):
     """Plan a window sum: ``sign * prefix(dy, dc)`` over ``runs`` = (dy, dc, sign) plus, over
     ``columns`` = (top, bottom, dc, sign), ``sign`` times the prefix at column offset ``dc``
     summed over rows ``top..bottom``.
@@ -100,8 +110,11 @@ def compile_terms(runs: Sequence[tuple[int, int, int]],
     ordered = sorted(runs, key=lambda t: (t[1], t[2], t[0]))
     start = 0
     for end in range(1, len(ordered) + 1):
-        if end < len(ordered) and ordered[end][1:] == ordered[end - 1][1:] \
-                and ordered[end][0] == ordered[end - 1][0] + 1:
+        if (
+            end < len(ordered)
+            and ordered[end][1:] == ordered[end - 1][1:]
+            and ordered[end][0] == ordered[end - 1][0] + 1
+        ):
             continue
         group = ordered[start:end]
         if len(group) == 1:
@@ -114,7 +127,7 @@ def compile_terms(runs: Sequence[tuple[int, int, int]],
     return tuple(sorted(terms, key=lambda term: -term[3]))
 
 
-@lru_cache(maxsize=None)
+@cache
 def disk_plan(radius: int):
     """Plan of the disk ``|d| <= radius`` (numerator of Eq. 3.3 and Eq. 3.10)."""
     w = half_widths(radius)
@@ -125,7 +138,7 @@ def disk_plan(radius: int):
     return compile_terms(runs)
 
 
-@lru_cache(maxsize=None)
+@cache
 def quarter_plan(radius: int, quadrant: tuple[int, int]):
     """Plan of quadrant ``k`` of A1, axes included (numerator of Eq. 3.7).
 
@@ -142,7 +155,7 @@ def quarter_plan(radius: int, quadrant: tuple[int, int]):
     return compile_terms(runs, [(rows[0], rows[1], 1, 1)])
 
 
-@lru_cache(maxsize=None)
+@cache
 def box_plan(half_side: int, quadrant: tuple[int, int]):
     """Plan of quadrant ``k`` of the bounding box of side ``half_side + 1`` (A1 + A2)."""
     vertical, horizontal = quadrant
@@ -151,12 +164,14 @@ def box_plan(half_side: int, quadrant: tuple[int, int]):
     return compile_terms((), [(top, bottom, right + 1, 1), (top, bottom, left, -1)])
 
 
-@lru_cache(maxsize=None)
+@cache
 def axes_plan(radius: int):
     """Plan of minus the centre column ``|dy| <= radius`` and the two centre-row runs
     ``0 <= +-dx <= radius`` (the parts the four quarters share)."""
-    return compile_terms([(0, radius + 1, -1), (0, 0, 1), (0, 1, -1), (0, -radius, 1)],
-                         [(-radius, radius, 1, -1), (-radius, radius, 0, 1)])
+    return compile_terms(
+        [(0, radius + 1, -1), (0, 0, 1), (0, 1, -1), (0, -radius, 1)],
+        [(-radius, radius, 1, -1), (-radius, radius, 0, 1)],
+    )
 
 
 def kernel_terms(plan, prefix_table: int) -> list[tuple[int, int, int, int]]:
@@ -190,8 +205,9 @@ class KernelPlan:
 def concatenated(plans: Sequence[list]) -> tuple[np.ndarray, np.ndarray]:
     """Terms of several windows in one int32 array and the start index of each window."""
     starts = np.cumsum([0] + [len(plan) for plan in plans])
-    return np.array([t for plan in plans for t in plan], np.int32).reshape(-1, 4), \
-        starts.astype(np.int64)
+    return np.array([t for plan in plans for t in plan], np.int32).reshape(-1, 4), starts.astype(
+        np.int64
+    )
 
 
 @lru_cache(maxsize=16)
@@ -211,14 +227,25 @@ def kernel_plan(radii: tuple[int, ...], margin: int) -> KernelPlan:
     sat = [kernel_terms(disk_plan(r), SAT_PREFIX) for r in sat_radii]
     n_quarter = [quarter_disk_size(r) for r in radii]
     n_box = [(r + margin + 1) ** 2 for r in radii]
-    scales = [(mean_scale(disk_size(r)), mean_scale(nq * (nb - nq)), mean_scale(disk_size(r)),
-               mean_scale(disk_size(2 * r) - disk_size(r)))
-              for r, nq, nb in zip(radii, n_quarter, n_box)]
-    return KernelPlan(*concatenated(light), *concatenated(sat),
-                      np.array([sat_radii.index(r) for r in radii], np.int64),
-                      np.array([sat_radii.index(2 * r) for r in radii], np.int64),
-                      np.array(radii, np.int32), np.array(n_quarter, np.int64),
-                      np.array(n_box, np.int64), np.array(scales, np.float32))
+    scales = [
+        (
+            mean_scale(disk_size(r)),
+            mean_scale(nq * (nb - nq)),
+            mean_scale(disk_size(r)),
+            mean_scale(disk_size(2 * r) - disk_size(r)),
+        )
+        for r, nq, nb in zip(radii, n_quarter, n_box)
+    ]
+    return KernelPlan(
+        *concatenated(light),
+        *concatenated(sat),
+        np.array([sat_radii.index(r) for r in radii], np.int64),
+        np.array([sat_radii.index(2 * r) for r in radii], np.int64),
+        np.array(radii, np.int32),
+        np.array(n_quarter, np.int64),
+        np.array(n_box, np.int64),
+        np.array(scales, np.float32),
+    )
 
 
 def full_runs(height: int, width: int) -> np.ndarray:
@@ -234,6 +261,7 @@ def weighted_root(product: np.ndarray, weights: Sequence[float]) -> np.ndarray:
     (``conspicuity_kernel.weighted_product``) this is the weighted geometric mean whose pixel
     ratios do not change when a feature is rescaled (Appendix A)."""
     return np.power(product, 1.0 / float(sum(weights)), dtype=np.float32)
+
 
 @dataclass(frozen=True)
 class ConspicuityMap:
@@ -253,9 +281,13 @@ def check_settings(radii: Sequence[int], weights: Sequence[float], margin: int) 
         raise ValueError(f"margin m must be >= 0; got {margin}")
 
 
-def conspicuity_map(image: np.ndarray, radii: Sequence[int] = tuple(range(1, 11)),
-                    weights: Sequence[float] = (1.0, 1.0, 1.0), margin: int = 0,
-                    quadrant_rule: str = "max") -> ConspicuityMap:
+def conspicuity_map(
+    image: np.ndarray,
+    radii: Sequence[int] = tuple(range(1, 11)),
+    weights: Sequence[float] = (1.0, 1.0, 1.0),
+    margin: int = 0,
+    quadrant_rule: str = "max",
+) -> ConspicuityMap:
     """Eq. 3.1-3.12 on every pixel of a BGR uint8 image.
 
     Parameters
@@ -284,14 +316,16 @@ def conspicuity_map(image: np.ndarray, radii: Sequence[int] = tuple(range(1, 11)
     >>> bool(cmap.values[20, 20] == cmap.values.max()), int(cmap.radius[20, 20])
     (True, 4)
     """
-    radii = sorted(set(int(r) for r in radii))
+    radii = sorted({int(r) for r in radii})
     check_settings(radii, weights, margin)
     if image.ndim != 3 or image.shape[2] != 3 or image.dtype != np.uint8:
-        raise ValueError(f"expected a BGR uint8 image of shape (H, W, 3); got {image.dtype} "
-                         f"{image.shape}")
+        raise ValueError(
+            f"expected a BGR uint8 image of shape (H, W, 3); got {image.dtype} {image.shape}"
+        )
     tables, pad = channel_tables(image, radii, margin)
-    best, best_radius = products_on_runs(tables, pad, full_runs(*image.shape[:2]), radii,
-                                         weights, margin, quadrant_rule)
+    best, best_radius = products_on_runs(
+        tables, pad, full_runs(*image.shape[:2]), radii, weights, margin, quadrant_rule
+    )
     return ConspicuityMap(weighted_root(best, weights), best_radius)
 
 
@@ -301,8 +335,15 @@ def channel_tables(image: np.ndarray, radii: Sequence[int], margin: int) -> tupl
     return prefix_tables(mirror(lightness(image), pad), mirror(saturation(image), pad)), pad
 
 
-def products_on_runs(tables: np.ndarray, pad: int, runs: np.ndarray, radii: Sequence[int],
-                     weights: Sequence[float], margin: int, quadrant_rule: str):
+def products_on_runs(
+    tables: np.ndarray,
+    pad: int,
+    runs: np.ndarray,
+    radii: Sequence[int],
+    weights: Sequence[float],
+    margin: int,
+    quadrant_rule: str,
+):
     """Eq. 3.1 under its root, maximised over the radii (Eq. 3.2), on the pixels of ``runs``;
     returns the float32 maximum (0 elsewhere) and the int32 arg-max radius (smallest radius
     elsewhere and on ties)."""
@@ -310,10 +351,25 @@ def products_on_runs(tables: np.ndarray, pad: int, runs: np.ndarray, radii: Sequ
     plan = kernel_plan(tuple(radii), margin)
     best = np.zeros(shape, np.float32)
     best_radius = np.full(shape, min(radii), np.int32)
-    best_products(tables, pad, runs, plan.light_terms, plan.light_starts, plan.sat_terms,
-                  plan.sat_starts, plan.sat_inner, plan.sat_outer, plan.radii, plan.n_quarter,
-                  plan.n_box, plan.scales, np.asarray(weights, np.float32),
-                  quadrant_rule == "min", best, best_radius)
+    best_products(
+        tables,
+        pad,
+        runs,
+        plan.light_terms,
+        plan.light_starts,
+        plan.sat_terms,
+        plan.sat_starts,
+        plan.sat_inner,
+        plan.sat_outer,
+        plan.radii,
+        plan.n_quarter,
+        plan.n_box,
+        plan.scales,
+        np.asarray(weights, np.float32),
+        quadrant_rule == "min",
+        best,
+        best_radius,
+    )
     return best, best_radius
 
 
@@ -324,14 +380,41 @@ class Conspicuity(Detector):
     summary = "Zheng's conspicuity map (lightness, quadrant contrast, saturation) + localization"
     section = "Zheng 2016, 3.2.1-3.2.2, Eq. 3.1-3.15, Algorithm 3-1, Table 5-1"
     params = (
-        Param("weights", "floats", (1.0, 1.0, 1.0), min=0, length=3, section="Table 5-1",
-              help="(w_L, w_LC, w_S): weights of lightness, contrast, saturation (Eq. 3.1)"),
-        Param("radii", "ints", tuple(range(1, 11)), min=1, max=64, section="Table 5-1",
-              help="the lens radius set RAD in pixels (Eq. 3.2)"),
-        Param("margin", "int", 0, min=0, max=32, section="Table 5-1",
-              help="A2 margin m around the lens disk A1 (Eq. 3.9)"),
-        Param("quadrant_rule", "str", "max", choices=("max", "min"), section="Eq. 3.5, 3.2.1",
-              help="combine the four quadrant contrasts by max (as printed) or min (prose)"),
+        Param(
+            "weights",
+            "floats",
+            (1.0, 1.0, 1.0),
+            min=0,
+            length=3,
+            section="Table 5-1",
+            help="(w_L, w_LC, w_S): weights of lightness, contrast, saturation (Eq. 3.1)",
+        ),
+        Param(
+            "radii",
+            "ints",
+            tuple(range(1, 11)),
+            min=1,
+            max=64,
+            section="Table 5-1",
+            help="the lens radius set RAD in pixels (Eq. 3.2)",
+        ),
+        Param(
+            "margin",
+            "int",
+            0,
+            min=0,
+            max=32,
+            section="Table 5-1",
+            help="A2 margin m around the lens disk A1 (Eq. 3.9)",
+        ),
+        Param(
+            "quadrant_rule",
+            "str",
+            "max",
+            choices=("max", "min"),
+            section="Eq. 3.5, 3.2.1",
+            help="combine the four quadrant contrasts by max (as printed) or min (prose)",
+        ),
         ROI_PARAM,
     ) + LOCALIZATION_PARAMS
 

@@ -13,6 +13,7 @@ the values are bit for bit the same (other weights use ``powf`` instead of ``cv2
 Integer sums wrap modulo 2**32 in the int32 buffers like the int32 tables do, so the true sums
 (which are small) come out exact even when the column integrals of a large frame overflow.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -36,8 +37,9 @@ def prefix_tables(light: np.ndarray, sat: np.ndarray) -> np.ndarray:
     """
     height, width = light.shape
     stack = np.zeros((4, height + 1, width + 1), np.int32)
-    for channel, (prefix, integral) in zip((light, sat), ((LIGHT_PREFIX, LIGHT_INTEGRAL),
-                                                           (SAT_PREFIX, SAT_INTEGRAL))):
+    for channel, (prefix, integral) in zip(
+        (light, sat), ((LIGHT_PREFIX, LIGHT_INTEGRAL), (SAT_PREFIX, SAT_INTEGRAL))
+    ):
         np.cumsum(channel, axis=1, dtype=np.int32, out=stack[prefix, 1:, 1:])
         np.cumsum(stack[prefix], axis=0, dtype=np.int32, out=stack[integral])
     return stack
@@ -50,7 +52,7 @@ def window_sum(tables, terms, first, last, row, col, count, out):
     out[:count] = 0
     for t in range(first, last):
         y, c = row + terms[t, 1], col + terms[t, 2]
-        source = tables[terms[t, 0], y, c:c + count]
+        source = tables[terms[t, 0], y, c : c + count]
         target = out[:count]
         if terms[t, 3] > 0:
             for x in range(count):
@@ -91,8 +93,9 @@ def saturation_feature(inner, outer, disk_scale, annulus_scale, count, out):
     """Eq. 3.10-3.12: the larger of the disk mean of saturation and the mean over the annulus
     A3 (``outer`` disk of radius ``2 r`` minus the ``inner`` disk of radius ``r``)."""
     for x in range(count):
-        out[x] = max(np.float32(inner[x]) * disk_scale,
-                     np.float32(outer[x] - inner[x]) * annulus_scale)
+        out[x] = max(
+            np.float32(inner[x]) * disk_scale, np.float32(outer[x] - inner[x]) * annulus_scale
+        )
 
 
 @njit(cache=True, nogil=True)
@@ -104,14 +107,17 @@ def weighted_product(lightness, contrast, saturation, weights, count, out):
             out[x] = lightness[x] * contrast[x] * saturation[x]
         return
     for x in range(count):
-        out[x] = (_powered(lightness[x], weights[0]) * _powered(contrast[x], weights[1])
-                  * _powered(saturation[x], weights[2]))
+        out[x] = (
+            _powered(lightness[x], weights[0])
+            * _powered(contrast[x], weights[1])
+            * _powered(saturation[x], weights[2])
+        )
 
 
 @njit(cache=True, nogil=True)
 def _powered(feature, weight):
     """``feature ** weight`` in float32, the feature itself for a unit weight."""
-    return feature if weight == 1 else np.float32(feature ** weight)
+    return feature if weight == 1 else np.float32(feature**weight)
 
 
 @njit(cache=True, nogil=True)
@@ -124,9 +130,25 @@ def keep_best(product, radius, count, best, best_radius):
 
 
 @njit(cache=True, nogil=True)
-def best_products(tables, pad, runs, light_terms, light_starts, sat_terms, sat_starts,
-                  sat_inner, sat_outer, radii, n_quarter, n_box, scales, weights, use_min,
-                  best, best_radius):
+def best_products(
+    tables,
+    pad,
+    runs,
+    light_terms,
+    light_starts,
+    sat_terms,
+    sat_starts,
+    sat_inner,
+    sat_outer,
+    radii,
+    n_quarter,
+    n_box,
+    scales,
+    weights,
+    use_min,
+    best,
+    best_radius,
+):
     """Eq. 3.1 (under its root) for every radius and the maximum of Eq. 3.2 over the pixels
     of ``runs``; ``best`` (zeros on entry) and ``best_radius`` are written in place.
 
@@ -167,20 +189,29 @@ def best_products(tables, pad, runs, light_terms, light_starts, sat_terms, sat_s
         i, x0, count = runs[run, 0], runs[run, 1], runs[run, 2] - runs[run, 1]
         row, col = pad + 1 + i, pad + x0
         for d in range(sat.shape[0]):
-            window_sum(tables, sat_terms, sat_starts[d], sat_starts[d + 1], row, col, count,
-                        sat[d])
+            window_sum(tables, sat_terms, sat_starts[d], sat_starts[d + 1], row, col, count, sat[d])
         for k in range(radii.shape[0]):
             for w in range(LIGHT_WINDOWS):
                 start = k * LIGHT_WINDOWS + w
-                window_sum(tables, light_terms, light_starts[start], light_starts[start + 1],
-                            row, col, count, light[w])
+                window_sum(
+                    tables,
+                    light_terms,
+                    light_starts[start],
+                    light_starts[start + 1],
+                    row,
+                    col,
+                    count,
+                    light[w],
+                )
             lightness_contrast(light, n_quarter[k], n_box[k], use_min, count, contrast)
             disk_from_quarters(light, count, disk)
             for x in range(count):
                 features[0, x] = np.float32(disk[x]) * scales[k, 0]
                 features[1, x] = np.float32(contrast[x]) * scales[k, 1]
-            saturation_feature(sat[sat_inner[k]], sat[sat_outer[k]], scales[k, 2], scales[k, 3],
-                               count, features[2])
+            saturation_feature(
+                sat[sat_inner[k]], sat[sat_outer[k]], scales[k, 2], scales[k, 3], count, features[2]
+            )
             weighted_product(features[0], features[1], features[2], weights, count, product)
-            keep_best(product, radii[k], count, best[i, x0:x0 + count],
-                      best_radius[i, x0:x0 + count])
+            keep_best(
+                product, radii[k], count, best[i, x0 : x0 + count], best_radius[i, x0 : x0 + count]
+            )

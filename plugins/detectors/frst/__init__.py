@@ -4,8 +4,23 @@ Building block for plugin authors: ``from tsrkit_plugins.detectors.frst import f
 transform of any 2-D float map (``frst.py``); ``lab_frst.py`` is Siogkas et al.'s detector
 (Zheng 5.2.2) that runs it on the L*(a+b) map.
 """
-from tsrkit_plugins.detectors.frst.frst import (affected_pixels, frst, kappa, orientation_strength,
-                                                radial_strength, select_voters, sobel_gradient)
 
-__all__ = ["affected_pixels", "frst", "kappa", "orientation_strength", "radial_strength",
-           "select_voters", "sobel_gradient"]
+from tsrkit_plugins.detectors.frst.frst import (
+    affected_pixels,
+    frst,
+    kappa,
+    orientation_strength,
+    radial_strength,
+    select_voters,
+    sobel_gradient,
+)
+
+__all__ = [
+    "affected_pixels",
+    "frst",
+    "kappa",
+    "orientation_strength",
+    "radial_strength",
+    "select_voters",
+    "sobel_gradient",
+]

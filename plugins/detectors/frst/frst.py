@@ -10,6 +10,7 @@ IEEE PAMI 25(8), 2003: the definition of the transform and its refinements
 not among the project's seed documents, so the functions below name each quantity by its
 symbol (O_n, M_n, F_n, A_n, S_n) instead of an equation number.
 """
+
 from __future__ import annotations
 
 import math
@@ -49,7 +50,7 @@ class Voters:
     def crop(self, flat: np.ndarray) -> np.ndarray:
         """The image part of a flat array over the working grid, as a 2-D view."""
         height, width = self.shape
-        return flat.reshape(self.grid)[self.pad:self.pad + height, self.pad:self.pad + width]
+        return flat.reshape(self.grid)[self.pad : self.pad + height, self.pad : self.pad + width]
 
 
 def sobel_gradient(image: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -103,8 +104,9 @@ def orientation_projection(index: np.ndarray, sign: int, size: int) -> np.ndarra
     return counts if sign > 0 else np.negative(counts, out=counts)
 
 
-def magnitude_projection(index: np.ndarray, weights: np.ndarray, sign: int,
-                         size: int) -> np.ndarray:
+def magnitude_projection(
+    index: np.ndarray, weights: np.ndarray, sign: int, size: int
+) -> np.ndarray:
     """M_n: ``+||g(p)||`` at each positively- or ``-||g(p)||`` at each negatively-affected pixel."""
     sums = np.bincount(index, weights=weights, minlength=size)
     return sums if sign > 0 else np.negative(sums, out=sums)
@@ -120,8 +122,9 @@ def clipped_orientation(orientation: np.ndarray, k: float) -> np.ndarray:
     return np.sign(orientation) * np.minimum(np.abs(orientation), k)
 
 
-def radial_strength(magnitude: np.ndarray, orientation: np.ndarray, k: float,
-                    alpha: float) -> np.ndarray:
+def radial_strength(
+    magnitude: np.ndarray, orientation: np.ndarray, k: float, alpha: float
+) -> np.ndarray:
     """F_n = (M_n / k_n) * (|O~_n| / k_n) ** alpha.
 
     O_n holds integer vote counts, so ``(|O~_n| / k_n) ** alpha / k_n`` takes at most
@@ -156,12 +159,14 @@ def gaussian_kernel(n: int) -> np.ndarray:
 def spread(strength: np.ndarray, n: int) -> np.ndarray:
     """S_n = F_n * A_n: separable Gaussian smoothing, zero outside the image."""
     kernel = gaussian_kernel(n).astype(np.float32)
-    return cv2.sepFilter2D(strength.astype(np.float32), cv2.CV_32F, kernel, kernel,
-                           borderType=cv2.BORDER_CONSTANT)
+    return cv2.sepFilter2D(
+        strength.astype(np.float32), cv2.CV_32F, kernel, kernel, borderType=cv2.BORDER_CONSTANT
+    )
 
 
-def check_frst_args(image: np.ndarray, radii: Sequence[int], alpha: float, beta: float,
-                    mode: str) -> None:
+def check_frst_args(
+    image: np.ndarray, radii: Sequence[int], alpha: float, beta: float, mode: str
+) -> None:
     """Raise ValueError naming the first argument :func:`frst` cannot use."""
     if image.ndim != 2 or 0 in image.shape:
         raise ValueError(f"frst needs a non-empty 2-D image; got shape {image.shape}")
@@ -175,8 +180,14 @@ def check_frst_args(image: np.ndarray, radii: Sequence[int], alpha: float, beta:
         raise ValueError(f"frst mode must be one of {', '.join(MODES)}; got {mode!r}")
 
 
-def frst(image: np.ndarray, radii: Sequence[int] = tuple(range(1, 11)), alpha: float = 2.0,
-         beta: float = 0.0, mode: str = "both", orientation_only: bool = False) -> np.ndarray:
+def frst(
+    image: np.ndarray,
+    radii: Sequence[int] = tuple(range(1, 11)),
+    alpha: float = 2.0,
+    beta: float = 0.0,
+    mode: str = "both",
+    orientation_only: bool = False,
+) -> np.ndarray:
     """Fast radial symmetry transform S = sum over n of S_n.
 
     Parameters
@@ -218,8 +229,11 @@ def frst(image: np.ndarray, radii: Sequence[int] = tuple(range(1, 11)), alpha: f
     for n in radii:
         orientation, magnitude = projections(voters, int(n), signs)
         k = kappa(int(n))
-        strength = (orientation_strength(orientation, k, alpha) if orientation_only
-                    else radial_strength(magnitude, orientation, k, alpha))
+        strength = (
+            orientation_strength(orientation, k, alpha)
+            if orientation_only
+            else radial_strength(magnitude, orientation, k, alpha)
+        )
         total += spread(voters.crop(strength), int(n))
     return total
 
@@ -228,8 +242,10 @@ def projections(voters: Voters, n: int, signs: Sequence[int]) -> tuple[np.ndarra
     """O_n and M_n (flat, working grid) for radius ``n``, voting at the pixels of ``signs``."""
     size = voters.grid[0] * voters.grid[1]
     votes = [(affected_pixels(voters, n, sign), sign) for sign in signs]
-    orientation = reduce(np.add, (orientation_projection(index, sign, size)
-                                  for index, sign in votes))
-    magnitude = reduce(np.add, (magnitude_projection(index, voters.magnitude, sign, size)
-                                for index, sign in votes))
+    orientation = reduce(
+        np.add, (orientation_projection(index, sign, size) for index, sign in votes)
+    )
+    magnitude = reduce(
+        np.add, (magnitude_projection(index, voters.magnitude, sign, size) for index, sign in votes)
+    )
     return orientation, magnitude

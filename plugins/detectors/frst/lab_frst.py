@@ -4,6 +4,7 @@ The CIELab feature map L*(a+b) makes red lenses bright and green lenses dark; th
 symmetry transform of each part picks round spots, and the five strongest of each become
 candidates hinted red (bright) or green (dark). Source: Zheng 2016, section 5.2.2.
 """
+
 from __future__ import annotations
 
 import cv2
@@ -32,8 +33,9 @@ def lab_feature_map(image: np.ndarray) -> np.ndarray:
     return lightness * chroma * np.float32(1.0 / (255.0 * 128.0))
 
 
-def symmetry_maps(feature: np.ndarray, radii, alpha: float, beta: float,
-                  orientation_only: bool) -> tuple[np.ndarray, np.ndarray]:
+def symmetry_maps(
+    feature: np.ndarray, radii, alpha: float, beta: float, orientation_only: bool
+) -> tuple[np.ndarray, np.ndarray]:
     """Bright-spot map of the positive part and dark-spot map of the negative part.
 
     Zheng 5.2.2: "the positive and negative parts of the CIELab based feature map are transformed
@@ -46,8 +48,7 @@ def symmetry_maps(feature: np.ndarray, radii, alpha: float, beta: float,
     return bright, -dark
 
 
-def spot_candidates(symmetry: np.ndarray, fraction: float, top: int,
-                    state: str) -> list[Candidate]:
+def spot_candidates(symmetry: np.ndarray, fraction: float, top: int, state: str) -> list[Candidate]:
     """The ``top`` strongest 8-connected spots of ``symmetry >= fraction * max`` (Zheng 5.2.2).
 
     Components are labelled inside the bounding box of the above-threshold pixels only (the
@@ -62,7 +63,7 @@ def spot_candidates(symmetry: np.ndarray, fraction: float, top: int,
         return []
     rows, cols = np.nonzero(symmetry >= fraction * peak)
     top_row, left = rows.min(), cols.min()
-    window = symmetry[top_row:rows.max() + 1, left:cols.max() + 1]
+    window = symmetry[top_row : rows.max() + 1, left : cols.max() + 1]
     mask = (window >= fraction * peak).astype(np.uint8)
     count, labels, stats, centroids = cv2.connectedComponentsWithStats(mask, connectivity=8)
     on = labels > 0
@@ -70,9 +71,16 @@ def spot_candidates(symmetry: np.ndarray, fraction: float, top: int,
     np.maximum.at(scores, labels[on] - 1, window[on])
     best = np.argsort(-scores, kind="stable")[:top]
     sides = np.maximum(stats[1:, cv2.CC_STAT_WIDTH], stats[1:, cv2.CC_STAT_HEIGHT])
-    return [Candidate.from_circle(centroids[i + 1][0] + left + 0.5,
-                                  centroids[i + 1][1] + top_row + 0.5,
-                                  sides[i] / 2, scores[i], state) for i in best]
+    return [
+        Candidate.from_circle(
+            centroids[i + 1][0] + left + 0.5,
+            centroids[i + 1][1] + top_row + 0.5,
+            sides[i] / 2,
+            scores[i],
+            state,
+        )
+        for i in best
+    ]
 
 
 class LabFrst(Detector):
@@ -86,35 +94,76 @@ class LabFrst(Detector):
     """
 
     name = "lab-frst"
-    summary = ("CIELab L*(a+b) map, fast radial symmetry transform, top bright (red) and "
-               "dark (green) spots")
+    summary = (
+        "CIELab L*(a+b) map, fast radial symmetry transform, top bright (red) and "
+        "dark (green) spots"
+    )
     section = "Zheng 2016, 5.2.2; Loy & Zelinsky 2003"
     params = (
-        Param("radii", "ints", tuple(range(1, 11)), min=1, max=64,
-              help="FRST radii n in pixels", section="Zheng 5.2.2"),
-        Param("alpha", "float", 3.0, min=0.1, max=10,
-              help="FRST radial strictness", section="Zheng 5.2.2"),
-        Param("beta", "float", 0.0, min=0, max=0.99,
-              help="gradient threshold as a fraction of the largest gradient (not stated by Zheng)",
-              section="Loy & Zelinsky 2003"),
-        Param("fraction", "float", 0.5, min=0.01, max=1,
-              help="binarise each symmetry map at this fraction of its maximum",
-              section="Zheng 5.2.2"),
-        Param("top", "int", 5, min=1, max=100,
-              help="spots kept per polarity (bright = red, dark = green)", section="Zheng 5.2.2"),
-        Param("orientation_only", "bool", False,
-              help="use the orientation-based FRST (no magnitude projection)",
-              section="Loy & Zelinsky 2003"),
+        Param(
+            "radii",
+            "ints",
+            tuple(range(1, 11)),
+            min=1,
+            max=64,
+            help="FRST radii n in pixels",
+            section="Zheng 5.2.2",
+        ),
+        Param(
+            "alpha",
+            "float",
+            3.0,
+            min=0.1,
+            max=10,
+            help="FRST radial strictness",
+            section="Zheng 5.2.2",
+        ),
+        Param(
+            "beta",
+            "float",
+            0.0,
+            min=0,
+            max=0.99,
+            help="gradient threshold as a fraction of the largest gradient (not stated by Zheng)",
+            section="Loy & Zelinsky 2003",
+        ),
+        Param(
+            "fraction",
+            "float",
+            0.5,
+            min=0.01,
+            max=1,
+            help="binarise each symmetry map at this fraction of its maximum",
+            section="Zheng 5.2.2",
+        ),
+        Param(
+            "top",
+            "int",
+            5,
+            min=1,
+            max=100,
+            help="spots kept per polarity (bright = red, dark = green)",
+            section="Zheng 5.2.2",
+        ),
+        Param(
+            "orientation_only",
+            "bool",
+            False,
+            help="use the orientation-based FRST (no magnitude projection)",
+            section="Loy & Zelinsky 2003",
+        ),
     )
 
     def detect(self, frame: Frame) -> list[Candidate]:
         """Up to ``top`` red-hinted and ``top`` green-hinted candidates, strongest first."""
         p = self.params
         feature = lab_feature_map(frame.image)
-        bright, dark = symmetry_maps(feature, p["radii"], p["alpha"], p["beta"],
-                                     p["orientation_only"])
-        found = (spot_candidates(bright, p["fraction"], p["top"], "red")
-                 + spot_candidates(dark, p["fraction"], p["top"], "green"))
+        bright, dark = symmetry_maps(
+            feature, p["radii"], p["alpha"], p["beta"], p["orientation_only"]
+        )
+        found = spot_candidates(bright, p["fraction"], p["top"], "red") + spot_candidates(
+            dark, p["fraction"], p["top"], "green"
+        )
         return sorted(found, key=lambda c: -c.score)
 
 

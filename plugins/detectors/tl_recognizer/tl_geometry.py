@@ -8,17 +8,19 @@ Sign conventions (the reading chosen where the extracted equations disagree): pi
 the camera up, so the horizon lies ``f tan(rho)`` *below* the centre (Eq. 1 with theta = 0);
 roll theta > 0 turns the horizon counter-clockwise as seen in the image, i.e. its direction is
 ``(cos theta, -sin theta)`` in y-down pixels. Eq. 1 as printed (and A.1/A.2) place the point P at
-``C + f tan(rho) (sin theta, cos theta)``, which is the foot of the perpendicular from C (the proof's
+``C + f tan(rho) (sin theta, cos theta)``, the foot of the perpendicular from C (the proof's
 "distance between C and P is f tan(rho)") only for this direction; the x terms of Eq. 1 carry the
 opposite sign, which we read as a garbled sign.
 """
+
 from __future__ import annotations
 
 import numpy as np
 
 
-def horizon_line(pitch: float, roll: float, centre: tuple[float, float],
-                 focal_px: float) -> tuple[float, float, float]:
+def horizon_line(
+    pitch: float, roll: float, centre: tuple[float, float], focal_px: float
+) -> tuple[float, float, float]:
     """Coefficients ``(a, b, c)`` of the horizon ``a x + b y + c = 0`` (Property 1, Eq. 1).
 
     ``a = sin(theta)``, ``b = cos(theta)``, ``c = -sin(theta) C_x - cos(theta) C_y - f tan(rho)``:
@@ -36,8 +38,7 @@ def horizon_line(pitch: float, roll: float, centre: tuple[float, float],
     return float(a), float(b), float(-a * cx - b * cy - focal_px * np.tan(pitch))
 
 
-def level_coordinates(points: np.ndarray, roll: float,
-                      centre: tuple[float, float]) -> np.ndarray:
+def level_coordinates(points: np.ndarray, roll: float, centre: tuple[float, float]) -> np.ndarray:
     """Rotate pixel ``points`` (N, 2) by the inverse horizon inclination (Algorithm 1, line 8).
 
     Returns ``(u, v)`` relative to the image centre in a frame where the horizon is horizontal:
@@ -58,8 +59,9 @@ def image_coordinates(uv: np.ndarray, roll: float, centre: tuple[float, float]) 
     return np.stack([x, y], axis=1) + np.asarray(centre, dtype=np.float64)
 
 
-def horizontal_distance(d1: float, d2: float, focal_px: float, pitch: float,
-                        lens_height: float) -> float:
+def horizontal_distance(
+    d1: float, d2: float, focal_px: float, pitch: float, lens_height: float
+) -> float:
     """Horizontal distance d_h from the camera to the lens (Property 2, Eq. 2).
 
     ``d1`` and ``d2`` are the directed (positive upwards) distances in pixels from the image
@@ -79,10 +81,19 @@ def object_width(distance: float, contour_width: float, focal_px: float, alpha: 
     return float(distance * contour_width / (focal_px * np.cos(alpha)))
 
 
-def passes_distance_and_width(top: float, bottom: float, width_px: float, *, focal_px: float,
-                              pitch: float, lens_m: float, horizontal_m: tuple[float, float],
-                              vertical_m: tuple[float, float], max_rotation: float,
-                              width_slack: float) -> bool:
+def passes_distance_and_width(
+    top: float,
+    bottom: float,
+    width_px: float,
+    *,
+    focal_px: float,
+    pitch: float,
+    lens_m: float,
+    horizontal_m: tuple[float, float],
+    vertical_m: tuple[float, float],
+    max_rotation: float,
+    width_slack: float,
+) -> bool:
     """The "distance" and "width" properties of 3.4 for one levelled contour.
 
     ``top`` and ``bottom`` are levelled ``v`` extents (pixels, y down, relative to the centre) and

@@ -6,6 +6,7 @@ filtered in HSV (3.3, Table 6), its contours are levelled by the horizon roll an
 default the patch covers the 3-lens housing the lens implies (``context=housing``, see
 :mod:`tl_templates`); ``context=lens`` validates the bare contour MBR against a lit disc.
 """
+
 from __future__ import annotations
 
 from collections.abc import Iterable
@@ -20,10 +21,16 @@ from tsrkit.models import Model, load_model
 from tsrkit.params import Param
 from tsrkit.plugin import Detector
 from tsrkit.types import Candidate, Frame, Sample
-
 from tsrkit_plugins.detectors.tl_recognizer import tl_geometry as geo
 from tsrkit_plugins.detectors.tl_recognizer.tl_templates import (
-    ORIENTATIONS, Layout, extract_patch, load_templates, ncc, patch_box, patch_size)
+    ORIENTATIONS,
+    Layout,
+    extract_patch,
+    load_templates,
+    ncc,
+    patch_box,
+    patch_size,
+)
 
 #: Filters of the ranges array: rows of ``ranges[k] = [[h, s, v]_min, [h, s, v]_max]``.
 FILTERS = ("green", "yellowred_first", "yellowred_second")
@@ -33,10 +40,15 @@ PASSES = {"green": (0,), "yellowred": (1, 2)}
 
 def table6_ranges(green_h, yellowred_h, s_range, v_range) -> np.ndarray:
     """The range-filter bounds of Table 6 as a (3, 2, 3) array (filter, min/max, H/S/V)."""
-    hues = ((green_h[0], green_h[1]), (yellowred_h[0], yellowred_h[1]),
-            (yellowred_h[2], yellowred_h[3]))
-    return np.array([[[lo, s_range[0], v_range[0]], [hi, s_range[1], v_range[1]]]
-                     for lo, hi in hues], dtype=np.float64)
+    hues = (
+        (green_h[0], green_h[1]),
+        (yellowred_h[0], yellowred_h[1]),
+        (yellowred_h[2], yellowred_h[3]),
+    )
+    return np.array(
+        [[[lo, s_range[0], v_range[0]], [hi, s_range[1], v_range[1]]] for lo, hi in hues],
+        dtype=np.float64,
+    )
 
 
 def range_mask(hsv: np.ndarray, ranges: np.ndarray, rows: tuple[int, ...]) -> np.ndarray:
@@ -49,14 +61,19 @@ def range_mask(hsv: np.ndarray, ranges: np.ndarray, rows: tuple[int, ...]) -> np
 
 def reduced_hsv(image: np.ndarray, factor: int) -> np.ndarray:
     """The frame divided by ``factor`` on both sides (area averaging), in HSV (4.2)."""
-    small = image if factor == 1 else cv2.resize(
-        image, (max(1, image.shape[1] // factor), max(1, image.shape[0] // factor)),
-        interpolation=cv2.INTER_AREA)
+    small = (
+        image
+        if factor == 1
+        else cv2.resize(
+            image,
+            (max(1, image.shape[1] // factor), max(1, image.shape[0] // factor)),
+            interpolation=cv2.INTER_AREA,
+        )
+    )
     return cv2.cvtColor(small, cv2.COLOR_BGR2HSV)
 
 
-def enclosed_cores(hsv: np.ndarray, mask: np.ndarray, core_v: int,
-                   ring_share: float) -> np.ndarray:
+def enclosed_cores(hsv: np.ndarray, mask: np.ndarray, core_v: int, ring_share: float) -> np.ndarray:
     """``mask`` plus the bright blobs outside it that are mostly ringed by ``mask`` pixels.
 
     An overexposed lens records as a white core (low S, V near 255) inside a coloured ring, and
@@ -91,8 +108,13 @@ def extract_contours(mask: np.ndarray) -> list[np.ndarray]:
     return list(contours)
 
 
-def red_or_yellow(patch_bgr: np.ndarray, s_min: float, v_min: float, red_h: tuple[int, int],
-                  yellow_h: tuple[int, int]) -> str:
+def red_or_yellow(
+    patch_bgr: np.ndarray,
+    s_min: float,
+    v_min: float,
+    red_h: tuple[int, int],
+    yellow_h: tuple[int, int],
+) -> str:
     """Red when the lit pixels of a patch hold more red hues than yellow ones, else yellow (4.1).
 
     Only pixels with S >= ``s_min`` and V >= ``v_min`` are counted (our reading: the hue of the
@@ -120,78 +142,274 @@ class TlRecognizer(Detector):
     summary = "HSV range filters, contour pruning and template NCC validation; assigns the state"
     section = "Mascetti 2016, 3.2-3.5, 4.1-4.2, 5.2, Table 6"
     params = (
-        Param("green_h", "ints", (70, 95), min=0, max=180, length=2,
-              help="hue range of the green filter (OpenCV scale)", section="Table 6"),
-        Param("yellowred_h", "ints", (0, 25, 166, 180), min=0, max=180, length=4,
-              help="the two hue ranges of the yellowRed filter", section="Table 6, 4.1"),
-        Param("s_range", "ints", (100, 255), min=0, max=255, length=2,
-              help="saturation range of every filter", section="Table 6"),
-        Param("v_range", "ints", (80, 255), min=0, max=255, length=2,
-              help="value range of every filter", section="Table 6"),
-        Param("red_h", "ints", (160, 179), min=0, max=180, length=2,
-              help="pure red hues counted for the red/yellow split", section="4.1"),
-        Param("yellow_h", "ints", (10, 30), min=0, max=180, length=2,
-              help="pure yellow hues counted for the red/yellow split", section="4.1"),
-        Param("threshold", "float", 0.586, min=-1, max=1,
-              help="NCC above which a patch is a lit lens (T)", section="3.5, 5.2"),
-        Param("resize_factor", "int", 3, min=1, max=16,
-              help="extraction and pruning on the frame reduced by this factor", section="4.2"),
-        Param("template_size", "int", 32, min=4, max=256,
-              help="side of the square templates in pixels", section="3.5"),
-        Param("templates", "path", None,
-              help="folder with red.*, yellow.*, green.* template images, resized to the patch "
-                   "(default: generated housings or lit discs)", section="3.5"),
-        Param("context", "str", "lens", choices=("lens", "housing"),
-              help="validate the bare lens MBR (the paper's text; the default, which keeps "
-                   "recall on real sets), or the 3-lens housing the lens implies (rejects "
-                   "round street lamps, but loses horizontal and 4-lens heads)",
-              section="3.5, Figs. 5, 6, 15e"),
-        Param("orientation", "str", "vertical", choices=("vertical", "horizontal", "both"),
-              help="housing orientation (red top/left, green bottom/right); both: better score",
-              section="2.4"),
-        Param("lens_pitch", "float", 1.3, min=1,
-              help="centre distance of neighbouring lenses in lens diameters (housing context)"),
-        Param("margin", "float", 0.5, min=0,
-              help="margin around the housing in lens diameters (housing context)"),
-        Param("fill_cores", "bool", False,
-              help="add white lens cores ringed by the colour to the range-filter mask "
-                   "(not in the paper; false is the paper's extraction)", section="3.3"),
-        Param("core_v", "int", 230, min=0, max=255,
-              help="smallest V of a white lens core (fill_cores)"),
-        Param("ring_share", "float", 0.5, min=0, max=1,
-              help="share of a core's border pixels that must pass the colour filter "
-                   "(fill_cores)"),
-        Param("focal_px", "float", None, min=1,
-              help="focal length in pixels, if frames lack metadata 'focal_px'", section="3.4"),
-        Param("pitch_deg", "float", 0.0, min=-90, max=90,
-              help="camera pitch (up positive), if frames lack 'pitch_deg'", section="Property 1"),
-        Param("roll_deg", "float", 0.0, min=-180, max=180,
-              help="camera roll, if frames lack 'roll_deg'", section="Property 1"),
-        Param("lens_m", "float", 0.2, min=0.01,
-              help="lens height and width in metres", section="2.4, Property 2"),
-        Param("horizontal_m", "floats", (2.5, 20.0), min=0, length=2,
-              help="allowed horizontal distance to the light", section="2.4, Property 2"),
-        Param("vertical_m", "floats", (0.5, 4.0), length=2,
-              help="allowed height of the light above the camera", section="2.4, Property 2"),
-        Param("max_rotation_deg", "float", 45.0, min=0, max=89,
-              help="maximum rotation distance of a light towards the user", section="2.4, Prop. 3"),
-        Param("width_slack", "float", 0.15, min=0, max=1,
-              help="relative tolerance of the width test for pixel quantisation (not in the paper)"),
-        Param("size_px", "floats", (3.0, 400.0), min=0, length=2,
-              help="lens height range in full-resolution pixels when focal_px is unknown"),
-        Param("min_aspect", "float", 0.5, min=0.01, max=1,
-              help="smallest width/height (and height/width) ratio when focal_px is unknown"),
-        Param("threads", "int", 1, min=1, max=2,
-              help="threads for the colour passes (2 runs green and yellowRed together)",
-              section="4.2"),
-        Param("fit_ranges", "bool", True,
-              help="training: derive the range-filter bounds (Figure 16) before T; false "
-                   "tunes T alone on the current ranges", section="5.2"),
-        Param("fit_coverage", "float", 1.0, min=0.5, max=1,
-              help="training: share of annotated lens pixels the derived ranges include",
-              section="5.2, Figure 16"),
-        Param("model", "path", None,
-              help="model from 'tsrkit train tl-recognizer' (ranges and T)", section="5.2"),
+        Param(
+            "green_h",
+            "ints",
+            (70, 95),
+            min=0,
+            max=180,
+            length=2,
+            help="hue range of the green filter (OpenCV scale)",
+            section="Table 6",
+        ),
+        Param(
+            "yellowred_h",
+            "ints",
+            (0, 25, 166, 180),
+            min=0,
+            max=180,
+            length=4,
+            help="the two hue ranges of the yellowRed filter",
+            section="Table 6, 4.1",
+        ),
+        Param(
+            "s_range",
+            "ints",
+            (100, 255),
+            min=0,
+            max=255,
+            length=2,
+            help="saturation range of every filter",
+            section="Table 6",
+        ),
+        Param(
+            "v_range",
+            "ints",
+            (80, 255),
+            min=0,
+            max=255,
+            length=2,
+            help="value range of every filter",
+            section="Table 6",
+        ),
+        Param(
+            "red_h",
+            "ints",
+            (160, 179),
+            min=0,
+            max=180,
+            length=2,
+            help="pure red hues counted for the red/yellow split",
+            section="4.1",
+        ),
+        Param(
+            "yellow_h",
+            "ints",
+            (10, 30),
+            min=0,
+            max=180,
+            length=2,
+            help="pure yellow hues counted for the red/yellow split",
+            section="4.1",
+        ),
+        Param(
+            "threshold",
+            "float",
+            0.586,
+            min=-1,
+            max=1,
+            help="NCC above which a patch is a lit lens (T)",
+            section="3.5, 5.2",
+        ),
+        Param(
+            "resize_factor",
+            "int",
+            3,
+            min=1,
+            max=16,
+            help="extraction and pruning on the frame reduced by this factor",
+            section="4.2",
+        ),
+        Param(
+            "template_size",
+            "int",
+            32,
+            min=4,
+            max=256,
+            help="side of the square templates in pixels",
+            section="3.5",
+        ),
+        Param(
+            "templates",
+            "path",
+            None,
+            help="folder with red.*, yellow.*, green.* template images, resized to the patch "
+            "(default: generated housings or lit discs)",
+            section="3.5",
+        ),
+        Param(
+            "context",
+            "str",
+            "lens",
+            choices=("lens", "housing"),
+            help="validate the bare lens MBR (the paper's text; the default, which keeps "
+            "recall on real sets), or the 3-lens housing the lens implies (rejects "
+            "round street lamps, but loses horizontal and 4-lens heads)",
+            section="3.5, Figs. 5, 6, 15e",
+        ),
+        Param(
+            "orientation",
+            "str",
+            "vertical",
+            choices=("vertical", "horizontal", "both"),
+            help="housing orientation (red top/left, green bottom/right); both: better score",
+            section="2.4",
+        ),
+        Param(
+            "lens_pitch",
+            "float",
+            1.3,
+            min=1,
+            help="centre distance of neighbouring lenses in lens diameters (housing context)",
+        ),
+        Param(
+            "margin",
+            "float",
+            0.5,
+            min=0,
+            help="margin around the housing in lens diameters (housing context)",
+        ),
+        Param(
+            "fill_cores",
+            "bool",
+            False,
+            help="add white lens cores ringed by the colour to the range-filter mask "
+            "(not in the paper; false is the paper's extraction)",
+            section="3.3",
+        ),
+        Param(
+            "core_v",
+            "int",
+            230,
+            min=0,
+            max=255,
+            help="smallest V of a white lens core (fill_cores)",
+        ),
+        Param(
+            "ring_share",
+            "float",
+            0.5,
+            min=0,
+            max=1,
+            help="share of a core's border pixels that must pass the colour filter (fill_cores)",
+        ),
+        Param(
+            "focal_px",
+            "float",
+            None,
+            min=1,
+            help="focal length in pixels, if frames lack metadata 'focal_px'",
+            section="3.4",
+        ),
+        Param(
+            "pitch_deg",
+            "float",
+            0.0,
+            min=-90,
+            max=90,
+            help="camera pitch (up positive), if frames lack 'pitch_deg'",
+            section="Property 1",
+        ),
+        Param(
+            "roll_deg",
+            "float",
+            0.0,
+            min=-180,
+            max=180,
+            help="camera roll, if frames lack 'roll_deg'",
+            section="Property 1",
+        ),
+        Param(
+            "lens_m",
+            "float",
+            0.2,
+            min=0.01,
+            help="lens height and width in metres",
+            section="2.4, Property 2",
+        ),
+        Param(
+            "horizontal_m",
+            "floats",
+            (2.5, 20.0),
+            min=0,
+            length=2,
+            help="allowed horizontal distance to the light",
+            section="2.4, Property 2",
+        ),
+        Param(
+            "vertical_m",
+            "floats",
+            (0.5, 4.0),
+            length=2,
+            help="allowed height of the light above the camera",
+            section="2.4, Property 2",
+        ),
+        Param(
+            "max_rotation_deg",
+            "float",
+            45.0,
+            min=0,
+            max=89,
+            help="maximum rotation distance of a light towards the user",
+            section="2.4, Prop. 3",
+        ),
+        Param(
+            "width_slack",
+            "float",
+            0.15,
+            min=0,
+            max=1,
+            help="relative tolerance of the width test for pixel quantisation (not in the paper)",
+        ),
+        Param(
+            "size_px",
+            "floats",
+            (3.0, 400.0),
+            min=0,
+            length=2,
+            help="lens height range in full-resolution pixels when focal_px is unknown",
+        ),
+        Param(
+            "min_aspect",
+            "float",
+            0.5,
+            min=0.01,
+            max=1,
+            help="smallest width/height (and height/width) ratio when focal_px is unknown",
+        ),
+        Param(
+            "threads",
+            "int",
+            1,
+            min=1,
+            max=2,
+            help="threads for the colour passes (2 runs green and yellowRed together)",
+            section="4.2",
+        ),
+        Param(
+            "fit_ranges",
+            "bool",
+            True,
+            help="training: derive the range-filter bounds (Figure 16) before T; false "
+            "tunes T alone on the current ranges",
+            section="5.2",
+        ),
+        Param(
+            "fit_coverage",
+            "float",
+            1.0,
+            min=0.5,
+            max=1,
+            help="training: share of annotated lens pixels the derived ranges include",
+            section="5.2, Figure 16",
+        ),
+        Param(
+            "model",
+            "path",
+            None,
+            help="model from 'tsrkit train tl-recognizer' (ranges and T)",
+            section="5.2",
+        ),
     )
 
     def __init__(self, **params):
@@ -203,8 +421,9 @@ class TlRecognizer(Detector):
             model = load_model(p["model"], plugin=self.name)
             self.ranges = np.asarray(model.arrays["ranges"], dtype=np.float64)
             self.threshold = float(model.arrays["threshold"])
-        self.layout = Layout(p["context"] == "housing", p["template_size"], p["lens_pitch"],
-                             p["margin"])
+        self.layout = Layout(
+            p["context"] == "housing", p["template_size"], p["lens_pitch"], p["margin"]
+        )
         self.orientations = ORIENTATIONS if p["orientation"] == "both" else (p["orientation"],)
         self.templates = load_templates(p["templates"], self.layout)
 
@@ -212,9 +431,11 @@ class TlRecognizer(Detector):
         """Focal length, pitch and roll from the frame's metadata, else from the parameters."""
         meta, p = frame.metadata, self.params
         focal = meta.get("focal_px", p["focal_px"])
-        return Camera(None if focal is None else float(focal),
-                      float(np.radians(meta.get("pitch_deg", p["pitch_deg"]))),
-                      float(np.radians(meta.get("roll_deg", p["roll_deg"]))))
+        return Camera(
+            None if focal is None else float(focal),
+            float(np.radians(meta.get("pitch_deg", p["pitch_deg"]))),
+            float(np.radians(meta.get("roll_deg", p["roll_deg"]))),
+        )
 
     def detect(self, frame: Frame) -> list[Candidate]:
         """Lit lenses whose NCC exceeds T, best first; ``state`` is red, yellow or green."""
@@ -233,8 +454,9 @@ class TlRecognizer(Detector):
             found = [self._colour_pass(*job) for job in jobs]
         return sorted((c for part in found for c in part), key=lambda c: -c.score)
 
-    def _colour_pass(self, hsv: np.ndarray, image: np.ndarray, colour: str,
-                     camera: Camera) -> list[Candidate]:
+    def _colour_pass(
+        self, hsv: np.ndarray, image: np.ndarray, colour: str, camera: Camera
+    ) -> list[Candidate]:
         """Extraction, pruning and validation for one colour (Algorithm 1, lines 3-16)."""
         mask = range_mask(hsv, self.ranges, PASSES[colour])
         if self.params["fill_cores"]:
@@ -250,8 +472,9 @@ class TlRecognizer(Detector):
         return out
 
     @staticmethod
-    def _levelled_box(contour: np.ndarray, scale: tuple[float, float], roll: float,
-                      centre: tuple[float, float]) -> tuple[float, float, float, float]:
+    def _levelled_box(
+        contour: np.ndarray, scale: tuple[float, float], roll: float, centre: tuple[float, float]
+    ) -> tuple[float, float, float, float]:
         """Pixel-edge extents ``(u0, v0, u1, v1)`` of a reduced-frame contour, levelled (line 8)."""
         pts = contour.reshape(-1, 2).astype(np.float64)
         pts = (pts + 0.5) * scale - 0.5
@@ -267,15 +490,26 @@ class TlRecognizer(Detector):
         p = self.params
         if camera.focal_px is None:
             aspect = width / height
-            return (p["size_px"][0] <= height <= p["size_px"][1]
-                    and p["min_aspect"] <= aspect <= 1 / p["min_aspect"])
+            return (
+                p["size_px"][0] <= height <= p["size_px"][1]
+                and p["min_aspect"] <= aspect <= 1 / p["min_aspect"]
+            )
         return geo.passes_distance_and_width(
-            v0, v1, width, focal_px=camera.focal_px, pitch=camera.pitch, lens_m=p["lens_m"],
-            horizontal_m=p["horizontal_m"], vertical_m=p["vertical_m"],
-            max_rotation=np.radians(p["max_rotation_deg"]), width_slack=p["width_slack"])
+            v0,
+            v1,
+            width,
+            focal_px=camera.focal_px,
+            pitch=camera.pitch,
+            lens_m=p["lens_m"],
+            horizontal_m=p["horizontal_m"],
+            vertical_m=p["vertical_m"],
+            max_rotation=np.radians(p["max_rotation_deg"]),
+            width_slack=p["width_slack"],
+        )
 
-    def _validate(self, image: np.ndarray, box_uv, colour: str, roll: float,
-                  centre: tuple[float, float]) -> Candidate:
+    def _validate(
+        self, image: np.ndarray, box_uv, colour: str, roll: float, centre: tuple[float, float]
+    ) -> Candidate:
         """Red/yellow split on the lens patch, then NCC with the state's template (3.5, 4.1).
 
         The candidate's box is the lens; its score the best over the allowed orientations.
@@ -284,18 +518,33 @@ class TlRecognizer(Detector):
         state = colour
         if colour == "yellowred":
             lens = extract_patch(image, box_uv, roll, centre, size)
-            state = red_or_yellow(lens, self.ranges[1, 0, 1], self.ranges[1, 0, 2],
-                                  self.params["red_h"], self.params["yellow_h"])
-        score = max(self._orientation_score(image, box_uv, state, orientation, roll, centre)
-                    for orientation in self.orientations)
+            state = red_or_yellow(
+                lens,
+                self.ranges[1, 0, 1],
+                self.ranges[1, 0, 2],
+                self.params["red_h"],
+                self.params["yellow_h"],
+            )
+        score = max(
+            self._orientation_score(image, box_uv, state, orientation, roll, centre)
+            for orientation in self.orientations
+        )
         u0, v0, u1, v1 = box_uv
-        corners = geo.image_coordinates(np.array([[u0, v0], [u1, v0], [u1, v1], [u0, v1]]),
-                                        roll, centre)
+        corners = geo.image_coordinates(
+            np.array([[u0, v0], [u1, v0], [u1, v1], [u0, v1]]), roll, centre
+        )
         (x0, y0), (x1, y1) = corners.min(axis=0), corners.max(axis=0)
         return Candidate.from_box((x0, y0, x1, y1), score, state)
 
-    def _orientation_score(self, image: np.ndarray, box_uv, state: str, orientation: str,
-                           roll: float, centre: tuple[float, float]) -> float:
+    def _orientation_score(
+        self,
+        image: np.ndarray,
+        box_uv,
+        state: str,
+        orientation: str,
+        roll: float,
+        centre: tuple[float, float],
+    ) -> float:
         """NCC of the patch a lens of ``state`` implies in a head of ``orientation``."""
         box = patch_box(box_uv, state, orientation, self.layout)
         patch = extract_patch(image, box, roll, centre, patch_size(orientation, self.layout))

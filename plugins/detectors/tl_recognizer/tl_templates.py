@@ -17,6 +17,7 @@ templates, e.g. with pedestrian figures; each image is resized to the patch shap
 sampled from the full-resolution frame straight at template size (rotation, crop and resize in one
 warp).
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -66,8 +67,11 @@ class Layout:
         if not self.housing:
             return 0.5, 0.5, 0.5
         k = LENS_INDEX[state]
-        return (k * self.pitch + 0.5 + self.margin, (2 - k) * self.pitch + 0.5 + self.margin,
-                0.5 + self.margin)
+        return (
+            k * self.pitch + 0.5 + self.margin,
+            (2 - k) * self.pitch + 0.5 + self.margin,
+            0.5 + self.margin,
+        )
 
     def shape(self) -> tuple[int, int]:
         """Patch (along, across) sides in pixels; the same for every state."""
@@ -75,8 +79,9 @@ class Layout:
         return int(round(self.size * (before + after) / (2 * across))), self.size
 
 
-def patch_box(box_uv: tuple[float, float, float, float], state: str, orientation: str,
-              layout: Layout) -> tuple[float, float, float, float]:
+def patch_box(
+    box_uv: tuple[float, float, float, float], state: str, orientation: str, layout: Layout
+) -> tuple[float, float, float, float]:
     """The levelled rectangle a patch covers, for the lens MBR ``box_uv`` of colour ``state``."""
     u0, v0, u1, v1 = box_uv
     cu, cv, du, dv = (u0 + u1) / 2, (v0 + v1) / 2, u1 - u0, v1 - v0
@@ -94,8 +99,8 @@ def patch_size(orientation: str, layout: Layout) -> tuple[int, int]:
 
 def _disc(image: np.ndarray, centre: tuple[float, float], radius: float, colour) -> None:
     """Fill a disc of ``image`` (float, in place)."""
-    yy, xx = np.mgrid[:image.shape[0], :image.shape[1]]
-    image[(xx - centre[0]) ** 2 + (yy - centre[1]) ** 2 <= radius ** 2] = colour
+    yy, xx = np.mgrid[: image.shape[0], : image.shape[1]]
+    image[(xx - centre[0]) ** 2 + (yy - centre[1]) ** 2 <= radius**2] = colour
 
 
 def _finish(image: np.ndarray, sigma: float) -> np.ndarray:
@@ -107,8 +112,9 @@ def _finish(image: np.ndarray, sigma: float) -> np.ndarray:
 def _check_state(state: str, size: int) -> None:
     """Raise ValueError for a state without a default template or a size under 4 pixels."""
     if state not in LENS_BGR:
-        raise ValueError(f"no default template for state {state!r}; expected one of "
-                         f"{', '.join(TEMPLATE_STATES)}")
+        raise ValueError(
+            f"no default template for state {state!r}; expected one of {', '.join(TEMPLATE_STATES)}"
+        )
     if size < 4:
         raise ValueError(f"template size must be at least 4 pixels; got {size}")
 
@@ -133,17 +139,18 @@ def housing_template(state: str, orientation: str, layout: Layout) -> np.ndarray
     by a Gaussian (sigma = one 32nd of the lens diameter).
     """
     _check_state(state, layout.size)
-    before, after, across = layout.extents(state)
-    lens_px = layout.size / (2 * across)          # lens diameter in template pixels
+    before, _after, across = layout.extents(state)
+    lens_px = layout.size / (2 * across)  # lens diameter in template pixels
     along, side = layout.shape()
     image = np.full((along, side, 3), SURROUND_BGR, np.float32)
     m = int(round(max(layout.margin - SCREEN_BORDER, 0.0) * lens_px))
-    image[m:along - m, m:side - m] = SCREEN_BGR
-    first = (before - LENS_INDEX[state] * layout.pitch) * lens_px   # centre of lens 0, along
+    image[m : along - m, m : side - m] = SCREEN_BGR
+    first = (before - LENS_INDEX[state] * layout.pitch) * lens_px  # centre of lens 0, along
     for k in range(3):
         colour = LENS_BGR[state] if k == LENS_INDEX[state] else DIM_BGR
-        _disc(image, ((side - 1) / 2, first + k * layout.pitch * lens_px - 0.5), lens_px / 2,
-              colour)
+        _disc(
+            image, ((side - 1) / 2, first + k * layout.pitch * lens_px - 0.5), lens_px / 2, colour
+        )
     image = _finish(image, lens_px / 32)
     return image if orientation == "vertical" else np.ascontiguousarray(image.transpose(1, 0, 2))
 
@@ -165,8 +172,10 @@ def folder_template(folder: str, state: str) -> np.ndarray:
     """
     found = sorted(Path(folder).glob(f"{state}.*"))
     if not found:
-        raise TsrkitError(f"templates folder {folder}: no image named {state}.* "
-                          f"(expected red.*, yellow.* and green.*)")
+        raise TsrkitError(
+            f"templates folder {folder}: no image named {state}.* "
+            f"(expected red.*, yellow.* and green.*)"
+        )
     return read_image(found[0])
 
 
@@ -175,15 +184,24 @@ def load_templates(folder: str | None, layout: Layout) -> dict[tuple[str, str], 
     out = {}
     for state in TEMPLATE_STATES:
         for orientation in ORIENTATIONS:
-            image = (default_template(state, orientation, layout) if folder is None
-                     else folder_template(folder, state))
-            out[state, orientation] = cv2.resize(image, patch_size(orientation, layout),
-                                                 interpolation=cv2.INTER_AREA)
+            image = (
+                default_template(state, orientation, layout)
+                if folder is None
+                else folder_template(folder, state)
+            )
+            out[state, orientation] = cv2.resize(
+                image, patch_size(orientation, layout), interpolation=cv2.INTER_AREA
+            )
     return out
 
 
-def extract_patch(image: np.ndarray, box_uv: tuple[float, float, float, float], roll: float,
-                  centre: tuple[float, float], size: int | tuple[int, int]) -> np.ndarray:
+def extract_patch(
+    image: np.ndarray,
+    box_uv: tuple[float, float, float, float],
+    roll: float,
+    centre: tuple[float, float],
+    size: int | tuple[int, int],
+) -> np.ndarray:
     """Sample the levelled rectangle ``box_uv`` of ``image`` at ``size`` (side or (w, h); 3.5).
 
     ``box_uv = (u0, v0, u1, v1)`` are pixel-edge extents in the levelled frame of
@@ -198,9 +216,13 @@ def extract_patch(image: np.ndarray, box_uv: tuple[float, float, float, float], 
     to_uv = np.array([[su, 0.0, u0 + su / 2], [0.0, sv, v0 + sv / 2]])
     to_xy = np.array([[c, s], [-s, c]])
     matrix = np.hstack([to_xy @ to_uv[:, :2], (to_xy @ to_uv[:, 2] + centre)[:, None]])
-    return cv2.warpAffine(image, matrix, (width, height),
-                          flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
-                          borderMode=cv2.BORDER_REPLICATE)
+    return cv2.warpAffine(
+        image,
+        matrix,
+        (width, height),
+        flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
+        borderMode=cv2.BORDER_REPLICATE,
+    )
 
 
 def ncc(patch: np.ndarray, template: np.ndarray) -> float:

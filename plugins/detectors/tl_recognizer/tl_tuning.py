@@ -5,6 +5,7 @@ in an annotated box of the same colour, gathers their pixels (without white V = 
 takes the smallest ranges that hold them. ``tune_threshold`` sets T to the highest NCC of a
 pruned patch that is not a light, so the tuning set is recognised with precision 1.
 """
+
 from __future__ import annotations
 
 import cv2
@@ -12,15 +13,23 @@ import numpy as np
 
 from tsrkit.eval.matching import centre_hits
 from tsrkit.models import Model
-
 from tsrkit_plugins.detectors.tl_recognizer.tl_recognizer import (
-    PASSES, extract_contours, range_mask, reduced_hsv)
+    PASSES,
+    extract_contours,
+    range_mask,
+    reduced_hsv,
+)
 
 #: The broad first ranges standing in for the paper's "few manually sampled pixels" (5.2):
 #: Table 6 widened by 20 hue steps and with S, V from 40.
-BROAD_RANGES = np.array([[[50, 40, 40], [115, 255, 255]],
-                         [[0, 40, 40], [45, 255, 255]],
-                         [[146, 40, 40], [180, 255, 255]]], dtype=np.float64)
+BROAD_RANGES = np.array(
+    [
+        [[50, 40, 40], [115, 255, 255]],
+        [[0, 40, 40], [45, 255, 255]],
+        [[146, 40, 40], [180, 255, 255]],
+    ],
+    dtype=np.float64,
+)
 #: Which annotated states each colour pass collects pixels for.
 PASS_STATES = {"green": ("green",), "yellowred": ("red", "yellow")}
 
@@ -30,7 +39,7 @@ def contour_pixels(hsv: np.ndarray, mask: np.ndarray, contour: np.ndarray) -> np
     x, y, w, h = cv2.boundingRect(contour)
     inside = np.zeros((h, w), np.uint8)
     cv2.drawContours(inside, [contour - (x, y)], -1, 255, thickness=cv2.FILLED)
-    return hsv[y:y + h, x:x + w][(inside > 0) & (mask[y:y + h, x:x + w] > 0)]
+    return hsv[y : y + h, x : x + w][(inside > 0) & (mask[y : y + h, x : x + w] > 0)]
 
 
 def lens_contour(contour: np.ndarray, scale: np.ndarray, boxes) -> bool:
@@ -57,12 +66,15 @@ def annotated_lens_pixels(samples, factor: int) -> dict[str, np.ndarray]:
             for contour in extract_contours(mask):
                 if lens_contour(contour, scale, boxes):
                     found[colour].append(contour_pixels(hsv, mask, contour))
-    return {colour: np.concatenate(parts) if parts else np.zeros((0, 3), np.uint8)
-            for colour, parts in found.items()}
+    return {
+        colour: np.concatenate(parts) if parts else np.zeros((0, 3), np.uint8)
+        for colour, parts in found.items()
+    }
 
 
-def smallest_ranges(pixels: dict[str, np.ndarray], fallback: np.ndarray,
-                    coverage: float) -> np.ndarray:
+def smallest_ranges(
+    pixels: dict[str, np.ndarray], fallback: np.ndarray, coverage: float
+) -> np.ndarray:
     """Ranges holding a ``coverage`` share of the lens pixels; ``fallback`` rows where none.
 
     White pixels (V = 255) are left out as in 5.2; dark ones never pass the broad filter. Hue
@@ -108,8 +120,9 @@ def patch_scores(detector, samples) -> tuple[np.ndarray, np.ndarray]:
             continue
         boxes = [a.bbox for a in sample.annotations]
         centres = [(c.x, c.y) for c in candidates]
-        inside = (centre_hits(centres, boxes).any(axis=1) if boxes
-                  else np.zeros(len(candidates), bool))
+        inside = (
+            centre_hits(centres, boxes).any(axis=1) if boxes else np.zeros(len(candidates), bool)
+        )
         for candidate, hit in zip(candidates, inside):
             (lights if hit else others).append(candidate.score)
     return np.array(lights, dtype=np.float64), np.array(others, dtype=np.float64)
@@ -135,12 +148,16 @@ def fit_model(detector, samples) -> Model:
     pixels = {colour: np.zeros((0, 3), np.uint8) for colour in PASSES}
     if detector.params["fit_ranges"]:
         pixels = annotated_lens_pixels(samples, detector.params["resize_factor"])
-        detector.ranges = smallest_ranges(pixels, detector.ranges,
-                                          detector.params["fit_coverage"])
+        detector.ranges = smallest_ranges(pixels, detector.ranges, detector.params["fit_coverage"])
     threshold, lights, others = tune_threshold(detector, samples)
     if threshold is not None:
         detector.threshold = threshold
-    return Model(arrays={"ranges": detector.ranges, "threshold": np.array(detector.threshold)},
-                 info={"lens_pixels": {k: int(len(v)) for k, v in pixels.items()},
-                       "patches_in_boxes": lights, "patches_outside_boxes": others,
-                       "threshold_from_data": threshold is not None})
+    return Model(
+        arrays={"ranges": detector.ranges, "threshold": np.array(detector.threshold)},
+        info={
+            "lens_pixels": {k: int(len(v)) for k, v in pixels.items()},
+            "patches_in_boxes": lights,
+            "patches_outside_boxes": others,
+            "threshold_from_data": threshold is not None,
+        },
+    )
