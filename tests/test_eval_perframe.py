@@ -2,7 +2,7 @@
 
 import pytest
 
-from tsrkit.eval.categories import category_table, precision_bound, recall_label
+from tsrkit.eval.categories import category_table, precision_bound, radius_label, recall_label
 from tsrkit.eval.perframe import FrameScore, max_target_radius, score_frame, summarise
 
 BOXES = [(0, 0, 10, 10), (20, 0, 30, 10), (40, 0, 50, 10), (60, 0, 70, 10)]
@@ -76,3 +76,33 @@ def test_category_table_groups_by_lighting_then_radius():
         {"recall": 1.0, "fpr": 0.0, "frames": 1},
     ]
     assert rows[1]["bubbles"] == [{"recall": 1.0, "fpr": 0.5, "frames": 1}]
+
+
+def test_large_radii_share_bins_so_full_resolution_sets_give_a_handful_of_rows():
+    # boxes of side 2r: radii 3, 9 keep their own rows (Table 5-2), 10-13 share one, 80 is >= 70
+    frames = [score_frame([], [(0, 0, 2 * r, 2 * r)], "day") for r in (3, 9, 10, 12, 13, 80)]
+    rows = category_table(frames)
+    assert [(r["max_radius"], r["frames"]) for r in rows] == [
+        (None, 6),
+        (3, 1),
+        (9, 1),
+        (10, 3),
+        (70, 1),
+    ]
+    assert [radius_label(r["max_radius"]) for r in rows[1:]] == ["3", "9", "10-13", ">=70"]
+
+
+def test_bubble_figure_stays_compact_whatever_the_radii(tmp_path):
+    from PIL import Image
+
+    from tsrkit_plugins.writers.plots import bubble_plot
+
+    frames = [
+        score_frame([(r, r)], [(0, 0, 2 * r, 2 * r)], light)
+        for r in range(2, 120)
+        for light in ("day", "dusk", "night")
+    ]
+    bubble_plot(category_table(frames), tmp_path / "b.png")
+    width, height = Image.open(tmp_path / "b.png").size
+    # 15 radius bins x 3 lightings: one axes, not 354 panels (the old layout: 1320 x 29000 px)
+    assert width <= 1800 and height <= 500

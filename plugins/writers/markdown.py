@@ -7,7 +7,7 @@ from pathlib import Path
 
 from tsrkit import ReportWriter, RunResult, hookimpl
 from tsrkit.atomic import atomic_open
-from tsrkit.eval.categories import recall_sort_key
+from tsrkit.eval.categories import radius_label, recall_sort_key
 from tsrkit.report import fmt, headline, markdown_table, title
 
 
@@ -85,7 +85,7 @@ def category_markdown(rows: list[dict]) -> str:
     )
     body = []
     for r in rows:
-        name = r["lighting"] if r["max_radius"] is None else f"{r['max_radius']}"
+        name = r["lighting"] if r["max_radius"] is None else radius_label(r["max_radius"])
         body.append(
             [name]
             + [str(r["recall_counts"].get(c, "")) for c in recall_cols]

@@ -1,13 +1,12 @@
 """Report writer ``plots``: PNG plots (matplotlib Agg): Fig. 5-1 bubbles, bars, PR curve, confusion.
 
-``bubble_plot`` follows Zheng 2016 Figure 5-1: one panel per lighting x max-radius category,
-recall against FPR = 1 - precision, circle area proportional to the share of the category's
-frames, bluer towards (FPR 0, recall 1) and redder away from it, ``N = frames`` in grey.
+``bubble_plot`` follows Zheng 2016 Figure 5-1 (recall against FPR = 1 - precision per lighting x
+max-radius category, circle area proportional to the share of the category's frames, bluer towards
+(FPR 0, recall 1) and redder away from it, ``N = frames`` in grey), drawn as one compact grid.
 """
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import matplotlib
@@ -17,6 +16,7 @@ import matplotlib.pyplot as plt
 
 from tsrkit import ReportWriter, RunResult, hookimpl
 from tsrkit.atomic import atomic_open
+from tsrkit.eval.categories import radius_label
 
 
 def _save(fig, path: Path) -> str:
@@ -27,24 +27,32 @@ def _save(fig, path: Path) -> str:
 
 
 def bubble_plot(rows: list[dict], path: Path) -> str:
-    """Figure 5-1: recall vs FPR bubbles per category (rows of ``report["categories"]``)."""
-    panels = [r for r in rows if r["max_radius"] is not None] or rows
-    cols = min(4, max(1, len(panels)))
-    nrows = max(1, math.ceil(len(panels) / cols))
-    fig, axes = plt.subplots(
-        nrows, cols, figsize=(3 * cols, 3 * nrows), squeeze=False, sharex=True, sharey=True
-    )
+    """Figure 5-1 as one compact figure: a grid of cells, lighting down, max-radius bin across.
+
+    Zheng draws one panel per category; at full resolution that is dozens of panels, so here each
+    category is one cell of a single axes, holding its recall (up) against FPR (right) bubbles
+    with ``N = frames``. The figure's size is bounded by the number of radius bins
+    (:data:`tsrkit.eval.categories.RADIUS_BIN_STARTS`) and lighting conditions, whatever the
+    dataset size.
+    """
+    cells = [r for r in rows if r["max_radius"] is not None] or rows
+    lightings = sorted({r["lighting"] for r in cells})
+    starts = sorted({r["max_radius"] for r in cells if r["max_radius"] is not None})
+    column = {start: k for k, start in enumerate(starts)} or {None: 0}
+    width, height = max(1, len(column)), max(1, len(lightings))
+    fig, ax = plt.subplots(figsize=(min(1.0 * width + 1.6, 16), 1.0 * height + 1.2))
     cmap = plt.get_cmap("coolwarm")
-    for ax, row in zip(axes.flat, panels):
+    inner = 0.8  # share of a cell the unit square (FPR, recall) occupies
+    for row in cells:
+        x0 = column[row["max_radius"]] + (1 - inner) / 2
+        y0 = height - 1 - lightings.index(row["lighting"]) + (1 - inner) / 2
         fpr = [b["fpr"] for b in row["bubbles"]]
         recall = [b["recall"] for b in row["bubbles"]]
-        share = [b["frames"] / row["frames"] for b in row["bubbles"]]
-        badness = [(f + (1 - r)) / 2 for f, r in zip(fpr, recall)]
         ax.scatter(
-            fpr,
-            recall,
-            s=[2000 * s for s in share],
-            c=badness,
+            [x0 + inner * f for f in fpr],
+            [y0 + inner * r for r in recall],
+            s=[250 * b["frames"] / row["frames"] for b in row["bubbles"]],
+            c=[(f + (1 - r)) / 2 for f, r in zip(fpr, recall)],
             cmap=cmap,
             vmin=0,
             vmax=1,
@@ -52,30 +60,28 @@ def bubble_plot(rows: list[dict], path: Path) -> str:
             edgecolors="k",
             linewidths=0.3,
         )
-        ax.set_title(f"{row['lighting']} - r {row['max_radius']}", fontsize=9)
-        ax.text(
-            0.95,
-            0.05,
-            f"N = {row['frames']}",
-            color="grey",
-            ha="right",
-            transform=ax.transAxes,
-            fontsize=8,
-        )
-        ax.set_xlim(-0.1, 1.1)
-        ax.set_ylim(-0.1, 1.1)
-    for ax in list(axes.flat)[len(panels) :]:
-        ax.axis("off")
-    fig.supxlabel("false positive rate (1 - precision)")
-    fig.supylabel("recall")
+        ax.add_patch(plt.Rectangle((x0, y0), inner, inner, fill=False, lw=0.4, color="grey"))
+        ax.text(x0, y0 + inner + 0.01, f"N={row['frames']}", color="grey", fontsize=6)
+    ax.set_xticks([k + 0.5 for k in range(width)], [_radius_name(s) for s in column])
+    ax.set_yticks([height - 1 - k + 0.5 for k in range(height)], lightings)
+    ax.set_xlim(0, width)
+    ax.set_ylim(0, height)
+    ax.tick_params(length=0, labelsize=8)
+    ax.set_xlabel("max target radius (px); in each cell: recall up, false positive rate right")
     fig.tight_layout()
     return _save(fig, path)
+
+
+def _radius_name(start: int | None) -> str:
+    return "all" if start is None else radius_label(start)
 
 
 def category_bars(rows: list[dict], path: Path) -> str:
     """Per-category bars of mean recall, mean precision and hit-frame fraction."""
     labels = [
-        r["lighting"] if r["max_radius"] is None else f"{r['lighting']}-{r['max_radius']}"
+        r["lighting"]
+        if r["max_radius"] is None
+        else f"{r['lighting']}-{radius_label(r['max_radius'])}"
         for r in rows
     ]
     fig, ax = plt.subplots(figsize=(max(5, 0.6 * len(rows) + 2), 3.5))

@@ -14,19 +14,24 @@ from tsrkit.eval.perframe import FrameScore, FrameScoreMetric, summarise
 
 #: Lower bounds (percent) of the precision columns; Table 5-2 uses a subset of these 5 % steps.
 PRECISION_BOUNDS = tuple(range(0, 101, 5))
+#: Lower bounds of the max-radius rows. Zheng's Table 5-2 has one row per pixel of radius (2-9 px
+#: on 480x356 frames), kept up to 9 px; above, rows widen about 1.5x per step so that 1280x720 or
+#: larger frames (lens radii 2-40 px and more) give a handful of rows, not one per pixel.
+RADIUS_BIN_STARTS = (*range(10), 10, 14, 20, 30, 45, 70)
 
 
 def category_table(scores: Sequence[FrameScore]) -> list[dict]:
     """The Table 5-2 rows: ground-truth frames grouped by lighting, then by max target radius.
 
     Each lighting condition gets a total row (``max_radius`` None) followed by one row per
-    radius. A row holds the frame count, the counts per recall label and per precision lower
+    radius bin (:func:`radius_bin`; ``max_radius`` is the bin's lower bound, :func:`radius_label`
+    names it). A row holds the frame count, the counts per recall label and per precision lower
     bound, its summary means, and the Figure 5-1 bubbles (recall, FPR = 1 - precision, frames).
     """
     groups: dict[tuple[str, int], list[FrameScore]] = defaultdict(list)
     for s in scores:
         if s.n_gt:
-            groups[(s.lighting, s.max_radius)].append(s)
+            groups[(s.lighting, radius_bin(s.max_radius))].append(s)
     rows = []
     for lighting in sorted({key[0] for key in groups}):
         radii = sorted(r for (light, r) in groups if light == lighting)
@@ -54,6 +59,28 @@ def _row(lighting: str, radius: int | None, members: Sequence[FrameScore]) -> di
         "precision_counts": {f"{b}%": precision_counts[b] for b in sorted(precision_counts)},
         "bubbles": [{"recall": r, "fpr": f, "frames": n} for (r, f), n in sorted(bubbles.items())],
     }
+
+
+def radius_bin(radius: int) -> int:
+    """The lower bound of the :data:`RADIUS_BIN_STARTS` bin holding a max target radius.
+
+    >>> radius_bin(7), radius_bin(12), radius_bin(100)
+    (7, 10, 70)
+    """
+    return max(start for start in RADIUS_BIN_STARTS if start <= max(int(radius), 0))
+
+
+def radius_label(start: int) -> str:
+    """The row name of the radius bin starting at ``start``: ``"7"``, ``"10-13"``, ``">=70"``.
+
+    >>> [radius_label(start) for start in (7, 10, 45, 70)]
+    ['7', '10-13', '45-69', '>=70']
+    """
+    index = RADIUS_BIN_STARTS.index(start)
+    if index + 1 == len(RADIUS_BIN_STARTS):
+        return f">={start}"
+    end = RADIUS_BIN_STARTS[index + 1] - 1
+    return str(start) if end == start else f"{start}-{end}"
 
 
 def recall_sort_key(label: str) -> tuple[float, str]:
