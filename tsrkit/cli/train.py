@@ -13,7 +13,13 @@ from tsrkit.training import train
 @click.command("train")
 @click.argument("plugin")
 @click.option(
-    "--dataset", "dataset_ref", required=True, help="Registry name or path of the training data."
+    "--dataset",
+    "dataset_refs",
+    required=True,
+    multiple=True,
+    metavar="NAME[:SPLIT]",
+    help="Registry name or path of the training data, optionally with its split; repeatable "
+    "(the datasets are concatenated).",
 )
 @click.option(
     "--format", "format_name", default=None, help="Dataset format when a path is ambiguous."
@@ -24,7 +30,9 @@ from tsrkit.training import train
     type=click.Path(file_okay=False),
     help="Root that image paths inside the annotation file resolve against.",
 )
-@click.option("--split", default=None, help="Use only this split (e.g. train).")
+@click.option(
+    "--split", default=None, help="Use only this split (e.g. train) of datasets given without one."
+)
 @click.option(
     "--param",
     "-p",
@@ -46,10 +54,10 @@ from tsrkit.training import train
     help="Detector whose candidates a trainable verifier learns on (its parameters: "
     "-p detector.KEY=VALUE).",
 )
-def train_command(plugin, dataset_ref, format_name, images, split, params, out, detector) -> None:
+def train_command(plugin, dataset_refs, format_name, images, split, params, out, detector) -> None:
     """Fit PLUGIN (a trainable detector, verifier or classifier) and save the model for
     --param model=."""
-    from tsrkit.datasets import open_dataset
+    from tsrkit.datasets import open_datasets
 
     assignments = parse_assignments(params)
     detector_params = {
@@ -59,9 +67,7 @@ def train_command(plugin, dataset_ref, format_name, images, split, params, out, 
     if detector_params and not detector:
         raise click.UsageError("detector.KEY=VALUE parameters need --detector")
     det = get_registry().create("detector", detector, detector_params) if detector else None
-    dataset = open_dataset(dataset_ref, format=format_name, images=images)
-    if split:
-        dataset = dataset.split(split)
+    dataset = open_datasets(dataset_refs, split, format=format_name, images=images)
     path = train(plugin, dataset, out, own, det)
     Console(stderr=True).print(
         f"trained {plugin} on {len(dataset)} samples of {dataset.name} -> {path}"

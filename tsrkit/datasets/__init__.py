@@ -5,6 +5,7 @@
 >>> ds = open_dataset("path/to/coco.json", format="coco")   # doctest: +SKIP
 """
 
+from tsrkit.datasets.concat import concat_datasets, open_datasets, parse_reference
 from tsrkit.datasets.errors import DatasetError
 from tsrkit.datasets.manifest import Verification, verify_manifest
 from tsrkit.datasets.opening import (
@@ -23,10 +24,13 @@ __all__ = [
     "DatasetEntry",
     "DatasetError",
     "Verification",
+    "concat_datasets",
     "data_dir",
     "detect_format",
     "load_registry",
     "open_dataset",
+    "open_datasets",
+    "parse_reference",
     "read_dataset",
     "registry_path",
     "relabel",

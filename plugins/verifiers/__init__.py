@@ -1,0 +1,1 @@
+"""Built-in verifiers: stages that rescore or reject the candidates of any detector."""

@@ -1,0 +1,212 @@
+"""``verifier``: a learned stage that rescores or rejects the candidates of any detector.
+
+Beyond the three documents (issue 11): a gradient-boosted classifier (scikit-learn's
+``HistGradientBoostingClassifier``) reads features of each candidate and its housing
+(:mod:`features`: HOG, Lab/HSV statistics of lens, annulus, surround and housing, surround
+darkness, geometry, frame position, the detector's score) and gives the probability that the
+candidate is a lit traffic light. Candidates below ``threshold`` are dropped; the rest take the
+probability as their score. Trained by ``tsrkit train verifier --detector X`` on that detector's
+candidates labelled by Zheng's centre rule (5.2.1), with hard-negative mining (:mod:`mining`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+from sklearn.ensemble import HistGradientBoostingClassifier
+
+from tsrkit.hookspecs import hookimpl
+from tsrkit.models import Model, ModelError, load_model
+from tsrkit.params import Param
+from tsrkit.plugin import Detector, Verifier
+from tsrkit.registry import get_registry
+from tsrkit.types import Candidate, Frame, Sample
+from tsrkit_plugins.verifiers.features import candidate_features, feature_names, layout
+from tsrkit_plugins.verifiers.mining import Labelled, Stage, hard_negatives, labelled_candidates
+from tsrkit_plugins.verifiers.persistence import estimator_arrays, load_estimator
+
+DEFAULT_MODEL = Path(__file__).parent / "models" / "verifier_default"
+
+
+class LearnedVerifier(Verifier):
+    """Rescore candidates by a learned probability of being a lit light; drop the unlikely."""
+
+    name = "verifier"
+    summary = "learned candidate verifier: HOG, colour and housing features, gradient boosting"
+    section = "issue 11 (beyond the documents); labels by Zheng 5.2.1"
+    params = (
+        Param(
+            "model",
+            "path",
+            None,
+            help="trained model (tsrkit train verifier); default: the shipped model, trained "
+            "on openly licensed data only (see the README)",
+        ),
+        Param(
+            "threshold",
+            "float",
+            0.5,
+            min=0.0,
+            max=1.0,
+            help="candidates whose probability is below this are rejected",
+        ),
+        Param(
+            "train_after",
+            "str",
+            "",
+            help="training only: a verifier run on the detector's candidates before the "
+            "features are read (e.g. housing), as in the pipeline the model will serve",
+        ),
+        Param("iterations", "int", 150, min=10, max=2000, help="training: boosting iterations"),
+        Param("leaves", "int", 15, min=4, max=255, help="training: leaves per tree"),
+        Param("learning_rate", "float", 0.1, min=0.001, max=1.0, help="training: learning rate"),
+        Param(
+            "negative_ratio",
+            "float",
+            3.0,
+            min=0.5,
+            max=100.0,
+            help="training: negatives per positive in the first round (a seeded random draw)",
+        ),
+        Param(
+            "mining_rounds",
+            "int",
+            1,
+            min=0,
+            max=5,
+            help="training: rounds that add as many of the highest-scored remaining "
+            "negatives (hard negatives) and refit",
+        ),
+        Param(
+            "synthetic_frames",
+            "int",
+            30,
+            min=0,
+            max=10000,
+            help="training: synthetic 1280x720 scenes without a lit light, mined for negatives",
+        ),
+        Param("seed", "int", 0, min=0, help="training: seed of the negative draw and the trees"),
+    )
+
+    def __init__(self, **params):
+        super().__init__(**params)
+        self._estimator: HistGradientBoostingClassifier | None = None
+
+    @property
+    def estimator(self) -> HistGradientBoostingClassifier:
+        """The trained classifier, loaded on first use.
+
+        Raises
+        ------
+        tsrkit.models.ModelError
+            A missing, corrupt or foreign model, or one trained on another feature layout.
+        """
+        if self._estimator is None:
+            where = str(self.params["model"] or DEFAULT_MODEL)
+            model = load_model(where, plugin=self.name)
+            trained_on = model.info.get("layout")
+            if trained_on != layout():
+                version = trained_on.get("version") if isinstance(trained_on, dict) else None
+                raise ModelError(
+                    f"model {where}: trained on another feature layout (version {version!r}; "
+                    f"this verifier reads version {layout()['version']}); retrain it "
+                    "(tsrkit train verifier)"
+                )
+            self._estimator = load_estimator(model, where)
+        return self._estimator
+
+    def probabilities(self, frame: Frame, candidates: Sequence[Candidate]) -> np.ndarray:
+        """The probability that each candidate is a lit traffic light."""
+        if not candidates:
+            return np.zeros(0)
+        features = candidate_features(frame.image, candidates)
+        return self.estimator.predict_proba(features)[:, 1]
+
+    def verify(self, frame: Frame, candidates: Sequence[Candidate]) -> list[Candidate]:
+        probability = self.probabilities(frame, candidates)
+        kept = [
+            replace(c, score=float(p))
+            for c, p in zip(candidates, probability)
+            if p >= self.params["threshold"]
+        ]
+        return sorted(kept, key=lambda c: -c.score)
+
+    def _stage(self) -> Stage:
+        name = self.params["train_after"]
+        if not name:
+            return lambda frame, candidates: candidates
+        before = get_registry().create("verifier", name)
+        return lambda frame, candidates: before.verify(frame, candidates) if candidates else []
+
+    def fit(self, samples: Iterable[Sample], *, detector: Detector | None = None) -> Model:
+        """Learn to verify ``detector``'s candidates on ``samples`` (deterministic).
+
+        Every candidate is labelled by Zheng's centre rule; candidates of
+        ``synthetic_frames`` no-light scenes are negatives. The first round draws
+        ``negative_ratio`` negatives per positive (seeded); each mining round adds as many of
+        the remaining negatives the current model scores highest, and refits.
+
+        Raises
+        ------
+        ValueError
+            No detector, or no positive or no negative candidate to learn from.
+        """
+        if detector is None:
+            raise ValueError("verifier: fit needs the detector whose candidates it verifies")
+        data = labelled_candidates(
+            samples,
+            detector,
+            self._stage(),
+            candidate_features,
+            len(feature_names()),
+            self.params["synthetic_frames"],
+        )
+        positives = np.flatnonzero(data.labels == 1)
+        negatives = np.flatnonzero(data.labels == 0)
+        if not len(positives) or not len(negatives):
+            raise ValueError(
+                f"verifier: {len(positives)} positive and {len(negatives)} negative candidates; "
+                "need both (is the detector finding the annotated lights?)"
+            )
+        rng = np.random.default_rng(self.params["seed"])
+        step = int(round(self.params["negative_ratio"] * len(positives)))
+        chosen = np.sort(rng.permutation(negatives)[:step])
+        estimator = self._fit_once(data, np.concatenate([positives, chosen]))
+        for _ in range(self.params["mining_rounds"]):
+            rest = np.setdiff1d(negatives, chosen)
+            if not len(rest):
+                break
+            probability = estimator.predict_proba(data.features[rest])[:, 1]
+            hard = rest[hard_negatives(probability, np.zeros(len(rest)), step)]
+            chosen = np.union1d(chosen, hard)
+            estimator = self._fit_once(data, np.concatenate([positives, chosen]))
+        return Model(
+            arrays=estimator_arrays(estimator),
+            info={
+                "layout": layout(),
+                "positives": int(len(positives)),
+                "negatives": int(len(negatives)),
+                "negatives_used": int(len(chosen)),
+                "frames": int(data.frames.max() + 1) if len(data.frames) else 0,
+            },
+        )
+
+    def _fit_once(self, data: Labelled, rows: np.ndarray) -> HistGradientBoostingClassifier:
+        rows = np.sort(rows)
+        estimator = HistGradientBoostingClassifier(
+            max_iter=self.params["iterations"],
+            max_leaf_nodes=self.params["leaves"],
+            learning_rate=self.params["learning_rate"],
+            class_weight="balanced",
+            early_stopping=False,
+            random_state=self.params["seed"],
+        )
+        return estimator.fit(data.features[rows], data.labels[rows])
+
+
+@hookimpl
+def register_verifiers(register):
+    register(LearnedVerifier)

@@ -1,0 +1,125 @@
+"""Training data of the learned verifier: a detector's candidates labelled by Zheng's rule, and
+hard negatives.
+
+A candidate is positive when its centre lies in the minimum enclosing circle of a ground-truth
+box of its frame (Zheng 2016, 5.2.1, :func:`tsrkit.eval.matching.centre_hits`), negative
+otherwise. Negatives also come from synthetic road scenes without any lit light
+(:mod:`tsrkit.synth`: dark housings, lamps, headlights, windows).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Iterator, Sequence
+from dataclasses import dataclass
+from itertools import chain
+
+import numpy as np
+
+from tsrkit.eval.matching import centre_hits
+from tsrkit.plugin import Detector
+from tsrkit.synth import SynthOptions, render_frame
+from tsrkit.types import Candidate, Frame, Sample
+
+#: Candidates of one frame -> the candidates the verifier will see (e.g. after a housing stage).
+Stage = Callable[[Frame, list[Candidate]], list[Candidate]]
+#: Frame size of the synthetic no-light frames (a dash-cam's).
+SYNTH_SIZE = (1280, 720)
+SYNTH_SEED = 1011
+
+
+@dataclass
+class Labelled:
+    """Feature rows of candidates, their labels and the index of the frame they came from."""
+
+    features: np.ndarray
+    labels: np.ndarray
+    frames: np.ndarray
+
+    @classmethod
+    def concat(cls, parts: Sequence[Labelled], width: int) -> Labelled:
+        """All parts stacked (an empty set of ``width`` columns when there are none)."""
+        if not parts:
+            return cls(np.zeros((0, width), np.float32), np.zeros(0, np.int8), np.zeros(0, int))
+        return cls(
+            np.concatenate([p.features for p in parts]),
+            np.concatenate([p.labels for p in parts]),
+            np.concatenate([p.frames for p in parts]),
+        )
+
+
+def centre_labels(candidates: Sequence[Candidate], boxes: Sequence[Sequence[float]]) -> np.ndarray:
+    """1 for every candidate whose centre lies in a box's enclosing circle, else 0 (Zheng 5.2.1).
+
+    Examples
+    --------
+    >>> from tsrkit.types import Candidate
+    >>> c = [Candidate.from_circle(10, 10, 2, 1.0), Candidate.from_circle(40, 10, 2, 1.0)]
+    >>> centre_labels(c, [(6, 0, 14, 20)]).tolist()
+    [1, 0]
+    """
+    if not candidates:
+        return np.zeros(0, np.int8)
+    if not boxes:
+        return np.zeros(len(candidates), np.int8)
+    hits = centre_hits([(c.x, c.y) for c in candidates], boxes)
+    return hits.any(axis=1).astype(np.int8)
+
+
+def no_light_frames(count: int, seed: int = SYNTH_SEED) -> Iterator[Frame]:
+    """``count`` synthetic 1280x720 road scenes in which no light is lit.
+
+    Housings are drawn dark (``off_fraction`` near 1); a scene that still drew a lit light is
+    skipped, so the frames are a deterministic function of ``count`` and ``seed``.
+    """
+    options = SynthOptions(off_fraction=0.999)
+    index = 0
+    made = 0
+    while made < count:
+        image, annotations, condition = render_frame(index, seed, *SYNTH_SIZE, options)
+        index += 1
+        if annotations:
+            continue
+        made += 1
+        yield Frame(image, f"synth-no-light:{seed}:{index - 1}", metadata={"lighting": condition})
+
+
+def labelled_candidates(
+    samples: Iterable[Sample],
+    detector: Detector,
+    stage: Stage,
+    features: Callable[[np.ndarray, Sequence[Candidate]], np.ndarray],
+    width: int,
+    no_light: int,
+) -> Labelled:
+    """Run ``detector`` (then ``stage``) on every sample and on ``no_light`` synthetic frames;
+    return every candidate's features, its Zheng label and its frame index."""
+    parts = []
+    frames: Iterator[tuple[Frame, list[tuple[float, ...]]]] = (
+        (s.load(), [a.bbox for a in s.annotations]) for s in samples
+    )
+    synthetic = ((f, []) for f in no_light_frames(no_light))
+    for index, (frame, boxes) in enumerate(chain(frames, synthetic)):
+        candidates = stage(frame, detector.detect(frame))
+        if not candidates:
+            continue
+        parts.append(
+            Labelled(
+                features(frame.image, candidates),
+                centre_labels(candidates, boxes),
+                np.full(len(candidates), index),
+            )
+        )
+    return Labelled.concat(parts, width)
+
+
+def hard_negatives(probability: np.ndarray, labels: np.ndarray, count: int) -> np.ndarray:
+    """Indices of the ``count`` negatives scored most positive (ties: earlier first).
+
+    Examples
+    --------
+    >>> hard_negatives(np.array([0.9, 0.2, 0.8, 0.7]), np.array([1, 0, 0, 0]), 2).tolist()
+    [2, 3]
+    """
+    negatives = np.flatnonzero(labels == 0)
+    order = np.argsort(-probability[negatives], kind="stable")
+    return np.sort(negatives[order[:count]])
