@@ -30,7 +30,7 @@ HOUSING_PX = (12, 22)
 HOG_SHRINK = 2
 ORIENTATIONS = 9
 #: Version of the feature layout; a model trained on another layout is refused.
-FEATURE_VERSION = 1
+FEATURE_VERSION = 2
 
 COLOUR_NAMES = ("L", "a", "b", "S", "V", "hue_cos", "hue_sin", "chroma")
 RINGS = ("lens", "annulus", "surround")
@@ -90,28 +90,29 @@ def sample_boxes(
     return out.reshape(n, height, width, -1)
 
 
-def stacked_hog(patches: np.ndarray, rows: int) -> np.ndarray:
+def stacked_hog(lightness: np.ndarray, rows: int) -> np.ndarray:
     """Per-cell HOG (L1-normalised orientation histograms) of every patch in one
     ``skimage.feature.hog`` call.
 
-    ``patches`` is (N, H, W, 3) BGR with ``H`` and ``W`` even. Each is turned grey, shrunk by
-    ``HOG_SHRINK`` (the cost of HOG grows with the pixel count), framed by two black rows above
-    and below, and cut into ``rows`` full-width cells. The framed patches are stacked
-    vertically: the black rows keep every gradient, and so every cell, a function of its own
-    patch alone (the outer black row has no gradient, stacked or at the image border), and
-    with one-cell blocks no block straddles two patches.
+    ``lightness`` is (N, H, W), CIELab L of 8-bit Lab (0-255), ``H`` and ``W`` even. Each patch
+    is shrunk by ``HOG_SHRINK`` (the cost of HOG grows with the pixel count), framed by two
+    black rows above and below, and cut into ``rows`` full-width cells. The framed patches are
+    stacked vertically: the black rows keep every gradient, and so every cell, a function of
+    its own patch alone (the outer black row has no gradient, stacked or at the image border),
+    and with one-cell blocks no block straddles two patches.
     """
-    n, height, width = patches.shape[:3]
-    grey = cv2.cvtColor(patches.reshape(n * height, width, 3), cv2.COLOR_BGR2GRAY)
+    n, height, width = lightness.shape
     small = cv2.resize(
-        grey, (width // HOG_SHRINK, n * height // HOG_SHRINK), interpolation=cv2.INTER_AREA
+        np.ascontiguousarray(lightness.reshape(n * height, width), np.float32) / 255.0,
+        (width // HOG_SHRINK, n * height // HOG_SHRINK),
+        interpolation=cv2.INTER_AREA,
     ).reshape(n, height // HOG_SHRINK, width // HOG_SHRINK)
     framed = np.pad(small, ((0, 0), (2, 2), (0, 0)))
     cell_rows, remainder = divmod(framed.shape[1], rows)
     if remainder:
         raise ValueError(f"{framed.shape[1]} framed rows do not split into {rows} cells")
     blocks = hog(
-        framed.reshape(-1, framed.shape[2]).astype(np.float32) / 255.0,
+        framed.reshape(-1, framed.shape[2]),
         orientations=ORIENTATIONS,
         pixels_per_cell=(cell_rows, framed.shape[2]),
         cells_per_block=(1, 1),
@@ -121,33 +122,41 @@ def stacked_hog(patches: np.ndarray, rows: int) -> np.ndarray:
     return blocks.reshape(n, -1).astype(np.float32)
 
 
-def _colour_planes(bgr: np.ndarray) -> np.ndarray:
-    """Per-pixel L, a, b, S, V, saturation-weighted hue cosine and sine, chroma (float)."""
-    shape = bgr.shape
-    flat = bgr.reshape(-1, shape[-2], 3)
-    lab = cv2.cvtColor(flat, cv2.COLOR_BGR2LAB).reshape(shape).astype(np.float32)
-    hsv = cv2.cvtColor(flat, cv2.COLOR_BGR2HSV).reshape(shape).astype(np.float32)
-    angle = hsv[..., 0] * (np.pi / 90.0)
-    sat = hsv[..., 1] / 255.0
-    chroma = np.hypot(lab[..., 1] - 128, lab[..., 2] - 128)
-    return np.concatenate(
-        [lab, hsv[..., 1:], np.stack([np.cos(angle) * sat, np.sin(angle) * sat, chroma], -1)],
-        axis=-1,
-    )
+def colour_planes(*patches: np.ndarray) -> list[np.ndarray]:
+    """Per-pixel L, a, b, S, V, saturation-weighted hue cosine and sine, and chroma of each
+    BGR stack in ``patches`` (one Lab and one HSV conversion for all of them).
+
+    Returns
+    -------
+    list of ndarray
+        One float32 array per input, shaped like it with 8 channels (:data:`COLOUR_NAMES`).
+    """
+    flat = np.concatenate([p.reshape(-1, 1, 3) for p in patches])
+    lab = cv2.cvtColor(flat, cv2.COLOR_BGR2LAB)[:, 0].astype(np.float32)
+    hsv = cv2.cvtColor(flat, cv2.COLOR_BGR2HSV)[:, 0].astype(np.float32)
+    angle = hsv[:, 0] * (np.pi / 90.0)
+    sat = hsv[:, 1] / 255.0
+    chroma = np.hypot(lab[:, 1] - 128, lab[:, 2] - 128)
+    planes = np.column_stack([lab, hsv[:, 1:], np.cos(angle) * sat, np.sin(angle) * sat, chroma])
+    ends = np.cumsum([0] + [p.size // 3 for p in patches])
+    return [
+        planes[start:end].reshape(*p.shape[:-1], len(COLOUR_NAMES))
+        for p, start, end in zip(patches, ends[:-1], ends[1:])
+    ]
 
 
 def colour_features(lens: np.ndarray, housing: np.ndarray) -> np.ndarray:
     """Lab / HSV statistics of lens, annulus, surround and housing, and surround darkness.
 
-    ``lens`` is (N, 16, 16, 3) BGR, ``housing`` (N, 22, 12, 3) BGR. Hue enters as its cosine
-    and sine weighted by saturation, so red near 0 and 180 is one colour.
+    ``lens`` (N, 16, 16, 8) and ``housing`` (N, 22, 12, 8) are :func:`colour_planes` of the
+    samples. Hue enters as its cosine and sine weighted by saturation, so red near 0 and 180
+    is one colour.
     """
-    planes = _colour_planes(lens)
-    rings = [planes[:, m].mean(axis=1) for m in RING_MASKS]
-    lens_l = planes[..., 0][:, RING_MASKS[0]]
-    lens_v = planes[..., 4][:, RING_MASKS[0]]
+    rings = [lens[:, m].mean(axis=1) for m in RING_MASKS]
+    lens_l = lens[..., 0][:, RING_MASKS[0]]
+    lens_v = lens[..., 4][:, RING_MASKS[0]]
     peak = np.column_stack([lens_l.max(axis=1), lens_l.std(axis=1), (lens_v > 240).mean(axis=1)])
-    house = _colour_planes(housing).reshape(len(housing), -1, len(COLOUR_NAMES))
+    house = housing.reshape(len(housing), -1, len(COLOUR_NAMES))
     light = house[..., 0]
     house_stats = np.column_stack(
         [
@@ -218,9 +227,9 @@ def geometry_features(
 def candidate_features(image: np.ndarray, candidates: Sequence[Candidate]) -> np.ndarray:
     """The feature matrix, one row per candidate, of ``candidates`` on ``image`` (BGR uint8).
 
-    Columns (:func:`feature_names`): HOG of the lens context (one cell) and of the upright
-    housing (top, middle, bottom cells), colour statistics (:func:`colour_features`) and
-    geometry (:func:`geometry_features`).
+    Columns (:func:`feature_names`): HOG of the lightness (CIELab L) of the lens context (one
+    cell) and of the upright housing (top, middle, bottom cells), colour statistics
+    (:func:`colour_features`) and geometry (:func:`geometry_features`).
     """
     if image.ndim == 2:
         image = cv2.cvtColor(image, cv2.COLOR_GRAY2BGR)
@@ -228,13 +237,15 @@ def candidate_features(image: np.ndarray, candidates: Sequence[Candidate]) -> np
         return np.zeros((0, len(feature_names())), np.float32)
     lens_boxes = np.array([lens_context_box(c) for c in candidates], np.float32)
     house_boxes = np.array([housing_box(c) for c in candidates], np.float32)
-    lens = sample_boxes(image, lens_boxes, (LENS_PX, LENS_PX))
-    housing = sample_boxes(image, house_boxes, HOUSING_PX, upright=True)
+    lens, housing = colour_planes(
+        sample_boxes(image, lens_boxes, (LENS_PX, LENS_PX)),
+        sample_boxes(image, house_boxes, HOUSING_PX, upright=True),
+    )
     height, width = image.shape[:2]
     return np.column_stack(
         [
-            stacked_hog(lens, 1),
-            stacked_hog(housing, 3),
+            stacked_hog(lens[..., 0], 1),
+            stacked_hog(housing[..., 0], 3),
             colour_features(lens, housing),
             geometry_features(candidates, house_boxes, width, height),
         ]

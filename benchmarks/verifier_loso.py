@@ -1,0 +1,242 @@
+"""Leave-one-dataset-out evaluation of the learned verifier on the real detection sets.
+
+For each of KR, cinTA and DTLD: train the ``verifier`` on the other sets' training splits (plus
+synthetic no-light scenes), test the pipeline (candidate detector [+ housing stage] + verifier)
+on the left-out set's test split; also in-domain (trained on the set's own training split).
+Beside it, every paper detector alone, and the best of them. Figures: housing AP50 (lens AP50
+on KR, whose boxes are mostly lenses), Zheng 5.2.1 per-frame recall / precision / hit-frame
+fraction, false positives per frame (exhaustive sets only) and on synthetic no-light frames,
+candidate recall per light size.
+
+Run: python benchmarks/verifier_loso.py [--detector conspicuity] [-p detector.KEY=V]
+         [--housing housing] [--no-light 30] [--out benchmarks/out/verifier_loso]
+"""
+
+from __future__ import annotations
+
+import os
+
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ[_var] = "1"
+
+import argparse  # noqa: E402
+import json  # noqa: E402
+import time  # noqa: E402
+from dataclasses import dataclass  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import cv2  # noqa: E402
+import numpy as np  # noqa: E402
+
+from tsrkit.benchmarking import run_benchmark  # noqa: E402
+from tsrkit.datasets import open_datasets  # noqa: E402
+from tsrkit.eval.perframe import score_frame  # noqa: E402
+from tsrkit.params import parse_assignments  # noqa: E402
+from tsrkit.plugin import Detector, Verifier  # noqa: E402
+from tsrkit.registry import get_registry  # noqa: E402
+from tsrkit.training import train  # noqa: E402
+from tsrkit.types import Dataset, Sample  # noqa: E402
+from tsrkit_plugins.verifiers.mining import no_light_frames  # noqa: E402
+
+cv2.setNumThreads(1)
+
+PAPER = ("conspicuity", "gray-tophat", "lab-frst", "tl-recognizer", "adaboost-hsv")
+
+
+@dataclass(frozen=True)
+class RealSet:
+    """A detection set: registry name, training and test splits, evaluated box, exhaustive."""
+
+    key: str
+    name: str
+    train: str
+    test: str
+    box: str
+    exhaustive: bool
+
+
+SETS = (
+    # The Roboflow sets ship test + valid only (their train splits are augmented copies):
+    # valid is the training split here.
+    RealSet("KR", "roboflow_traffic_light_kr", "valid", "test", "lens", True),
+    RealSet("cinTA", "roboflow_cinta_v2_id", "valid", "test", "housing", True),
+    RealSet("DTLD", "dtld_fridtjofs", "train", "test", "housing", False),
+)
+SIZE_BINS = ((0, 3), (3, 6), (6, 12), (12, 1e9))
+THRESHOLDS = (0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9)
+
+
+class Memo(Detector):
+    """A detector whose candidates are computed once per image (the folds share frames)."""
+
+    def __init__(self, inner: Detector):
+        super().__init__(**inner.params)
+        self.inner = inner
+        self.name = inner.name  # type: ignore[misc]
+        self._seen: dict[str, list] = {}
+
+    def detect(self, frame):
+        key = f"{frame.source}#{frame.index}"
+        if key not in self._seen:
+            self._seen[key] = self.inner.detect(frame)
+        return self._seen[key]
+
+
+class Chain(Verifier):
+    """Verifiers applied in turn (the housing stage, then the learned verifier)."""
+
+    name = "chain"
+
+    def __init__(self, stages):
+        super().__init__()
+        self.stages = stages
+
+    def verify(self, frame, candidates):
+        for stage in self.stages:
+            candidates = stage.verify(frame, candidates) if candidates else []
+        return candidates
+
+
+def no_light_dataset(count: int) -> Dataset:
+    """Synthetic 1280x720 scenes without a lit light (another seed than training's)."""
+    samples = tuple(
+        Sample(f.source, (), f.width, f.height, "test", image=f.image)
+        for f in no_light_frames(count, seed=2024)
+    )
+    return Dataset("synthetic-no-light", samples, info={"box": "housing"})
+
+
+def evaluate(dataset, detector, verifier, box, thresholds=(0.0,)):
+    """One run (verifier threshold 0); Zheng figures recomputed at every score threshold."""
+    run = run_benchmark(dataset, detector, verifier=verifier, cache=False, box=box)
+    ap = run.report["iou50"]["ap"]
+    pairs = list(run.pairs())
+    rows = {}
+    for t in thresholds:
+        scores = []
+        for sample, record in pairs:
+            points = [(d.x, d.y) for d in record.detections if d.score >= t]
+            scores.append(score_frame(points, [a.bbox for a in sample.annotations]))
+        gt = [s for s in scores if s.n_gt]
+        with_det = [s for s in gt if s.n_det]
+        fps = [s.n_det - s.det_tp for s in scores]
+        rows[t] = {
+            "recall": float(np.mean([s.recall for s in gt])) if gt else None,
+            "precision": float(np.mean([s.precision for s in with_det])) if with_det else None,
+            "hit": float(np.mean([s.gt_hit > 0 for s in gt])) if gt else None,
+            "fp_per_frame": float(np.mean(fps)) if fps else None,
+            "det_per_frame": float(np.mean([s.n_det for s in scores])) if scores else None,
+        }
+    return ap, rows, pairs
+
+
+def candidate_recall(pairs) -> dict[str, float | None]:
+    """Share of annotated lights with a candidate centre in their circle, per lens radius."""
+    hit = {b: [0, 0] for b in SIZE_BINS}
+    total = [0, 0]
+    for sample, record in pairs:
+        boxes = [a.bbox for a in sample.annotations]
+        if not boxes:
+            continue
+        from tsrkit.eval.matching import centre_hits
+
+        points = [(d.x, d.y) for d in record.detections]
+        found = centre_hits(points, boxes).any(axis=0) if points else np.zeros(len(boxes), bool)
+        for box, ok in zip(boxes, found):
+            r = min(box[2] - box[0], box[3] - box[1]) / 2
+            for b in SIZE_BINS:
+                if b[0] <= r < b[1]:
+                    hit[b][0] += int(ok)
+                    hit[b][1] += 1
+            total[0] += int(ok)
+            total[1] += 1
+    out = {"all": total[0] / total[1] if total[1] else None, "n": total[1]}
+    for b, (k, n) in hit.items():
+        label = (
+            f"r<{b[1]:g}" if b[0] == 0 else (f"r>={b[0]:g}" if b[1] > 1e8 else f"{b[0]:g}-{b[1]:g}")
+        )
+        out[label] = (k / n if n else None, n)
+    return out
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--detector", default="conspicuity")
+    parser.add_argument(
+        "-p", "--param", action="append", default=[], help="detector.KEY=V / verifier.KEY=V"
+    )
+    parser.add_argument("--housing", default="", help="housing verifier run before the verifier")
+    parser.add_argument("--no-light", type=int, default=30, help="synthetic no-light test frames")
+    parser.add_argument("--out", default="benchmarks/out/verifier_loso")
+    parser.add_argument("--skip-paper", action="store_true", help="no paper-detector baselines")
+    args = parser.parse_args()
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    reg = get_registry()
+    assigned = parse_assignments(args.param)
+    det_params = {k[9:]: v for k, v in assigned.items() if k.startswith("detector.")}
+    ver_params = {k[9:]: v for k, v in assigned.items() if k.startswith("verifier.")}
+    if args.housing:
+        ver_params["train_after"] = args.housing
+    detector = Memo(reg.create("detector", args.detector, det_params))
+    housing = [reg.create("verifier", args.housing)] if args.housing else []
+    tests = {s.key: open_datasets([f"{s.name}:{s.test}"]) for s in SETS}
+    nolight = no_light_dataset(args.no_light)
+    started = time.perf_counter()
+    results: dict = {"detector": args.detector, "params": args.param, "housing": args.housing}
+
+    if not args.skip_paper:
+        paper: dict = {}
+        for s in SETS:
+            for name in PAPER:
+                det = Memo(reg.create("detector", name))
+                ap, rows, _ = evaluate(tests[s.key], det, None, s.box)
+                _, nl, _ = evaluate(nolight, det, None, "housing")
+                paper.setdefault(s.key, {})[name] = {
+                    **rows[0.0],
+                    "ap50": ap,
+                    "nolight_fp": nl[0.0]["fp_per_frame"],
+                }
+                print(s.key, name, paper[s.key][name], flush=True)
+        results["paper"] = paper
+
+    folds: dict = {}
+    for s in SETS:
+        others = [f"{o.name}:{o.train}" for o in SETS if o.key != s.key]
+        for mode, refs in (("loso", others), ("in-domain", [f"{s.name}:{s.train}"])):
+            model = out / f"verifier_{mode}_{s.key}"
+            t0 = time.perf_counter()
+            train("verifier", open_datasets(refs), model, ver_params, detector)
+            fit_s = time.perf_counter() - t0
+            verifier = reg.create("verifier", "verifier", {"model": str(model), "threshold": 0.0})
+            chain = Chain([*housing, verifier])
+            ap, rows, pairs = evaluate(tests[s.key], detector, chain, s.box, THRESHOLDS)
+            _, nl, _ = evaluate(nolight, detector, chain, "housing", THRESHOLDS)
+            folds.setdefault(s.key, {})[mode] = {
+                "train": refs,
+                "fit_seconds": round(fit_s, 1),
+                "ap50": ap,
+                "by_threshold": {
+                    str(t): {**rows[t], "nolight_fp": nl[t]["fp_per_frame"]} for t in THRESHOLDS
+                },
+            }
+            print(s.key, mode, json.dumps(folds[s.key][mode])[:400], flush=True)
+        ap, rows, pairs = evaluate(
+            tests[s.key], detector, Chain(housing) if housing else None, s.box
+        )
+        _, nl, _ = evaluate(nolight, detector, Chain(housing) if housing else None, "housing")
+        folds[s.key]["candidates"] = {
+            **rows[0.0],
+            "ap50": ap,
+            "nolight_fp": nl[0.0]["fp_per_frame"],
+            "candidate_recall": candidate_recall(pairs),
+        }
+        print(s.key, "candidates", folds[s.key]["candidates"], flush=True)
+    results["folds"] = folds
+    results["seconds"] = round(time.perf_counter() - started, 1)
+    (out / "results.json").write_text(json.dumps(results, indent=1))
+    print(f"wrote {out / 'results.json'} in {results['seconds']} s")
+
+
+if __name__ == "__main__":
+    main()
