@@ -214,7 +214,8 @@ def parse_assignments(items: Iterable[str]) -> dict[str, str]:
 
 
 def load_config(path: str | os.PathLike) -> dict[str, Any]:
-    """Read a YAML run configuration.
+    """Read a YAML run configuration: a file, or the name of a shipped preset
+    (:mod:`tsrkit.presets`).
 
     The file is a mapping whose optional keys ``detector``, ``classifier`` and ``tracker`` are
     each either a plugin name or ``{"name": ..., "params": {...}}``; other keys are kept.
@@ -224,6 +225,9 @@ def load_config(path: str | os.PathLike) -> dict[str, Any]:
     ParamError
         When the file cannot be read or does not have that shape.
     """
+    from tsrkit.presets import resolve_config
+
+    path = resolve_config(path)
     try:
         with open(path, encoding="utf-8") as fh:
             data = yaml.safe_load(fh) or {}

@@ -12,6 +12,7 @@ def register_commands(cli):
     from tsrkit.cli.datasets import datasets_group
     from tsrkit.cli.detect import detect_command
     from tsrkit.cli.plugins_cmd import plugins_command
+    from tsrkit.cli.presets_cmd import presets_command
     from tsrkit.cli.train import train_command
 
     for command in (
@@ -21,5 +22,6 @@ def register_commands(cli):
         datasets_group,
         benchmark_command,
         compare_command,
+        presets_command,
     ):
         cli.add_command(command)

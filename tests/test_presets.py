@@ -1,0 +1,51 @@
+"""Presets: named run configurations shipped in the package (--config NAME, tsrkit presets)."""
+
+from __future__ import annotations
+
+import pytest
+from click.testing import CliRunner
+
+import tsrkit
+from tsrkit.cli.main import cli
+from tsrkit.errors import TsrkitError
+from tsrkit.params import load_config
+from tsrkit.presets import describe, preset_names, preset_path, resolve_config
+
+
+def test_every_preset_loads_and_names_installed_plugins():
+    assert "recommended" in preset_names()
+    for name in preset_names():
+        chosen = tsrkit.select(config=name)
+        assert chosen.detector is not None
+        assert describe(name)
+
+
+def test_recommended_runs_the_learned_verifier_and_a_state_classifier():
+    chosen = tsrkit.select(config="recommended")
+    assert chosen.verifier is not None and chosen.verifier.name == "verifier"
+    assert chosen.classifier is not None
+    # the command line overrides the preset, as with any config file
+    assert tsrkit.select(detector="gray-tophat", config="recommended").detector.name == (
+        "gray-tophat"
+    )
+
+
+def test_files_win_over_preset_names_and_unknown_names_are_one_error(tmp_path, monkeypatch):
+    mine = tmp_path / "recommended"
+    mine.write_text("detector: gray-tophat\n")
+    assert resolve_config(mine) == mine
+    monkeypatch.chdir(tmp_path)
+    assert load_config("recommended")["detector"]["name"] == "gray-tophat"
+    assert resolve_config("missing.yaml").name == "missing.yaml"  # a file name stays a file
+    with pytest.raises(TsrkitError, match=r"presets: .*recommended"):
+        preset_path("nope")
+    result = CliRunner().invoke(cli, ["benchmark", "--config", "nope", "-q"])
+    assert result.exit_code == 2 and "no preset called 'nope'" in result.output
+
+
+def test_presets_command_lists_and_shows():
+    listed = CliRunner().invoke(cli, ["presets"])
+    assert listed.exit_code == 0 and "recommended" in listed.output
+    shown = CliRunner().invoke(cli, ["presets", "--show", "recommended"])
+    assert shown.exit_code == 0
+    assert shown.output == preset_path("recommended").read_text(encoding="utf-8")

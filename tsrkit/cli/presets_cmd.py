@@ -1,0 +1,24 @@
+"""``tsrkit presets``: the named run configurations shipped with tsrkit (``--config NAME``)."""
+
+from __future__ import annotations
+
+import click
+from rich.console import Console
+from rich.table import Table
+
+from tsrkit.presets import describe, preset_names, preset_path
+
+
+@click.command("presets")
+@click.option("--show", "show", default=None, metavar="NAME", help="Print the preset's YAML.")
+def presets_command(show: str | None) -> None:
+    """List the shipped presets; use one with --config NAME on detect, benchmark or compare."""
+    if show is not None:
+        click.echo(preset_path(show).read_text(encoding="utf-8"), nl=False)
+        return
+    table = Table(title="tsrkit presets (--config NAME)")
+    table.add_column("name")
+    table.add_column("description")
+    for name in preset_names():
+        table.add_row(name, describe(name))
+    Console().print(table)
