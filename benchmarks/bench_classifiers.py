@@ -1,7 +1,7 @@
 """Accuracy, per-class recall, confusion and single-thread speed of the state classifiers
 (ab-hist, hsi-backprojection) on the real sets, each trained on udacity_mit_tl_crops train.
 
-Run: /work/venv/bin/python benchmarks/bench_classifiers.py [--repeats 5]
+Run: python benchmarks/bench_classifiers.py [--repeats 5]
 """
 
 from __future__ import annotations

@@ -2,7 +2,7 @@
 
 Frames are the Korean Roboflow scenes resized to each size. Also times the fast FRST against the
 loop oracle of tests/oracles on the same feature maps (one frame) and checks they agree.
-Run: /work/venv/bin/python benchmarks/bench_lab_frst.py [--frames N] [--repeats R]
+Run: python benchmarks/bench_lab_frst.py [--frames N] [--repeats R]
 """
 
 from __future__ import annotations

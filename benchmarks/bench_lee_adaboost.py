@@ -7,7 +7,7 @@
    (roboflow_cinta_v2_id) only; ranks by the F1 of Zheng's per-frame recall and precision.
 3. ms per 1280x720 frame on one thread (three-colour table vs. evaluating the stumps).
 
-    /work/venv/bin/python benchmarks/bench_lee_adaboost.py
+    python benchmarks/bench_lee_adaboost.py
 """
 
 from __future__ import annotations

@@ -5,7 +5,7 @@ over the 2,046 crops (43 classes, up to 50 each); the crop is the GTSRB ROI box.
 log-polar features with plain pixels (same PCA + SVM), unrotated and with the test crops
 rotated by +-10 deg about the ROI centre, and measures classified crops per second.
 
-    /work/venv/bin/python benchmarks/bench_lee_classify.py
+    python benchmarks/bench_lee_classify.py
 """
 
 from __future__ import annotations

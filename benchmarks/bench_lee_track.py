@@ -6,7 +6,7 @@ orange on other renders, then runs ``Pipeline(detector)`` and ``Pipeline(detecto
 tracker=meanshift)`` over the decoded video. Prints per frame the centre error and PASCAL
 overlap, and Lee's summary: frames localised at overlap > 0.65, area precision / recall.
 
-    /work/venv/bin/python benchmarks/bench_lee_track.py
+    python benchmarks/bench_lee_track.py
 """
 
 from __future__ import annotations

@@ -4,7 +4,7 @@ Each run is a child process (``--child N``) benchmarking the first N frames of o
 synthetic set with gray-tophat, 2 worker processes, no cache; the parent samples the summed RSS
 of the child and all its descendants (the pool workers) every 20 ms and keeps the peak.
 
-    /work/venv/bin/python benchmarks/memory_benchmark.py [--repeats 3] [--data DIR]
+    python benchmarks/memory_benchmark.py [--repeats 3] [--data DIR]
 """
 
 from __future__ import annotations

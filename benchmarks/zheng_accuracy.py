@@ -4,7 +4,7 @@ Compares the three detectors with ``tsrkit.comparison.compare`` on two real sets
 ones, again with the radius range scaled to each real set's lens sizes, then evaluates a grid of
 conspicuity weights (w_L, w_LC, w_S), chosen per lighting class on one split and reported on the
 other (the 5.2.3 tuning rules). Prints Markdown tables; every run's outputs go under OUT.
-Run: /work/venv/bin/python benchmarks/zheng_accuracy.py [OUT] [--workers 2] [--synth PATH]
+Run: python benchmarks/zheng_accuracy.py [OUT] [--workers 2] [--synth PATH]
 """
 
 from __future__ import annotations

@@ -19,7 +19,7 @@ from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 from tsrkit.atomic import atomic_open
 from tsrkit.errors import TsrkitError
@@ -32,6 +32,8 @@ from tsrkit.registry import PluginNotFound, get_registry
 from tsrkit.types import Candidate, Frame, Sample
 
 ENGINES = ("local", "dask")
+Item = TypeVar("Item")
+Result = TypeVar("Result")
 
 
 class BenchmarkError(TsrkitError):
@@ -141,18 +143,20 @@ _WORKER_JOB: Job | None = None
 def _init_worker(job: Job) -> None:
     global _WORKER_JOB
     _WORKER_JOB = job
-    _single_thread()
+    single_thread()
 
 
-def _single_thread() -> None:
+def single_thread() -> None:
+    """One OpenCV thread per worker process: the workers are the parallelism."""
     import cv2
 
     cv2.setNumThreads(1)
 
 
-def _pool_context():
-    """Workers from a fork server: forking a process whose OpenCV thread pool has started can
-    crash the child, so children fork from a clean server that preloads the runner."""
+def pool_context():
+    """The multiprocessing context of every worker pool: workers fork from a clean fork server
+    that preloads the engine, because forking a process whose OpenCV thread pool has started
+    can crash the child."""
     context = multiprocessing.get_context("forkserver")
     context.set_forkserver_preload(["tsrkit.engine"])
     return context
@@ -164,15 +168,15 @@ def _run_in_worker(index: int, sample: Sample) -> FrameRecord:
 
 
 def ordered(
-    submit: Callable[[int, Sample], Any],
-    result: Callable[[Any], FrameRecord],
-    samples: Iterable[Sample],
+    submit: Callable[[int, Item], Any],
+    result: Callable[[Any], Result],
+    items: Iterable[Item],
     window: int,
-) -> Iterator[FrameRecord]:
-    """Submit tasks with at most ``window`` in flight; yield their results in dataset order."""
+) -> Iterator[Result]:
+    """Submit tasks with at most ``window`` in flight; yield their results in input order."""
     pending: deque = deque()
-    for index, sample in enumerate(samples):
-        pending.append(submit(index, sample))
+    for index, item in enumerate(items):
+        pending.append(submit(index, item))
         if len(pending) >= window:
             yield result(pending.popleft())
     while pending:
@@ -197,7 +201,7 @@ def run_records(
         yield from (process_sample(i, s, job) for i, s in enumerate(samples))
     else:
         with ProcessPoolExecutor(
-            workers, mp_context=_pool_context(), initializer=_init_worker, initargs=(job,)
+            workers, mp_context=pool_context(), initializer=_init_worker, initargs=(job,)
         ) as pool:
             yield from ordered(
                 lambda i, s: pool.submit(_run_in_worker, i, s),

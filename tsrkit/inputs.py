@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Iterable, Iterator
+from dataclasses import dataclass
 from pathlib import Path
 
 import cv2
@@ -69,6 +70,59 @@ def expand_paths(paths: Iterable[str | os.PathLike]) -> Iterator[Path | Skipped]
             yield Skipped(str(path), "no such file or folder")
 
 
+@dataclass(frozen=True)
+class Work:
+    """A unit of input one reader handles: an image file, or a run of a video's frames."""
+
+    path: str
+    video: bool = False
+    start: int = 0
+    end: int | None = None
+
+
+def plan_work(
+    paths: Iterable[str | os.PathLike],
+    every: int = 1,
+    start: int = 0,
+    end: int | None = None,
+    chunk: int | None = None,
+) -> Iterator[Work | Skipped]:
+    """The units of work of ``paths``: one per image, one per video or, with ``chunk``, one per
+    ``chunk`` kept frames of a video whose container declares its frame count (so that workers
+    each decode their own part); unusable paths as :class:`Skipped`."""
+    if every < 1 or start < 0 or (end is not None and end < start):
+        raise ValueError("need every >= 1, start >= 0 and end >= start")
+    for item in expand_paths(paths):
+        if isinstance(item, Skipped):
+            yield item
+            continue
+        suffix = item.suffix.lower()
+        if suffix in VIDEO_EXTENSIONS:
+            count = video_frame_count(item) if chunk else 0
+            if not count:
+                yield Work(str(item), True, start, end)
+                continue
+            stop = count if end is None else min(end, count)
+            step = chunk * every if chunk else stop
+            for first in range(start, max(stop, start + 1), step):
+                yield Work(str(item), True, first, min(first + step, stop))
+        elif suffix in IMAGE_EXTENSIONS:
+            yield Work(str(item))
+        else:
+            yield Skipped(str(item), f"not an image or video (unsupported type '{suffix}')")
+
+
+def read_work(work: Work, every: int = 1) -> Iterator[Frame | Skipped]:
+    """The frames of one unit of :func:`plan_work` (videos: every ``every``-th frame)."""
+    if work.video:
+        yield from iter_video(Path(work.path), every, work.start, work.end)
+        return
+    try:
+        yield Frame(image=read_image(work.path), source=work.path)
+    except ImageReadError as exc:
+        yield Skipped(work.path, str(exc).removeprefix(f"{work.path}: "))
+
+
 def iter_frames(
     paths: Iterable[str | os.PathLike], every: int = 1, start: int = 0, end: int | None = None
 ) -> Iterator[Frame | Skipped]:
@@ -83,22 +137,11 @@ def iter_frames(
     start, end : int
         Video frame numbers: the first kept and the one to stop before (None: to the end).
     """
-    if every < 1 or start < 0 or (end is not None and end < start):
-        raise ValueError("need every >= 1, start >= 0 and end >= start")
-    for item in expand_paths(paths):
-        if isinstance(item, Skipped):
-            yield item
-            continue
-        suffix = item.suffix.lower()
-        if suffix in VIDEO_EXTENSIONS:
-            yield from iter_video(item, every, start, end)
-        elif suffix in IMAGE_EXTENSIONS:
-            try:
-                yield Frame(image=read_image(item), source=str(item))
-            except ImageReadError as exc:
-                yield Skipped(str(item), str(exc).removeprefix(f"{item}: "))
+    for work in plan_work(paths, every, start, end):
+        if isinstance(work, Skipped):
+            yield work
         else:
-            yield Skipped(str(item), f"not an image or video (unsupported type '{suffix}')")
+            yield from read_work(work, every)
 
 
 def iter_video(
@@ -111,7 +154,7 @@ def iter_video(
             yield Skipped(str(path), "cannot open video")
             return
         fps = capture.get(cv2.CAP_PROP_FPS) or 0.0
-        index = 0
+        index = _seek(capture, start)
         decoded = 0
         while end is None or index < end:
             wanted = index >= start and (index - start) % every == 0
@@ -130,5 +173,28 @@ def iter_video(
             index += 1
         if decoded == 0 and index <= start:
             yield Skipped(str(path), "no frames decoded (empty or unreadable video)")
+    finally:
+        capture.release()
+
+
+def _seek(capture: cv2.VideoCapture, start: int) -> int:
+    """Jump to frame ``start`` when the backend can (FFmpeg seeks to the key frame before it and
+    decodes forward); returns the index of the next frame to grab: ``start``, or 0 when the
+    backend cannot seek and the frames before ``start`` are grabbed and dropped instead."""
+    if start <= 0 or int(capture.get(cv2.CAP_PROP_FRAME_COUNT) or 0) <= start:
+        return 0
+    if capture.set(cv2.CAP_PROP_POS_FRAMES, start) and (
+        int(capture.get(cv2.CAP_PROP_POS_FRAMES)) == start
+    ):
+        return start
+    capture.set(cv2.CAP_PROP_POS_FRAMES, 0)
+    return 0
+
+
+def video_frame_count(path: str | os.PathLike) -> int:
+    """The frame count a video's container declares (0 when it declares none)."""
+    capture = cv2.VideoCapture(str(path), cv2.CAP_FFMPEG)
+    try:
+        return int(capture.get(cv2.CAP_PROP_FRAME_COUNT) or 0) if capture.isOpened() else 0
     finally:
         capture.release()

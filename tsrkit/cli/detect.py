@@ -15,9 +15,9 @@ from tsrkit.atomic import atomic_open
 from tsrkit.cli.common import plugin_options
 from tsrkit.draw import draw_detections
 from tsrkit.errors import TsrkitError
-from tsrkit.inputs import iter_frames
 from tsrkit.pipeline import Pipeline
 from tsrkit.selection import build
+from tsrkit.streams import run_pipeline
 from tsrkit.types import Frame, Skipped
 
 
@@ -29,39 +29,34 @@ def run_detect(
     every: int = 1,
     start: int = 0,
     end: int | None = None,
+    workers: int = 1,
 ) -> tuple[int, int, list[Skipped]]:
-    """Write one JSON Lines record per frame to the text stream ``out``.
+    """Write one JSON Lines record per frame to the text stream ``out``, in input order.
 
     A frame on which a plugin crashes is reported as skipped and the run goes on; a
     :class:`TsrkitError` from a plugin (a setup problem such as a mismatched model) stops it.
+    ``workers`` > 1 runs the pipeline in worker processes (:func:`tsrkit.streams.run_pipeline`);
+    overlays (``draw``) need the frames here, so they need one worker.
 
     Returns
     -------
     frames, detections, skipped
     """
+    if draw is not None and workers > 1:
+        raise TsrkitError("--draw needs the frames in this process: use it with --workers 1")
     frames = detections = 0
     skipped: list[Skipped] = []
-    for item in iter_frames(paths, every=every, start=start, end=end):
-        if isinstance(item, Skipped):
-            skipped.append(item)
-            continue
-        try:
-            result = pipeline.process(item)
-        except TsrkitError:  # a setup problem (missing model...) would recur on every frame
-            raise
-        except Exception as exc:  # a crashing plugin costs one frame, not the run
-            skipped.append(Skipped(_label(item), f"plugin error: {type(exc).__name__}: {exc}"))
+    stream = run_pipeline(pipeline, paths, every=every, start=start, end=end, workers=workers)
+    for result, frame in stream:
+        if isinstance(result, Skipped):
+            skipped.append(result)
             continue
         out.write(json.dumps(result.to_record()) + "\n")
         frames += 1
         detections += len(result.detections)
-        if draw is not None:
-            _write_overlay(draw, item, frames, result.detections)
+        if draw is not None and frame is not None:
+            _write_overlay(draw, frame, frames, result.detections)
     return frames, detections, skipped
-
-
-def _label(frame: Frame) -> str:
-    return f"{frame.source}#{frame.index}" if frame.index else frame.source
 
 
 def _write_overlay(folder: Path, frame: Frame, number: int, detections) -> None:
@@ -100,8 +95,27 @@ def default_inputs() -> list[str]:
 @click.option("--every", type=click.IntRange(min=1), default=1, help="Keep every N-th frame.")
 @click.option("--start", type=click.IntRange(min=0), default=0, help="First video frame.")
 @click.option("--end", type=click.IntRange(min=0), default=None, help="Video frame to stop before.")
+@click.option(
+    "--workers",
+    "-w",
+    type=click.IntRange(min=1),
+    default=1,
+    help="Worker processes; each decodes its own images or 64-frame video chunks.",
+)
 def detect_command(
-    paths, detector, verifier, classifier, tracker, params, config, out, draw, every, start, end
+    paths,
+    detector,
+    verifier,
+    classifier,
+    tracker,
+    params,
+    config,
+    out,
+    draw,
+    every,
+    start,
+    end,
+    workers,
 ) -> None:
     """Detect lit signal lenses in images, folders (recursive) or videos.
 
@@ -115,7 +129,9 @@ def detect_command(
         draw_dir.mkdir(parents=True, exist_ok=True)
     sink = atomic_open(out) if out else nullcontext(sys.stdout)
     with sink as stream:
-        frames, found, skipped = run_detect(pipeline, inputs, stream, draw_dir, every, start, end)
+        frames, found, skipped = run_detect(
+            pipeline, inputs, stream, draw_dir, every, start, end, workers
+        )
     console = Console(stderr=True)
     console.print(
         f"[bold]{frames}[/bold] frames, [bold]{found}[/bold] detections, "

@@ -1,0 +1,104 @@
+"""A pipeline over images and videos, in this process or in worker processes, in input order.
+
+With workers, each unit of :func:`tsrkit.inputs.plan_work` (an image, or a chunk of
+:data:`CHUNK_FRAMES` kept frames of a video) is read by the worker that processes it: the worker
+opens the video, seeks to the chunk's first frame and decodes only its chunk, so the main process
+neither decodes nor ships pixels. At most ``4 x workers`` units are in flight
+(:func:`tsrkit.engine.ordered`) and results come back in input order, so memory stays flat
+however long the video.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterable, Iterator
+from concurrent.futures import ProcessPoolExecutor
+
+from tsrkit.engine import ordered, pool_context, single_thread
+from tsrkit.errors import TsrkitError
+from tsrkit.inputs import Work, iter_frames, plan_work, read_work
+from tsrkit.pipeline import FrameResult, Pipeline
+from tsrkit.types import Frame, Skipped
+
+#: Kept frames of a video per unit of work: long enough that the seek to a chunk's key frame is
+#: a small share of its decoding, short enough to spread a short clip over the workers.
+CHUNK_FRAMES = 64
+
+
+def process_frame(pipeline: Pipeline, frame: Frame) -> FrameResult | Skipped:
+    """The pipeline's result on ``frame``, or the frame skipped with the reason its plugin crashed.
+
+    A :class:`~tsrkit.errors.TsrkitError` (a setup problem, such as a mismatched model, that
+    would recur on every frame) propagates.
+    """
+    try:
+        return pipeline.process(frame)
+    except TsrkitError:
+        raise
+    except Exception as exc:  # a crashing plugin costs one frame, not the run
+        label = f"{frame.source}#{frame.index}" if frame.index else frame.source
+        return Skipped(label, f"plugin error: {type(exc).__name__}: {exc}")
+
+
+def run_pipeline(
+    pipeline: Pipeline,
+    paths: Iterable[str | os.PathLike],
+    *,
+    every: int = 1,
+    start: int = 0,
+    end: int | None = None,
+    workers: int = 1,
+) -> Iterator[tuple[FrameResult | Skipped, Frame | None]]:
+    """Each frame's result (or skip) in input order, with the frame itself when ``workers`` is 1.
+
+    Parameters
+    ----------
+    pipeline : Pipeline
+    paths : iterable of path-like
+        Images, videos and folders, as :func:`tsrkit.inputs.iter_frames` reads them.
+    every, start, end : int
+        Video frame selection (see :func:`tsrkit.inputs.iter_frames`).
+    workers : int
+        Worker processes; 1 runs here. A tracker follows a video frame by frame, so a pipeline
+        with one runs here only.
+    """
+    if workers < 1:
+        raise TsrkitError(f"workers must be at least 1; got {workers}")
+    if workers == 1:
+        for item in iter_frames(paths, every, start, end):
+            yield (
+                (item, None) if isinstance(item, Skipped) else (process_frame(pipeline, item), item)
+            )
+        return
+    if pipeline.tracker is not None:
+        raise TsrkitError("a tracker follows a video frame by frame: run it with one worker")
+    units = plan_work(paths, every, start, end, chunk=CHUNK_FRAMES)
+    with ProcessPoolExecutor(
+        workers, mp_context=pool_context(), initializer=_init_worker, initargs=(pipeline, every)
+    ) as pool:
+        for results in ordered(
+            lambda _, unit: unit if isinstance(unit, Skipped) else pool.submit(_process_work, unit),
+            lambda done: [done] if isinstance(done, Skipped) else done.result(),
+            units,
+            4 * workers,
+        ):
+            for result in results:
+                yield result, None
+
+
+_WORKER: tuple[Pipeline, int] | None = None
+
+
+def _init_worker(pipeline: Pipeline, every: int) -> None:
+    global _WORKER
+    _WORKER = (pipeline, every)
+    single_thread()
+
+
+def _process_work(unit: Work) -> list[FrameResult | Skipped]:
+    assert _WORKER is not None, "the pool initializer sets the pipeline"
+    pipeline, every = _WORKER
+    return [
+        item if isinstance(item, Skipped) else process_frame(pipeline, item)
+        for item in read_work(unit, every)
+    ]
