@@ -1,5 +1,6 @@
 """Speed of the conspicuity and GRAY-TOPHAT detectors against the direct-correlation oracle
-and against an earlier commit's conspicuity map (A/B in the same run).
+against the straightforward OpenCV ``filter2D`` map (``conspicuity_filter2d.py``) and against an
+earlier commit's conspicuity map (A/B in the same run).
 
 Frames: roboflow_traffic_light_kr road scenes resized to 480x356 (the thesis's size) and
 1280x720. Single thread. The timed calls are interleaved (every repetition runs each call on
@@ -33,6 +34,7 @@ from tsrkit_plugins.detectors.localization import localize  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "tests"))
+from conspicuity_filter2d import conspicuity_filter2d  # noqa: E402
 from oracles.conspicuity_oracle import conspicuity_reference  # noqa: E402
 
 cv2.setNumThreads(1)
@@ -119,6 +121,8 @@ def main():
         ),
         "conspicuity 1280x720": (detect(conspicuity), large),
         "  map only 1280x720": (conspicuity_map, large),
+        "filter2D map 480x356": (conspicuity_filter2d, small),
+        "filter2D map 1280x720": (conspicuity_filter2d, large),
         "gray-tophat 480x356": (detect(tophat), small),
         "gray-tophat 1280x720": (detect(tophat), large),
     }
@@ -153,6 +157,10 @@ def main():
             f"1280x720 / 480x356: {ratio('conspicuity 1280x720', 'conspicuity 480x356'):.2f}x"
             f" (map only {ratio('  map only 1280x720', '  map only'):.2f}x); gray-tophat "
             f"1280x720 / 480x356: {ratio('gray-tophat 1280x720', 'gray-tophat 480x356'):.2f}x"
+        )
+        line += (
+            f"; filter2D map / map: {ratio('filter2D map 480x356', '  map only'):.1f}x at "
+            f"480x356, {ratio('filter2D map 1280x720', '  map only 1280x720'):.1f}x at 1280x720"
         )
         if args.baseline:
             baseline = ratio(f"baseline {args.baseline} map", "  map only")
