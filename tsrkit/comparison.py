@@ -1,8 +1,10 @@
 """``compare``: several detectors benchmarked on the same frames, side by side, tested pairwise.
 
-Each run writes its folder ``OUT/<detector>/``; ``OUT/compare.json`` and ``OUT/compare.md`` hold
-the reports side by side and, for every pair, a Wilcoxon signed-rank test on per-frame recall
-over the ground-truth frames both evaluated.
+Each run writes its folder ``OUT/<run>/``; ``OUT/compare.json`` and ``OUT/compare.md`` hold
+the reports side by side, for every pair a Wilcoxon signed-rank test on per-frame recall over
+the ground-truth frames both evaluated, and every run's AP50 on the lens box and on the housing
+box. With ``without_verifier`` each detector runs twice, with and without the verifier, so the
+paired tests show what the verifier adds.
 """
 
 from __future__ import annotations
@@ -15,6 +17,7 @@ from typing import Any
 from tsrkit.atomic import atomic_open, write_json
 from tsrkit.benchmarking import run_benchmark
 from tsrkit.engine import BenchmarkError
+from tsrkit.eval.coco import coco_ap, coco_run
 from tsrkit.eval.perframe import frame_score
 from tsrkit.eval.stats import paired_test
 from tsrkit.plugin import Classifier, Detector
@@ -43,38 +46,93 @@ def paired_tests(names: Sequence[str], runs: Sequence[RunResult]) -> list[dict[s
     return tests
 
 
+def verifier_tests(without: RunResult, with_it: RunResult, a: str, b: str) -> list[dict[str, Any]]:
+    """What a verifier changes on the same frames: Wilcoxon signed-rank tests of per-frame
+    recall, precision (frames with detections in both runs) and false positives (fewer is
+    better; exhaustively labelled datasets only) of run ``b`` (with) against ``a`` (without)."""
+    left = {r.index: frame_score(s, r) for s, r in without.pairs()}
+    right = {r.index: frame_score(s, r) for s, r in with_it.pairs()}
+    common = sorted(left.keys() & right.keys())
+    measures = {
+        "per-frame recall": lambda f: f.recall,
+        "per-frame precision": lambda f: f.precision if f.n_gt else None,
+        "false positives per frame (negated: higher is fewer)": lambda f: -(f.n_det - f.det_tp),
+    }
+    exhaustive = (without.report.get("iou50") or {}).get("ap") is not None
+    tests = []
+    for metric, value in measures.items():
+        if metric != "per-frame recall" and not exhaustive:
+            continue
+        kept = [i for i in common if value(left[i]) is not None and value(right[i]) is not None]
+        test = paired_test([value(right[i]) for i in kept], [value(left[i]) for i in kept], b, a)
+        tests.append({"a": b, "b": a, "metric": metric, **test})
+    return tests
+
+
+def box_ap50(run: RunResult) -> dict[str, float | None]:
+    """AP50 of a run on the lens box and on the housing box (``bbox``); None for both when
+    the run's evaluation leaves AP out (a dataset not exhaustively labelled)."""
+    if (run.report.get("iou50") or {}).get("ap") is None:
+        return {"lens": None, "housing": None}
+    pairs = list(run.pairs())
+    return {
+        box: coco_ap(*coco_run(run.report["dataset"], pairs, box))["ap50"]
+        for box in ("lens", "housing")
+    }
+
+
 def compare(
     dataset: Dataset,
     detectors: Sequence[Detector],
     classifier: Classifier | None = None,
     *,
     out: str | os.PathLike | None = None,
+    without_verifier: bool = False,
     **options: Any,
 ) -> dict[str, Any]:
     """Benchmark several detectors on the same frames and test each pair.
 
     Other keyword options are those of :func:`tsrkit.benchmarking.benchmark` (``verifier=``,
-    ``box=``, ``workers=``...). Returns ``{"dataset", "detectors", "reports", "paired_tests"}``.
+    ``box=``, ``workers=``...). With ``without_verifier`` (and a ``verifier``) every detector
+    also runs without it, as ``DETECTOR`` beside ``DETECTOR+VERIFIER``. Returns ``{"dataset",
+    "detectors", "runs", "reports", "paired_tests", "box_ap50"}``.
     """
     names = [d.name for d in detectors]
-    if len(set(names)) != len(names) or len(names) < 2:
+    verifier = options.get("verifier")
+    ablate = without_verifier and verifier is not None
+    if len(set(names)) != len(names) or len(names) < (1 if ablate else 2):
         raise BenchmarkError(f"compare needs at least two different detectors; got {names}")
+    plan = [
+        (f"{d.name}+{verifier.name}" if verifier is not None else d.name, d, verifier)
+        for d in detectors
+    ]
+    if ablate:
+        plan = [run for d, with_it in zip(detectors, plan) for run in ((d.name, d, None), with_it)]
+    labels = [label for label, _, _ in plan]
     runs = [
         run_benchmark(
             dataset,
             detector,
             classifier,
-            out=Path(out) / detector.name if out is not None else None,
-            **options,
+            out=Path(out) / label if out is not None else None,
+            **{**options, "verifier": stage},
         )
-        for detector in detectors
+        for label, detector, stage in plan
     ]
     comparison = {
         "dataset": dataset.name,
         "detectors": names,
+        "runs": labels,
         "reports": [run.report for run in runs],
-        "paired_tests": paired_tests(names, runs),
+        "paired_tests": paired_tests(labels, runs),
+        "box_ap50": [{"run": label, **box_ap50(run)} for label, run in zip(labels, runs)],
     }
+    if ablate:
+        comparison["verifier_tests"] = [
+            test
+            for k in range(0, len(runs), 2)
+            for test in verifier_tests(runs[k], runs[k + 1], labels[k], labels[k + 1])
+        ]
     if out is not None:
         write_compare(Path(out), comparison)
     return comparison
@@ -110,6 +168,36 @@ def compare_markdown(comparison: dict) -> str:
             ],
         )
     )
+    if comparison.get("verifier_tests"):
+        lines += [
+            "",
+            "## With vs without the verifier (Wilcoxon signed-rank on the same frames)",
+            "",
+            markdown_table(
+                ["with", "without", "figure", "frames", "mean with - without", "p", "verdict"],
+                [
+                    [
+                        t["a"],
+                        t["b"],
+                        t["metric"],
+                        str(t["frames"]),
+                        fmt(t["mean_difference"]),
+                        fmt(t["p_value"]),
+                        t["verdict"],
+                    ]
+                    for t in comparison["verifier_tests"]
+                ],
+            ),
+        ]
+    lines += [
+        "",
+        "## AP50 by evaluated box (pycocotools): the lens circle's box vs the housing",
+        "",
+        markdown_table(
+            ["run", "lens AP50", "housing AP50"],
+            [[b["run"], fmt(b["lens"]), fmt(b["housing"])] for b in comparison["box_ap50"]],
+        ),
+    ]
     return "\n".join(lines) + "\n"
 
 

@@ -199,9 +199,9 @@ def headline(report: dict) -> dict[str, str]:
 
 
 def title(report: dict) -> str:
-    """``detector + classifier`` as a run's name."""
-    names = [p["name"] for p in (report["detector"], report["classifier"]) if p]
-    return " + ".join(names)
+    """``detector + verifier + classifier`` as a run's name."""
+    stages = (report["detector"], report.get("verifier"), report["classifier"])
+    return " + ".join(p["name"] for p in stages if p)
 
 
 def markdown_table(header: list[str], rows: list[list[str]]) -> str:

@@ -90,14 +90,29 @@ def build_compare(
     classifier: str | None = None,
     verifier: str | None = None,
     params: Params = (),
+    config: Config = None,
 ) -> list[Selection]:
     """One :class:`Selection` per detector, sharing the classifier and verifier.
 
     A key prefixed with a detector's name (``conspicuity.weights``) goes to that detector, one
     prefixed with a kind (``classifier.model``, ``detector.roi``) to that stage; an unprefixed
     key to every chosen plugin that declares it. A key no chosen plugin declares is refused.
+    ``config`` (a run configuration or preset) names the verifier and classifier when the
+    arguments do not, and gives its plugins' params (its detector's to that detector, if
+    compared); ``params`` override them.
     """
-    assignments = _assignments(params)
+    settings = _config(config)
+    verifier = verifier or (settings.get("verifier") or {}).get("name")
+    classifier = classifier or (settings.get("classifier") or {}).get("name")
+    assignments: dict[str, Any] = {}
+    for kind, name in (("verifier", verifier), ("classifier", classifier)):
+        entry = settings.get(kind) or {}
+        if name and entry.get("name") == name:
+            assignments.update({f"{kind}.{k}": v for k, v in entry.get("params", {}).items()})
+    entry = settings.get("detector") or {}
+    if entry.get("name") in detectors:
+        assignments.update({f"{entry['name']}.{k}": v for k, v in entry["params"].items()})
+    assignments.update(_assignments(params))
     registry = get_registry()
     shared = {
         kind: name for kind, name in (("verifier", verifier), ("classifier", classifier)) if name

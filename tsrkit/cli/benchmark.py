@@ -198,6 +198,11 @@ def benchmark_command(
     help="Comma-separated detector plugins.",
 )
 @click.option("--verifier", "-V", default=None, help="Verifier plugin for every run.")
+@click.option(
+    "--without-verifier",
+    is_flag=True,
+    help="Also run every detector without the verifier (paired tests show what it adds).",
+)
 @click.option("--classifier", "-c", default=None, help="Classifier plugin for every run.")
 @click.option(
     "--param",
@@ -208,6 +213,13 @@ def benchmark_command(
     help="Parameter for one detector (prefix with its name), for classifier. or "
     "verifier.; unprefixed, for every chosen plugin that declares the key.",
 )
+@click.option(
+    "--config",
+    type=click.Path(dir_okay=False),
+    default=None,
+    help="YAML run configuration or preset name (tsrkit presets): its verifier, classifier "
+    "and their params.",
+)
 @run_options
 def compare_command(
     dataset_ref,
@@ -216,8 +228,10 @@ def compare_command(
     split,
     detector_names,
     verifier,
+    without_verifier,
     classifier,
     params,
+    config,
     workers,
     engine,
     scheduler,
@@ -230,8 +244,9 @@ def compare_command(
 ) -> None:
     """Benchmark several detectors on the same frames; one report side by side.
 
-    Writes OUT/<detector>/ for each run plus OUT/compare.json and OUT/compare.md with a paired
-    test (Wilcoxon signed-rank on per-frame recall) for every pair.
+    Writes OUT/<run>/ for each run plus OUT/compare.json and OUT/compare.md with a paired
+    test (Wilcoxon signed-rank on per-frame recall) for every pair and each run's AP50 on the
+    lens box and on the housing box.
     """
     run_compare(
         dataset_ref,
@@ -244,6 +259,8 @@ def compare_command(
         out,
         _run_kwargs(workers, engine, scheduler, no_cache, iou_threshold, quiet, eval_box, writers),
         verifier,
+        config=config,
+        without_verifier=without_verifier,
     )
 
 
@@ -258,21 +275,31 @@ def run_compare(
     out: str,
     options: dict,
     verifier: str | None = None,
+    config: str | None = None,
+    without_verifier: bool = False,
 ) -> None:
     """Build every detector, compare them, print the table and the paired verdicts."""
     from tsrkit.comparison import compare
 
     names = [n.strip() for n in detector_names.split(",") if n.strip()]
-    runs = build_compare(names, classifier, verifier, params)
+    runs = build_compare(names, classifier, verifier, params, config)
+    if without_verifier and runs[0].verifier is None:
+        raise click.UsageError("--without-verifier needs a verifier (--verifier or --config)")
     dataset = load_dataset(dataset_ref, format_name, images, split)
     detectors = [run.detector for run in runs if run.detector is not None]
     comparison = compare(
-        dataset, detectors, runs[0].classifier, out=out, verifier=runs[0].verifier, **options
+        dataset,
+        detectors,
+        runs[0].classifier,
+        out=out,
+        verifier=runs[0].verifier,
+        without_verifier=without_verifier,
+        **options,
     )
     print_table(comparison["reports"])
-    for test in comparison["paired_tests"]:
+    for test in comparison["paired_tests"] + comparison.get("verifier_tests", []):
         click.echo(
-            f"{test['a']} vs {test['b']}: {test['verdict']} "
+            f"{test['a']} vs {test['b']}, {test['metric']}: {test['verdict']} "
             f"(p = {test['p_value']:.3g}, {test['frames']} frames)"
         )
     click.echo(f"report: {os.path.join(out, 'compare.md')}", err=True)
