@@ -31,8 +31,21 @@ from tsrkit.synth import LIGHTINGS, generate
     help="Comma-separated lighting conditions, assigned to frames in turn.",
 )
 @click.option("--overwrite", is_flag=True, help="Replace an existing folder with other data.")
+@click.option(
+    "--video",
+    default=None,
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="Also write the frames, in order, as an MPEG-4 video (10 frames/s).",
+)
 def synth_command(
-    out: Path, frames: int, seed: int, width: int, height: int, lighting: str, overwrite: bool
+    out: Path,
+    frames: int,
+    seed: int,
+    width: int,
+    height: int,
+    lighting: str,
+    overwrite: bool,
+    video: Path | None,
 ) -> None:
     """Render FRAMES road scenes with lit signal lenses of known centre, radius and state.
 
@@ -51,3 +64,7 @@ def synth_command(
         f"wrote {len(dataset)} frames, {sum(states.values())} lit lenses "
         f"({', '.join(f'{k} {v}' for k, v in sorted(states.items()))}) to {out}"
     )
+    if video is not None:
+        from tsrkit.synth.video import write_video
+
+        click.echo(f"video: {write_video(dataset, video)}")
