@@ -31,7 +31,7 @@ def write_video(dataset: Dataset, path: str | os.PathLike, fps: float = 10.0) ->
         prefix=f".{path.stem}.", suffix=path.suffix or ".mp4", dir=path.parent
     )
     os.close(fd)
-    writer = cv2.VideoWriter(tmp, cv2.VideoWriter_fourcc(*"mp4v"), fps, (width, height))
+    writer = cv2.VideoWriter(tmp, cv2.VideoWriter.fourcc(*"mp4v"), fps, (width, height))
     try:
         if not writer.isOpened():
             raise TsrkitError(f"{path}: OpenCV cannot write an MPEG-4 video here")
