@@ -8,8 +8,11 @@ on KR, whose boxes are mostly lenses), Zheng 5.2.1 per-frame recall / precision 
 fraction, false positives per frame (exhaustive sets only) and on synthetic no-light frames,
 candidate recall per light size.
 
-Run: python benchmarks/verifier_loso.py [--detector conspicuity] [-p detector.KEY=V]
-         [--housing housing] [--no-light 30] [--out benchmarks/out/verifier_loso]
+Run: python benchmarks/verifier_loso.py [--detector lab-frst]... [-p lab-frst.KEY=V]
+         [-p verifier.KEY=V] [--housing housing] [--no-light 30] [--skip-paper]
+         [--out benchmarks/out/verifier_loso]
+Several --detector options form a union of their candidates (a later candidate whose centre
+lies within the larger radius of a kept one is dropped), a stand-in until a union plugin exists.
 """
 
 from __future__ import annotations
@@ -80,6 +83,25 @@ class Memo(Detector):
         if key not in self._seen:
             self._seen[key] = self.inner.detect(frame)
         return self._seen[key]
+
+
+class Union(Detector):
+    """Every detector's candidates, in the order given; a candidate whose centre lies within
+    the larger radius of an already kept one is a duplicate and dropped."""
+
+    name = "union"
+
+    def __init__(self, members):
+        super().__init__(members=[(m.name, m.params) for m in members])
+        self.members = members
+
+    def detect(self, frame):
+        kept = []
+        for member in self.members:
+            for c in member.detect(frame):
+                if all(np.hypot(c.x - k.x, c.y - k.y) > max(c.radius, k.radius) for k in kept):
+                    kept.append(c)
+        return kept
 
 
 class Chain(Verifier):
@@ -159,31 +181,97 @@ def candidate_recall(pairs) -> dict[str, float | None]:
     return out
 
 
+def _f(value, spec=".2f") -> str:
+    return "n/a" if value is None else format(value, spec)
+
+
+def markdown(results: dict, threshold: str = "0.5") -> str:
+    """The result tables (Markdown) of a results.json."""
+    exhaustive = {s.key: s.exhaustive for s in SETS}
+    boxes = {s.key: s.box for s in SETS}
+    lines = [
+        f"Candidates: {' + '.join(results['detector'])} "
+        f"({' '.join(results['params']) or 'defaults'})"
+        f"{', housing: ' + results['housing'] if results['housing'] else ''}; verifier threshold "
+        f"{threshold}. FP/frame: detections outside every ground-truth circle (exhaustive sets "
+        "only); no-light: synthetic 1280x720 scenes without a lit light.",
+        "",
+        "| test set | pipeline | AP50 (box) | recall | hit | precision | FP/frame "
+        "| no-light FP/frame |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for key, fold in results["folds"].items():
+        c = fold["candidates"]
+        rows = [("candidates alone", c, c["ap50"])]
+        rows += [
+            (f"+ verifier, {mode}", fold[mode]["by_threshold"][threshold], fold[mode]["ap50"])
+            for mode in ("loso", "in-domain")
+        ]
+        paper = results.get("paper", {}).get(key, {})
+        if paper:
+            best = max(paper, key=lambda n: (paper[n]["hit"], paper[n]["recall"]))
+            rows.append((f"best paper detector: {best}", paper[best], paper[best]["ap50"]))
+        for label, r, ap in rows:
+            lines.append(
+                f"| {key} | {label} | {_f(ap)} ({boxes[key]}) | {_f(r['recall'])} | {_f(r['hit'])}"
+                f" | {_f(r['precision'] if exhaustive[key] else None)}"
+                f" | {_f(r['fp_per_frame'] if exhaustive[key] else None)} | {_f(r['nolight_fp'])} |"
+            )
+    lines += [
+        "",
+        "Candidate recall (share of annotated lights with a candidate centre in their circle) "
+        "by lens radius r = half the box's shorter side, px (count):",
+        "",
+        "| test set | all | r<3 | 3-6 | 6-12 | r>=12 |",
+        "|---|---|---|---|---|---|",
+    ]
+    for key, fold in results["folds"].items():
+        cr = fold["candidates"]["candidate_recall"]
+        cells = [f"{_f(cr[b][0])} ({cr[b][1]})" for b in ("r<3", "3-6", "6-12", "r>=12")]
+        lines.append(f"| {key} | {_f(cr['all'])} ({cr['n']}) | " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--detector", default="conspicuity")
+    parser.add_argument("--detector", action="append", default=[], help="repeatable: a union")
     parser.add_argument(
-        "-p", "--param", action="append", default=[], help="detector.KEY=V / verifier.KEY=V"
+        "-p", "--param", action="append", default=[], help="DETECTOR.KEY=V / verifier.KEY=V"
     )
     parser.add_argument("--housing", default="", help="housing verifier run before the verifier")
     parser.add_argument("--no-light", type=int, default=30, help="synthetic no-light test frames")
     parser.add_argument("--out", default="benchmarks/out/verifier_loso")
     parser.add_argument("--skip-paper", action="store_true", help="no paper-detector baselines")
+    parser.add_argument(
+        "--tables", metavar="RESULTS_JSON", help="only print the Markdown tables of a results.json"
+    )
+    parser.add_argument("--threshold", default="0.5", help="verifier threshold of the tables")
     args = parser.parse_args()
+    if args.tables:
+        print(markdown(json.loads(Path(args.tables).read_text()), args.threshold))
+        return
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     reg = get_registry()
     assigned = parse_assignments(args.param)
-    det_params = {k[9:]: v for k, v in assigned.items() if k.startswith("detector.")}
+    names = args.detector or ["lab-frst"]
     ver_params = {k[9:]: v for k, v in assigned.items() if k.startswith("verifier.")}
     if args.housing:
         ver_params["train_after"] = args.housing
-    detector = Memo(reg.create("detector", args.detector, det_params))
+    members = [
+        reg.create(
+            "detector",
+            name,
+            {k.split(".", 1)[1]: v for k, v in assigned.items() if k.startswith(f"{name}.")},
+        )
+        for name in names
+    ]
+    detector = Memo(members[0] if len(members) == 1 else Union(members))
     housing = [reg.create("verifier", args.housing)] if args.housing else []
     tests = {s.key: open_datasets([f"{s.name}:{s.test}"]) for s in SETS}
     nolight = no_light_dataset(args.no_light)
     started = time.perf_counter()
-    results: dict = {"detector": args.detector, "params": args.param, "housing": args.housing}
+    results: dict = {"detector": names, "params": args.param, "housing": args.housing}
 
     if not args.skip_paper:
         paper: dict = {}
@@ -235,6 +323,7 @@ def main() -> None:
     results["folds"] = folds
     results["seconds"] = round(time.perf_counter() - started, 1)
     (out / "results.json").write_text(json.dumps(results, indent=1))
+    print(markdown(results))
     print(f"wrote {out / 'results.json'} in {results['seconds']} s")
 
 

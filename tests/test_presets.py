@@ -49,3 +49,14 @@ def test_presets_command_lists_and_shows():
     shown = CliRunner().invoke(cli, ["presets", "--show", "recommended"])
     assert shown.exit_code == 0
     assert shown.output == preset_path("recommended").read_text(encoding="utf-8")
+
+
+def test_recommended_verifier_model_was_trained_on_the_presets_candidates():
+    from tsrkit.models import load_model
+    from tsrkit_plugins.verifiers.learned import DEFAULT_MODEL
+
+    preset = load_config("recommended")
+    training = load_model(DEFAULT_MODEL, "verifier").meta["training"]["detector"]
+    assert training["name"] == preset["detector"]["name"]
+    for key, value in preset["detector"]["params"].items():
+        assert training["params"][key] == value
