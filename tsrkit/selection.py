@@ -169,13 +169,15 @@ def route_params(
     """Give each ``key: value`` to the selected plugin that declares ``key``.
 
     A key may be prefixed with the plugin kind (``classifier.model``); an unprefixed key goes
-    to the only selected plugin that declares it. Config params come first; ``assignments``
-    override them.
+    to the only selected plugin that declares it. Config params come first (only for the
+    plugin the config names); ``assignments`` override them.
     """
     registry = get_registry()
     routed: dict[str, dict[str, Any]] = {kind: {} for kind in selected}
-    for kind in selected:
-        routed[kind].update((config or {}).get(kind, {}).get("params", {}))
+    for kind, name in selected.items():
+        entry = (config or {}).get(kind) or {}
+        if entry.get("name") in (None, name):  # a plugin named instead drops the config's params
+            routed[kind].update(entry.get("params", {}))
     for key, value in assignments.items():
         kind, dot, bare = key.partition(".")
         if dot and kind in selected:
