@@ -122,6 +122,11 @@ def stacked_hog(lightness: np.ndarray, rows: int) -> np.ndarray:
     return blocks.reshape(n, -1).astype(np.float32)
 
 
+#: Cosine and sine of every OpenCV 8-bit hue (0-179, 2 degrees a step).
+_HUE_COS = np.cos(np.arange(180) * (np.pi / 90.0)).astype(np.float32)
+_HUE_SIN = np.sin(np.arange(180) * (np.pi / 90.0)).astype(np.float32)
+
+
 def colour_planes(*patches: np.ndarray) -> list[np.ndarray]:
     """Per-pixel L, a, b, S, V, saturation-weighted hue cosine and sine, and chroma of each
     BGR stack in ``patches`` (one Lab and one HSV conversion for all of them).
@@ -131,13 +136,22 @@ def colour_planes(*patches: np.ndarray) -> list[np.ndarray]:
     list of ndarray
         One float32 array per input, shaped like it with 8 channels (:data:`COLOUR_NAMES`).
     """
-    flat = np.concatenate([p.reshape(-1, 1, 3) for p in patches])
-    lab = cv2.cvtColor(flat, cv2.COLOR_BGR2LAB)[:, 0].astype(np.float32)
-    hsv = cv2.cvtColor(flat, cv2.COLOR_BGR2HSV)[:, 0].astype(np.float32)
-    angle = hsv[:, 0] * (np.pi / 90.0)
-    sat = hsv[:, 1] / 255.0
-    chroma = np.hypot(lab[:, 1] - 128, lab[:, 2] - 128)
-    planes = np.column_stack([lab, hsv[:, 1:], np.cos(angle) * sat, np.sin(angle) * sat, chroma])
+    flat = np.concatenate([p.reshape(-1, 3) for p in patches])[None]  # one row: fastest
+    lab = cv2.cvtColor(flat, cv2.COLOR_BGR2LAB)[0].T.astype(np.float32)
+    hsv = cv2.cvtColor(flat, cv2.COLOR_BGR2HSV)[0].T
+    hue, saturation = hsv[0], hsv[1].astype(np.float32) / 255.0
+    a, b = lab[1] - 128.0, lab[2] - 128.0
+    planes = np.stack(
+        [
+            *lab,
+            hsv[1].astype(np.float32),
+            hsv[2].astype(np.float32),
+            _HUE_COS[hue] * saturation,
+            _HUE_SIN[hue] * saturation,
+            np.sqrt(a * a + b * b),
+        ],
+        axis=-1,
+    )
     ends = np.cumsum([0] + [p.size // 3 for p in patches])
     return [
         planes[start:end].reshape(*p.shape[:-1], len(COLOUR_NAMES))
