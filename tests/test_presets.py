@@ -60,3 +60,23 @@ def test_recommended_verifier_model_was_trained_on_the_presets_candidates():
     assert training["name"] == preset["detector"]["name"]
     for key, value in preset["detector"]["params"].items():
         assert training["params"][key] == value
+
+
+def test_detect_runs_the_recommended_preset_on_a_video(tmp_path):
+    import json
+
+    video = tmp_path / "drive.mp4"
+    synth = ["datasets", "synth", "--out", str(tmp_path / "s"), "--frames", "2"]
+    made = CliRunner().invoke(cli, [*synth, "--video", str(video)])
+    assert made.exit_code == 0, made.output
+    out = tmp_path / "drive.jsonl"
+    result = CliRunner().invoke(
+        cli, ["detect", str(video), "--config", "recommended", "--out", str(out)]
+    )
+    assert result.exit_code == 0, result.output
+    records = [json.loads(line) for line in out.read_text().splitlines()]
+    assert [r["frame"] for r in records] == [0, 1]
+    for record in records:
+        for d in record["detections"]:
+            assert d["score"] >= 0.3  # the preset's verifier threshold: probabilities kept
+            assert d["state"] in ("red", "yellow", "green", "unknown")
