@@ -219,13 +219,15 @@ def test_untrusted_types_in_the_estimator_bytes_are_refused():
 
 
 def test_fit_needs_a_detector_and_both_classes():
-    with pytest.raises(ValueError, match="detector"):
+    from tsrkit.errors import TsrkitError
+
+    with pytest.raises(TsrkitError, match="detector"):
         make().fit(tiny_dataset(1))
     empty = Dataset(
         "none", (Sample("blank", (), 64, 64, "train", image=np.zeros((64, 64, 3), np.uint8)),)
     )
     detector = get_registry().create("detector", "gray-tophat")
-    with pytest.raises(ValueError, match="positive"):
+    with pytest.raises(TsrkitError, match="positive"):
         make(synthetic_frames=0).fit(empty, detector=detector)
 
 

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 from sklearn.ensemble import HistGradientBoostingClassifier
 
+from tsrkit.errors import TsrkitError
 from tsrkit.hookspecs import hookimpl
 from tsrkit.models import Model, ModelError, load_model
 from tsrkit.params import Param
@@ -151,11 +152,11 @@ class LearnedVerifier(Verifier):
 
         Raises
         ------
-        ValueError
+        TsrkitError
             No detector, or no positive or no negative candidate to learn from.
         """
         if detector is None:
-            raise ValueError("verifier: fit needs the detector whose candidates it verifies")
+            raise TsrkitError("verifier: fit needs the detector whose candidates it verifies")
         data = labelled_candidates(
             samples,
             detector,
@@ -167,7 +168,7 @@ class LearnedVerifier(Verifier):
         positives = np.flatnonzero(data.labels == 1)
         negatives = np.flatnonzero(data.labels == 0)
         if not len(positives) or not len(negatives):
-            raise ValueError(
+            raise TsrkitError(
                 f"verifier: {len(positives)} positive and {len(negatives)} negative candidates; "
                 "need both (is the detector finding the annotated lights?)"
             )
