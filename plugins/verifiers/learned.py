@@ -181,7 +181,7 @@ class LearnedVerifier(Verifier):
             if not len(rest):
                 break
             probability = estimator.predict_proba(data.features[rest])[:, 1]
-            hard = rest[hard_negatives(probability, np.zeros(len(rest)), step)]
+            hard = rest[hard_negatives(probability, data.labels[rest], step)]
             chosen = np.union1d(chosen, hard)
             estimator = self._fit_once(data, np.concatenate([positives, chosen]))
         return Model(
