@@ -12,6 +12,7 @@ from __future__ import annotations
 import io
 import re
 import zipfile
+from collections.abc import Sequence
 
 import numpy as np
 import skops.io as sio
@@ -58,14 +59,19 @@ def estimator_arrays(estimator: HistGradientBoostingClassifier) -> dict[str, np.
     return {ARRAY: np.frombuffer(canonical_skops(sio.dumps(estimator)), dtype=np.uint8)}
 
 
-def load_estimator(model: Model, where: str) -> HistGradientBoostingClassifier:
+def load_estimator(
+    model: Model, where: str, classes: Sequence | None = (0, 1)
+) -> HistGradientBoostingClassifier:
     """The estimator stored by :func:`estimator_arrays` in ``model`` (read from ``where``).
+
+    ``classes`` are the labels the estimator must have been fitted on (the verifier's 0 / 1;
+    another plugin's own labels; None accepts any).
 
     Raises
     ------
     ModelError
         No estimator array, bytes skops cannot read, a type outside :data:`TRUSTED_TYPES`, or
-        an object that is not a fitted binary classifier.
+        an object that is not a fitted classifier of ``classes``.
     """
     data = model.arrays.get(ARRAY)
     if data is None or data.dtype != np.uint8 or data.ndim != 1:
@@ -83,8 +89,9 @@ def load_estimator(model: Model, where: str) -> HistGradientBoostingClassifier:
         raise ModelError(
             f"model {where}: unreadable estimator ({type(exc).__name__}: {exc})"
         ) from None
-    if not isinstance(estimator, HistGradientBoostingClassifier) or list(
-        getattr(estimator, "classes_", [])
-    ) != [0, 1]:
-        raise ModelError(f"model {where}: the estimator is not a fitted verifier classifier")
+    fitted = list(getattr(estimator, "classes_", []))
+    if not isinstance(estimator, HistGradientBoostingClassifier) or (
+        fitted != list(classes) if classes is not None else not fitted
+    ):
+        raise ModelError(f"model {where}: the estimator is not a fitted classifier of {classes}")
     return estimator

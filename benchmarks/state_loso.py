@@ -1,0 +1,178 @@
+"""lamp-state across cameras: leave-one-dataset-out and in-domain accuracy and red recall, with
+the paper classifiers (ab-hist, hsi-backprojection, as shipped) on the same lights.
+
+Training follows ``lamp-state``'s fit: its default parameters (colour-jittered copies
+included), the lights of the training parts only; test lights are not jittered.
+
+Sets: MIT crops (train / test), VGIS bulb crops day and night (deduplicated by sha256, first
+occurrence kept, as the datasets README asks), KR (test + valid), cinTA (test + valid), DTLD
+(train / test). Leave-one-dataset-out trains on every other dataset (their train parts: MIT
+train, all VGIS, all KR, all cinTA, DTLD train) and tests on the held-out one; in-domain adds
+the held-out dataset's own train part (MIT train, KR valid, cinTA valid, DTLD train) and tests
+on its test split. Features are computed once per light.
+
+    python benchmarks/state_loso.py
+"""
+
+from __future__ import annotations
+
+import os
+
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ[_var] = "1"
+
+import hashlib  # noqa: E402
+import time  # noqa: E402
+from collections import Counter  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+from tsrkit.datasets import open_dataset  # noqa: E402
+from tsrkit.registry import get_registry  # noqa: E402
+from tsrkit.types import Candidate, Dataset  # noqa: E402
+from tsrkit_plugins.classifiers.lamp_state import (  # noqa: E402
+    STATES,
+    fit_estimator,
+    labelled_features,
+)
+from tsrkit_plugins.classifiers.lamp_state.features import lamp_features  # noqa: E402
+
+
+def deduplicated(dataset: Dataset, lighting: str) -> Dataset:
+    """VGIS crops of one lighting, each distinct file once (first occurrence)."""
+    seen, kept = set(), []
+    for sample in dataset:
+        with open(sample.source, "rb") as fh:
+            digest = hashlib.sha256(fh.read()).hexdigest()
+        if sample.metadata.get("lighting") == lighting and digest not in seen:
+            kept.append(sample)
+        seen.add(digest)
+    return Dataset(f"vgis {lighting}", tuple(kept), dataset.format, dataset.root, dataset.info)
+
+
+def parts() -> dict[str, dict[str, Dataset]]:
+    """Per dataset: its ``train`` part (used when the dataset trains) and ``test`` sets."""
+    mit = open_dataset("udacity_mit_tl_crops")
+    vgis = open_dataset("lisa_vgis_bulb_crops")
+    kr = open_dataset("roboflow_traffic_light_kr")
+    cinta = open_dataset("roboflow_cinta_v2_id")
+    dtld = open_dataset("dtld_fridtjofs")
+    day, night = deduplicated(vgis, "day"), deduplicated(vgis, "night")
+    both = Dataset("vgis", day.samples + night.samples, vgis.format, vgis.root, vgis.info)
+    return {
+        "mit": {
+            "train": mit.split("train"),
+            "own": mit.split("train"),
+            "mit test": mit.split("test"),
+        },
+        "vgis": {"train": both, "vgis day": day, "vgis night": night},
+        "kr": {"train": kr, "own": kr.split("valid"), "kr": kr, "kr test": kr.split("test")},
+        "cinta": {
+            "train": cinta,
+            "own": cinta.split("valid"),
+            "cinta": cinta,
+            "cinta test": cinta.split("test"),
+        },
+        "dtld": {
+            "train": dtld.split("train"),
+            "own": dtld.split("train"),
+            "dtld test": dtld.split("test"),
+        },
+    }
+
+
+def scores(truth: np.ndarray, predicted: list[str]) -> tuple[float, float, int]:
+    """Accuracy, red recall and count over lights whose true state is in :data:`STATES`."""
+    names = [STATES[i] for i in truth]
+    right = sum(t == p for t, p in zip(names, predicted))
+    reds = [p for t, p in zip(names, predicted) if t == "red"]
+    red = sum(p == "red" for p in reds) / len(reds) if reds else float("nan")
+    return right / max(len(names), 1), red, len(names)
+
+
+def paper(name: str, dataset: Dataset) -> list[str]:
+    classifier = get_registry().create("classifier", name)
+    out = []
+    for sample in dataset:
+        wanted = [a for a in sample.annotations if a.state in STATES]
+        if wanted:
+            frame = sample.load()
+            found = classifier.classify(frame, [Candidate.from_box(a.bbox, 1.0) for a in wanted])
+            out += [d.state for d in found]
+    return out
+
+
+def main() -> None:
+    params = get_registry().create("classifier", "lamp-state").params
+    data = parts()
+    copies = params["copies"]
+    features = {
+        (group, key): labelled_features(ds, copies if key in ("train", "own") else 0)
+        for group, sets in data.items()
+        for key, ds in sets.items()
+    }
+    print(
+        "lights:",
+        {f"{g}/{k}": len(v[1]) for (g, k), v in features.items() if k not in ("train", "own")},
+    )
+    rows = []
+    for group, sets in data.items():
+        for key, dataset in sets.items():
+            if key in ("train", "own"):
+                continue
+            x, y = features[(group, key)]
+            others = [features[(g, "train")] for g in data if g != group]
+            loso, states = fit_estimator(
+                np.concatenate([o[0] for o in others]),
+                np.concatenate([o[1] for o in others]),
+                params,
+            )
+            predicted = [states[i] for i in loso.predict(x)]
+            row = {"set": key, "n": len(y), "loso": scores(y, predicted)[:2]}
+            if "own" in sets and key.endswith("test"):
+                train = others + [features[(group, "own")]]
+                own, states = fit_estimator(
+                    np.concatenate([o[0] for o in train]),
+                    np.concatenate([o[1] for o in train]),
+                    params,
+                )
+                row["in-domain"] = scores(y, [states[i] for i in own.predict(x)])[:2]
+            for name in ("ab-hist", "hsi-backprojection"):
+                row[name] = scores(y, paper(name, dataset))[:2]
+            row["truth"] = dict(Counter(STATES[i] for i in y))
+            rows.append(row)
+            print(row, flush=True)
+    print()
+    print(
+        "| set | lights | lamp-state LOSO acc / red recall | lamp-state in-domain "
+        "| ab-hist | hsi-backprojection |"
+    )
+    print("|---|---:|---|---|---|---|")
+
+    def pair(v):
+        return "-" if v is None else f"{v[0]:.3f} / {v[1]:.3f}"
+
+    for row in rows:
+        print(
+            f"| {row['set']} | {row['n']} | {pair(row['loso'])} | {pair(row.get('in-domain'))} | "
+            f"{pair(row['ab-hist'])} | {pair(row['hsi-backprojection'])} |"
+        )
+    frame = open_dataset("roboflow_cinta_v2_id").samples[0].load()
+    candidates = [Candidate.from_box((10 + 8 * i, 20, 30 + 8 * i, 80), 1.0) for i in range(50)]
+    start = time.perf_counter()
+    for _ in range(20):
+        lamp_features(frame.image, candidates)
+    feature_ms = (time.perf_counter() - start) / 20 * 1000
+    classifier = get_registry().create("classifier", "lamp-state")
+    classifier.classify(frame, candidates)
+    start = time.perf_counter()
+    for _ in range(20):
+        classifier.classify(frame, candidates)
+    print(
+        f"\nspeed, one thread, 50 housing candidates: features {feature_ms:.2f} ms, "
+        f"classify (features + model) {(time.perf_counter() - start) / 20 * 1000:.2f} ms"
+    )
+
+
+if __name__ == "__main__":
+    main()

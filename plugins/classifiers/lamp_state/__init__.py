@@ -1,0 +1,178 @@
+"""``lamp-state``: a trainable state classifier that reads the lit lamp's colour, its rim and its
+position in the housing, learned from several cameras at once.
+
+Beyond the documents (issue 11): Zheng's ab-hist and Lee's hsi-backprojection stay available,
+unchanged, beside it. Features: :mod:`.features`; model: scikit-learn's
+``HistGradientBoostingClassifier`` stored with skops (explicit trusted types, no pickle; see
+``tsrkit_plugins.verifiers.persistence``). ``red_yellow`` is a state of its own where the
+training data labels it (DTLD); other labels (arrows, off) are passed over in training.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+from pathlib import Path
+
+import numpy as np
+from sklearn.ensemble import HistGradientBoostingClassifier
+
+from tsrkit.errors import TsrkitError
+from tsrkit.hookspecs import hookimpl
+from tsrkit.models import Model, ModelError, load_model
+from tsrkit.params import Param
+from tsrkit.plugin import Classifier, Detector
+from tsrkit.types import Candidate, Detection, Frame, Sample
+from tsrkit_plugins.classifiers.lamp_state.features import N_FEATURES, VERSION, lamp_features
+from tsrkit_plugins.verifiers.persistence import estimator_arrays, load_estimator
+
+#: The states lamp-state can learn (those present in the training data are learned).
+STATES = ("red", "yellow", "green", "red_yellow")
+DEFAULT_MODEL = Path(__file__).parent / "models" / "lamp_state_default"
+
+
+def colour_jitter(image: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """``image`` as another camera might see it: channel gains in [0.85, 1.15] (white balance)
+    and a gamma in [0.8, 1.25] (response curve), drawn from ``rng``."""
+    gains = rng.uniform(0.85, 1.15, 3)
+    gamma = rng.uniform(0.8, 1.25)
+    scaled = np.clip(image.astype(np.float32) * (gains / 255.0), 0.0, 1.0)
+    return (255.0 * scaled**gamma).astype(np.uint8)
+
+
+def labelled_features(
+    samples: Iterable[Sample], copies: int = 0, seed: int = 0
+) -> tuple[np.ndarray, np.ndarray]:
+    """Features and state indices of every annotation in :data:`STATES`, plus ``copies``
+    colour-jittered views of each (:func:`colour_jitter`, seeded: deterministic)."""
+    rng = np.random.default_rng(seed)
+    rows, labels = [], []
+    for sample in samples:
+        wanted = [a for a in sample.annotations if a.state in STATES]
+        if not wanted:
+            continue
+        image = sample.load().image
+        boxes = [Candidate.from_box(a.bbox, 1.0) for a in wanted]
+        for view in range(copies + 1):
+            rows.append(lamp_features(colour_jitter(image, rng) if view else image, boxes))
+            labels += [STATES.index(a.state) for a in wanted]
+    if not rows:
+        return np.zeros((0, N_FEATURES), np.float32), np.zeros(0, np.int64)
+    return np.concatenate(rows), np.array(labels, np.int64)
+
+
+def fit_estimator(
+    features: np.ndarray, labels: np.ndarray, params
+) -> tuple[HistGradientBoostingClassifier, list[str]]:
+    """The classifier of ``labels`` (indices into :data:`STATES`) and the states it knows."""
+    present = sorted(set(labels.tolist()))
+    estimator = HistGradientBoostingClassifier(
+        max_iter=params["iterations"],
+        max_leaf_nodes=params["leaves"],
+        learning_rate=params["learning_rate"],
+        class_weight="balanced",
+        early_stopping=False,
+        random_state=params["seed"],
+    ).fit(features, np.searchsorted(present, labels))
+    return estimator, [STATES[i] for i in present]
+
+
+class LampState(Classifier):
+    """Lit-lamp colour, rim colour and position in the housing, gradient boosted."""
+
+    name = "lamp-state"
+    summary = "learned state: lamp and rim colour plus lit position in the housing (trainable)"
+    section = "issue 11 (beyond the documents)"
+    params = (
+        Param(
+            "model",
+            "path",
+            None,
+            help="trained model (tsrkit train lamp-state); unset: the shipped model, trained on "
+            "openly licensed sets only (MIT, VGIS, KR valid, cinTA valid)",
+        ),
+        Param("iterations", "int", 100, min=10, max=2000, help="training: boosting iterations"),
+        Param("leaves", "int", 15, min=4, max=255, help="training: leaves per tree"),
+        Param("learning_rate", "float", 0.1, min=0.001, max=1.0, help="training: learning rate"),
+        Param(
+            "copies",
+            "int",
+            3,
+            min=0,
+            max=20,
+            help="training: colour-jittered views added per light (camera white balance and "
+            "response), for states that carry over to unseen cameras",
+        ),
+        Param("seed", "int", 0, min=0, help="training: seed of the jitter and the trees"),
+    )
+
+    def __init__(self, **params):
+        super().__init__(**params)
+        self._estimator: HistGradientBoostingClassifier | None = None
+        self._states: tuple[str, ...] = ()
+
+    @property
+    def estimator(self) -> HistGradientBoostingClassifier:
+        """The trained classifier, loaded on first use.
+
+        Raises
+        ------
+        tsrkit.models.ModelError
+            A missing, corrupt or foreign model, or one of another feature layout.
+        """
+        if self._estimator is None:
+            where = str(self.params["model"] or DEFAULT_MODEL)
+            model = load_model(where, plugin=self.name)
+            if model.info.get("layout") != VERSION:
+                raise ModelError(
+                    f"model {where}: feature layout {model.info.get('layout')!r}, this "
+                    f"lamp-state reads {VERSION}; retrain it (tsrkit train lamp-state)"
+                )
+            states = model.info.get("states")
+            if not isinstance(states, list) or not set(states) <= set(STATES):
+                raise ModelError(f"model {where}: 'states' must be a list of {STATES}")
+            self._estimator = load_estimator(model, where, classes=list(range(len(states))))
+            self._states = tuple(states)
+        return self._estimator
+
+    def classify(self, frame: Frame, candidates: Sequence[Candidate]) -> list[Detection]:
+        if not candidates:
+            return []
+        estimator = self.estimator
+        probability = estimator.predict_proba(lamp_features(frame.image, candidates))
+        out = []
+        for candidate, p in zip(candidates, probability):
+            scores = {state: float(v) for state, v in zip(self._states, p)}
+            out.append(Detection(candidate, self._states[int(np.argmax(p))], scores))
+        return out
+
+    def fit(self, samples: Iterable[Sample], *, detector: Detector | None = None) -> Model:
+        """Learn the states of the annotated lights of ``samples`` and of ``copies``
+        colour-jittered views of each (deterministic for a given ``seed``).
+
+        Raises
+        ------
+        TsrkitError
+            Fewer than two states among the annotations.
+        """
+        features, labels = labelled_features(samples, self.params["copies"], self.params["seed"])
+        present = sorted(set(labels.tolist()))
+        if len(present) < 2:
+            raise TsrkitError(
+                f"lamp-state: {len(labels)} labelled lights of {len(present)} state(s); need "
+                f"at least two of {', '.join(STATES)}"
+            )
+        estimator, states = fit_estimator(features, labels, self.params)
+        counts = np.bincount(np.searchsorted(present, labels), minlength=len(states))
+        return Model(
+            arrays=estimator_arrays(estimator),
+            info={
+                "layout": VERSION,
+                "states": states,
+                "counts": {s: int(n) for s, n in zip(states, counts)},
+            },
+        )
+
+
+@hookimpl
+def register_classifiers(register):
+    register(LampState)

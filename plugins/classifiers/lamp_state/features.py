@@ -1,0 +1,207 @@
+"""What ``lamp-state`` reads of a candidate: the colour of its lit lamp, the colour of that lamp's
+rim, and where in the housing the light is lit.
+
+Beyond the documents (issue 11). Zheng (3.3) and Lee (5.3.3) read the lens colour only; on
+dash-cam frames the lit lamp is often over-exposed white with a coloured rim, and red-orange
+lamps sit at the hue of other cameras' ambers. Three groups of features make the reading
+robust across cameras:
+
+* **lamp colour**: hue histograms (weighted by saturation x value) of the lens disk and of its
+  rim ``0.6 r .. 1.3 r`` (a white core is read by the rim), CIELab a/b of the brightest disk
+  pixels and of the most chromatic rim pixels, the over-exposed share of the disk, mean value,
+  saturation and normalised red/green chromaticity;
+* **housing colour**: the hue histogram of the bright pixels of the whole housing box;
+* **position**: the housing resampled upright (vertical or horizontal head) to
+  :data:`HOUSING_SIZE`, the brightness and colourfulness of its top, middle and bottom thirds
+  and the lit centroid along its axis (red on top, amber in the middle, green at the bottom in
+  most countries; red+amber lights two thirds at once). Without a housing (a lens box) these are
+  zero and ``has_housing`` is 0.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import cv2
+import numpy as np
+
+from tsrkit.geometry import clip_box
+from tsrkit.types import Candidate
+
+#: OpenCV hue (0-180) bin edges: reds split off at both ends, orange, amber, yellow, greens, blues.
+HUE_EDGES = np.array([0, 6, 12, 18, 24, 32, 45, 70, 95, 130, 165, 181])
+#: Lens patch side (pixels) after resampling; the lens radius is ``LENS_PATCH / (2 * 1.3)``.
+LENS_PATCH = 16
+#: Upright housing patch (across, along) after resampling.
+HOUSING_SIZE = (12, 36)
+#: Long / short side ratio from which a box without a fitted housing is read as a housing.
+ELONGATION = 1.5
+#: Feature layout version: a model trained on another layout is refused.
+VERSION = 1
+
+
+def _lens_masks() -> tuple[np.ndarray, np.ndarray]:
+    centre = (LENS_PATCH - 1) / 2
+    yy, xx = np.mgrid[:LENS_PATCH, :LENS_PATCH]
+    d = np.hypot(yy - centre, xx - centre) / (LENS_PATCH / (2 * 1.3))
+    return d <= 1.0, (d > 0.6) & (d <= 1.3)
+
+
+DISK, RIM = _lens_masks()
+N_HUE = len(HUE_EDGES) - 1
+#: Number of features: 2 x lens hue, 4 Lab, 5 lens statistics, housing hue, 9 position.
+N_FEATURES = 2 * N_HUE + 4 + 5 + N_HUE + 9
+
+
+def housing_of(candidate: Candidate) -> tuple[float, float, float, float] | None:
+    """The housing to read: the fitted one, else the candidate's box when it is elongated."""
+    if candidate.housing is not None:
+        return candidate.housing
+    x0, y0, x1, y1 = candidate.bbox
+    short, long = sorted((x1 - x0, y1 - y0))
+    return candidate.bbox if short > 0 and long / short >= ELONGATION else None
+
+
+def quantiles(values: np.ndarray, q: float) -> np.ndarray:
+    """The lower ``q`` quantile of each row of a 2-D array (by partition, for speed)."""
+    k = min(int(q * values.shape[1]), values.shape[1] - 1)
+    return np.partition(values, k, axis=1)[:, k]
+
+
+def hue_histograms(hsv: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    """Per patch of an (N, H, W, 3) HSV stack, the share of saturation x value weight per
+    :data:`HUE_EDGES` bin over the (H, W) or (N, H, W) ``mask``."""
+    n = hsv.shape[0]
+    mask = np.broadcast_to(mask, hsv.shape[:3])
+    bins = np.digitize(hsv[..., 0], HUE_EDGES) - 1 + N_HUE * np.arange(n)[:, None, None]
+    weight = hsv[..., 1].astype(np.float32) * hsv[..., 2] / 65025.0
+    hist = np.bincount(bins[mask], weights=weight[mask], minlength=n * N_HUE)
+    hist = hist[: n * N_HUE].reshape(n, N_HUE)
+    return hist / np.maximum(hist.sum(axis=1, keepdims=True), 1e-6)
+
+
+def patches(image: np.ndarray, boxes: np.ndarray, size: tuple[int, int]) -> np.ndarray:
+    """The (N, height, width, 3) stack of ``boxes`` resampled to ``size`` = (width, height);
+    a box wholly outside the image gives a black patch."""
+    out = np.zeros((len(boxes), size[1], size[0], 3), np.uint8)
+    for i, box in enumerate(boxes):
+        x0, y0, x1, y1 = clip_box(box, image.shape[1], image.shape[0])
+        if x1 > x0 and y1 > y0:
+            out[i] = cv2.resize(image[y0:y1, x0:x1], size, interpolation=cv2.INTER_AREA)
+    return out
+
+
+def convert(stack: np.ndarray, code: int) -> np.ndarray:
+    """One OpenCV colour conversion over a whole (N, H, W, 3) stack."""
+    n, h, w, _ = stack.shape
+    return cv2.cvtColor(stack.reshape(n * h, w, 3), code).reshape(n, h, w, 3)
+
+
+def lens_features(image: np.ndarray, lenses: Sequence[Candidate]) -> np.ndarray:
+    """Lens and rim colour of each lens (see the module notes), (N, 2 x hue bins + 9)."""
+    r = np.array([max(c.radius, 0.5) * 1.3 for c in lenses])
+    x, y = np.array([c.x for c in lenses]), np.array([c.y for c in lenses])
+    stack = patches(image, np.stack([x - r, y - r, x + r, y + r], axis=1), (LENS_PATCH,) * 2)
+    n = len(lenses)
+    hsv = convert(stack, cv2.COLOR_BGR2HSV)
+    lab = convert(stack, cv2.COLOR_BGR2LAB).astype(np.float32) - (0, 128, 128)
+    value = hsv[..., 2][:, DISK].astype(np.float32)
+    bright = value >= quantiles(value, 0.7)[:, None]
+    chroma = np.hypot(lab[..., 1], lab[..., 2])[:, RIM]
+    vivid = chroma >= quantiles(chroma, 0.7)[:, None]
+
+    def masked_mean(values: np.ndarray, mask: np.ndarray) -> np.ndarray:
+        return (values * mask[..., None]).sum(axis=1) / np.maximum(mask.sum(axis=1), 1)[:, None]
+
+    bgr = stack[:, DISK].astype(np.float32)
+    chromaticity = bgr / (bgr.sum(axis=2, keepdims=True) + 1e-3)
+    weight = value / np.maximum(value.sum(axis=1, keepdims=True), 1e-3)
+    saturation = hsv[..., 1][:, DISK]
+    over = (value > 230) & (saturation < 80)
+    return np.concatenate(
+        [
+            hue_histograms(hsv, DISK),
+            hue_histograms(hsv, RIM),
+            masked_mean(lab[:, DISK, 1:], bright) / 128,
+            masked_mean(lab[:, RIM, 1:], vivid) / 128,
+            over.mean(axis=1, keepdims=True),
+            value.mean(axis=1, keepdims=True) / 255,
+            saturation.mean(axis=1, keepdims=True) / 255,
+            (chromaticity[..., 2] * weight).sum(axis=1, keepdims=True),
+            (chromaticity[..., 1] * weight).sum(axis=1, keepdims=True),
+        ],
+        axis=1,
+    ).reshape(n, -1)
+
+
+def upright_housings(image: np.ndarray, boxes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The housings resampled to :data:`HOUSING_SIZE`, long axis vertical (horizontal heads
+    transposed), and whether each was vertical."""
+    vertical = (boxes[:, 3] - boxes[:, 1]) >= (boxes[:, 2] - boxes[:, 0])
+    out = patches(image, boxes, HOUSING_SIZE)
+    wide = np.flatnonzero(~vertical)
+    if len(wide):
+        out[wide] = patches(image, boxes[wide], HOUSING_SIZE[::-1]).transpose(0, 2, 1, 3)
+    return out, vertical
+
+
+def lit_lenses(
+    boxes: np.ndarray, vertical: np.ndarray, hsv: np.ndarray, lens_fraction: float = 0.4
+) -> list[Candidate]:
+    """The lit lens of each upright housing patch, in image coordinates: the window of
+    ``2 * lens_fraction`` short sides along the axis with the highest mean saturation x
+    value^2 (the rule of ``tsrkit_plugins.classifiers.regions.find_lens``, on the patch)."""
+    value = hsv[..., 2].astype(np.float32) / 255
+    lit = (hsv[..., 1].astype(np.float32) / 255 * value * value).mean(axis=2)
+    across, along = HOUSING_SIZE
+    window = max(1, int(round(2 * lens_fraction * across)))
+    kernel = np.ones(window, np.float32)
+    t = np.array([np.argmax(np.convolve(row, kernel, mode="same")) for row in lit]) + 0.5
+    t = t / along
+    x0, y0, x1, y1 = boxes.T
+    radius = lens_fraction * np.minimum(x1 - x0, y1 - y0)
+    cx = np.where(vertical, (x0 + x1) / 2, x0 + t * (x1 - x0))
+    cy = np.where(vertical, y0 + t * (y1 - y0), (y0 + y1) / 2)
+    return [Candidate.from_circle(*v, 1.0) for v in zip(cx, cy, radius)]
+
+
+def housing_features(hsv: np.ndarray, vertical: np.ndarray) -> np.ndarray:
+    """Housing hue and lit-position features of upright housing patches in HSV."""
+    n = hsv.shape[0]
+    value = hsv[..., 2].astype(np.float32) / 255
+    lit = value >= np.maximum(0.5 * value.max(axis=(1, 2)), 1e-3)[:, None, None]
+    colourful = hsv[..., 1].astype(np.float32) / 255 * value
+    thirds = np.array_split(np.arange(value.shape[1]), 3)
+    weight = value.max(axis=2) ** 4
+    position = weight @ np.linspace(0, 1, weight.shape[1]) / np.maximum(weight.sum(axis=1), 1e-6)
+    return np.concatenate(
+        [
+            hue_histograms(hsv, lit),
+            np.stack([quantiles(value[:, rows].reshape(n, -1), 0.9) for rows in thirds], 1),
+            np.stack([quantiles(colourful[:, rows].reshape(n, -1), 0.9) for rows in thirds], 1),
+            position[:, None],
+            vertical[:, None].astype(np.float32),
+            np.ones((n, 1), np.float32),
+        ],
+        axis=1,
+    )
+
+
+def lamp_features(image: np.ndarray, candidates: Sequence[Candidate]) -> np.ndarray:
+    """The (N, :data:`N_FEATURES`) float32 features of ``candidates`` in ``image``."""
+    rows = np.zeros((len(candidates), N_FEATURES), np.float32)
+    housings = [housing_of(c) for c in candidates]
+    boxed = [i for i, h in enumerate(housings) if h is not None]
+    lenses = list(candidates)
+    if boxed:
+        boxes = np.array([housings[i] for i in boxed], np.float64)
+        upright, vertical = upright_housings(image, boxes)
+        hsv = convert(upright, cv2.COLOR_BGR2HSV)
+        rows[boxed, 2 * N_HUE + 9 :] = housing_features(hsv, vertical)
+        found = lit_lenses(boxes, vertical, hsv)
+        for k, i in enumerate(boxed):
+            if candidates[i].housing is None:
+                lenses[i] = found[k]
+    if lenses:
+        rows[:, : 2 * N_HUE + 9] = lens_features(image, lenses)
+    return np.nan_to_num(rows)

@@ -1,0 +1,105 @@
+"""lamp-state: lamps of known colour and position, deterministic training, safe models."""
+
+import cv2
+import numpy as np
+import pytest
+
+import tsrkit
+from tsrkit.models import ModelError, load_model, save_model
+from tsrkit.types import Annotation, Candidate, Frame, Sample
+from tsrkit_plugins.classifiers.lamp_state import STATES
+from tsrkit_plugins.classifiers.lamp_state.features import N_FEATURES, lamp_features
+
+#: BGR of lit lamps as cameras record them (saturated, slightly orange red; amber; blue-green).
+COLOURS = {"red": (40, 40, 230), "yellow": (20, 170, 250), "green": (170, 230, 40)}
+SLOT = {"red": 0, "yellow": 1, "green": 2}
+
+
+def head(state: str, white_core: bool = False, size: int = 20) -> tuple[np.ndarray, tuple]:
+    """A road-grey image with a dark vertical 3-lamp housing whose ``state`` lamp is lit;
+    returns the image and the housing box."""
+    image = np.full((160, 120, 3), (120, 125, 130), np.uint8)
+    x0, y0 = 40, 20
+    box = (x0, y0, x0 + 2 * size, y0 + 6 * size)
+    cv2.rectangle(image, box[:2], (box[2] - 1, box[3] - 1), (25, 25, 25), -1)
+    for k in range(3):
+        centre = (x0 + size, y0 + size + 2 * size * k)
+        cv2.circle(image, centre, int(0.75 * size), (45, 45, 45), -1)
+    centre = (x0 + size, y0 + size + 2 * size * SLOT[state])
+    cv2.circle(image, centre, int(0.75 * size), COLOURS[state], -1)
+    if white_core:
+        cv2.circle(image, centre, int(0.5 * size), (250, 250, 250), -1)
+    return cv2.GaussianBlur(image, (3, 3), 0), box
+
+
+@pytest.mark.parametrize("white_core", [False, True])
+@pytest.mark.parametrize("state", ["red", "yellow", "green"])
+def test_shipped_model_reads_rendered_heads(state, white_core):
+    image, box = head(state, white_core)
+    found = tsrkit.classifier("lamp-state").classify(
+        Frame(image, "head"), [Candidate.from_box(box, 1.0)]
+    )
+    assert found[0].state == state
+    assert found[0].state_scores[state] == max(found[0].state_scores.values())
+
+
+def test_features_see_the_lit_position_and_the_rim():
+    top, box = head("red", white_core=True)
+    bottom, _ = head("green", white_core=True)
+    a, b = (lamp_features(i, [Candidate.from_box(box, 1.0)])[0] for i in (top, bottom))
+    assert a.shape == (N_FEATURES,)
+    position = N_FEATURES - 3  # lit centroid along the housing axis, 0 top .. 1 bottom
+    assert a[position] < 0.3 < 0.7 < b[position]
+    assert a[-1] == 1.0  # has_housing
+    lens_box = [Candidate.from_circle(60, 40, 10, 1.0)]
+    assert lamp_features(top, lens_box)[0][-1] == 0.0
+
+
+def save(path, model):
+    return save_model(path, model, plugin="lamp-state", plugin_version="0", params={}, training={})
+
+
+def samples(tmp_path):
+    out = []
+    for i, state in enumerate(["red", "yellow", "green"] * 4):
+        image, box = head(state, white_core=i % 2 == 1, size=16 + i % 3)
+        path = tmp_path / f"{i}.png"
+        cv2.imwrite(str(path), image)
+        out.append(Sample(str(path), (Annotation(box, state),)))
+    return out
+
+
+def test_training_is_deterministic_and_round_trips(tmp_path):
+    data = samples(tmp_path)
+    first = tsrkit.classifier("lamp-state", iterations=20).fit(data)
+    second = tsrkit.classifier("lamp-state", iterations=20).fit(data)
+    assert first.info == second.info and first.info["states"] == ["red", "yellow", "green"]
+    assert all(np.array_equal(first.arrays[k], second.arrays[k]) for k in first.arrays)
+    path = tmp_path / "model"
+    save(path, first)
+    loaded = tsrkit.classifier("lamp-state", model=str(path))
+    image, box = head("green")
+    assert loaded.classify(Frame(image, "x"), [Candidate.from_box(box, 1.0)])[0].state == "green"
+    assert set(STATES) >= set(load_model(path, "lamp-state").info["states"])
+
+
+def test_corrupt_or_foreign_model_is_one_clear_error(tmp_path):
+    path = tmp_path / "model"
+    save(path, tsrkit.classifier("lamp-state", iterations=10).fit(samples(tmp_path)))
+    npz = path.with_suffix(".npz")
+    npz.write_bytes(npz.read_bytes()[:200])
+    image, box = head("red")
+    with pytest.raises(ModelError, match="model"):
+        tsrkit.classifier("lamp-state", model=str(path)).classify(
+            Frame(image, "x"), [Candidate.from_box(box, 1.0)]
+        )
+    with pytest.raises(ModelError):
+        tsrkit.classifier("lamp-state", model=str(tmp_path / "missing")).classify(
+            Frame(image, "x"), [Candidate.from_box(box, 1.0)]
+        )
+
+
+def test_one_state_is_not_enough(tmp_path):
+    only_red = [s for s in samples(tmp_path) if s.annotations[0].state == "red"]
+    with pytest.raises(tsrkit.TsrkitError, match="need at least two"):
+        tsrkit.classifier("lamp-state").fit(only_red)
