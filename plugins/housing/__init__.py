@@ -1,0 +1,78 @@
+"""``housing``: a verifier stage that fits the signal housing around every candidate's lens.
+
+Works after any detector (``-V housing``): each candidate keeps its lens (``x``, ``y``,
+``radius``, ``lens_bbox`` in records) and gains ``housing`` and ``housing_score``
+(:mod:`.fit`), so records, COCO output and IoU metrics evaluate housing boxes on datasets that
+box housings (``--eval-box housing``). Candidates whose housings overlap a better-scored one's
+are the same light and are dropped (``nms_iou``); ``min_score`` drops poor fits.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import replace
+
+import cv2
+
+from tsrkit.geometry import iou_matrix
+from tsrkit.hookspecs import hookimpl
+from tsrkit.params import Param
+from tsrkit.plugin import Verifier
+from tsrkit.types import Candidate, Frame
+from tsrkit_plugins.housing.fit import fit_housings
+
+
+def suppress(candidates: list[Candidate], threshold: float) -> list[Candidate]:
+    """Greedy non-maximum suppression on the housings of score-ordered ``candidates``."""
+    if threshold >= 1.0 or len(candidates) < 2:
+        return candidates
+    overlap = iou_matrix([c.housing for c in candidates], [c.housing for c in candidates])
+    kept: list[int] = []
+    for i in range(len(candidates)):
+        if all(overlap[i, j] <= threshold for j in kept):
+            kept.append(i)
+    return [candidates[i] for i in kept]
+
+
+class Housing(Verifier):
+    """Fit the dark housing around each candidate's lens; optionally drop poor fits."""
+
+    name = "housing"
+    summary = "housing box around each lens: layout search, edge refinement, darkness score"
+    section = "issue 11 (beyond the documents)"
+    params = (
+        Param(
+            "nms_iou",
+            "float",
+            0.5,
+            min=0.0,
+            max=1.0,
+            help="a candidate whose housing overlaps a better-scored one's by more than this IoU "
+            "is the same light and is dropped (1 keeps all)",
+        ),
+        Param(
+            "min_score",
+            "float",
+            0.0,
+            min=0.0,
+            max=1.0,
+            help="drop candidates whose housing fit scores below this (0 keeps all)",
+        ),
+    )
+
+    def verify(self, frame: Frame, candidates: Sequence[Candidate]) -> list[Candidate]:
+        if not candidates:
+            return []
+        gray = cv2.cvtColor(frame.image, cv2.COLOR_BGR2GRAY)
+        boxes, scores, _ = fit_housings(gray, [(c.x, c.y, c.radius) for c in candidates])
+        fitted = [
+            replace(c, housing=tuple(float(v) for v in box), housing_score=float(score))
+            for c, box, score in zip(candidates, boxes, scores)
+            if score >= self.params["min_score"]
+        ]
+        return suppress(sorted(fitted, key=lambda c: -c.score), self.params["nms_iou"])
+
+
+@hookimpl
+def register_verifiers(register):
+    register(Housing)

@@ -1,0 +1,90 @@
+"""Signal heads of known geometry: a dark housing with 3 or 4 lenses, vertical or horizontal, one
+lamp lit, on a textured background (the test bed of the housing stage, issue 11).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+#: BGR of lit lamps (a slightly orange red, amber, blue-green) by state.
+LAMP_COLOURS = {"red": (40, 40, 230), "yellow": (20, 170, 250), "green": (170, 230, 40)}
+
+
+@dataclass(frozen=True)
+class Head:
+    """A rendered head: the housing box and the lit lens (centre, radius), image coordinates."""
+
+    housing: tuple[float, float, float, float]
+    lens: tuple[float, float, float]
+
+
+def render_head(
+    image: np.ndarray,
+    centre: tuple[float, float],
+    radius: float,
+    lenses: int = 3,
+    lit: int = 0,
+    vertical: bool = True,
+    colour: tuple[int, int, int] = LAMP_COLOURS["red"],
+    white_core: bool = False,
+) -> Head:
+    """Draw a head whose lamp ``lit`` (0 = top or left) has its centre at ``centre``.
+
+    The housing is ``2.8 radius`` across and ``2.8 radius`` per lens along its axis (cells as
+    wide as the housing), dark grey; unlit lenses are darker discs. Drawn in place on ``image``
+    with 4x sub-pixel precision.
+    """
+    pitch = width = 2.8 * radius
+    cx, cy = centre
+    along0 = (cy if vertical else cx) - (lit + 0.5) * pitch
+    if vertical:
+        box = (cx - width / 2, along0, cx + width / 2, along0 + lenses * pitch)
+    else:
+        box = (along0, cy - width / 2, along0 + lenses * pitch, cy + width / 2)
+    shift = 2
+    scale = 1 << shift
+
+    def fixed(v: float) -> int:
+        return int(round(v * scale))
+
+    cv2.rectangle(
+        image,
+        (fixed(box[0]), fixed(box[1])),
+        (fixed(box[2]) - 1, fixed(box[3]) - 1),
+        (28, 28, 30),
+        -1,
+        cv2.LINE_AA,
+        shift,
+    )
+    for k in range(lenses):
+        offset = (k - lit) * pitch
+        x, y = (cx, cy + offset) if vertical else (cx + offset, cy)
+        on = k == lit
+        cv2.circle(
+            image,
+            (fixed(x), fixed(y)),
+            fixed(radius),
+            colour if on else (50, 50, 52),
+            -1,
+            cv2.LINE_AA,
+            shift,
+        )
+        if on and white_core:
+            core = (245, 245, 245)
+            cv2.circle(
+                image, (fixed(x), fixed(y)), fixed(0.6 * radius), core, -1, cv2.LINE_AA, shift
+            )
+    return Head(box, (cx, cy, radius))
+
+
+def background(height: int, width: int, seed: int = 0) -> np.ndarray:
+    """A sky-to-road gradient with mild noise, BGR uint8."""
+    rng = np.random.default_rng(seed)
+    rows = np.linspace(0, 1, height)[:, None, None]
+    sky, road = np.array([215, 190, 160]), np.array([110, 115, 120])
+    image = (sky * (1 - rows) + road * rows) * np.ones((1, width, 1))
+    image += rng.normal(0, 6, image.shape)
+    return np.clip(image, 0, 255).astype(np.uint8)
