@@ -256,8 +256,7 @@ def main() -> None:
     assigned = parse_assignments(args.param)
     names = args.detector or ["lab-frst"]
     ver_params = {k[9:]: v for k, v in assigned.items() if k.startswith("verifier.")}
-    if args.housing:
-        ver_params["train_after"] = args.housing
+    ver_params["after"] = args.housing or ""
     members = [
         reg.create(
             "detector",
@@ -296,8 +295,12 @@ def main() -> None:
             t0 = time.perf_counter()
             train("verifier", open_datasets(refs), model, ver_params, detector)
             fit_s = time.perf_counter() - t0
-            verifier = reg.create("verifier", "verifier", {"model": str(model), "threshold": 0.0})
-            chain = Chain([*housing, verifier])
+            verifier = reg.create(
+                "verifier",
+                "verifier",
+                {"model": str(model), "threshold": 0.0, "after": ver_params["after"]},
+            )
+            chain = Chain([verifier])  # the verifier runs its `after` stage (housing) itself
             ap, rows, pairs = evaluate(tests[s.key], detector, chain, s.box, THRESHOLDS)
             _, nl, _ = evaluate(nolight, detector, chain, "housing", THRESHOLDS)
             folds.setdefault(s.key, {})[mode] = {

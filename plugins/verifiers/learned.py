@@ -55,11 +55,13 @@ class LearnedVerifier(Verifier):
             help="candidates whose probability is below this are rejected",
         ),
         Param(
-            "train_after",
+            "after",
             "str",
-            "",
-            help="training only: a verifier run on the detector's candidates before the "
-            "features are read (e.g. housing), as in the pipeline the model will serve",
+            "housing",
+            help="a verifier run on the candidates before the features are read, in training "
+            "and at run time ('housing': the housing stage fits each candidate's housing, "
+            "whose box the features read and the records report); '' for none. A model "
+            "remembers the stage it was trained after",
         ),
         Param("iterations", "int", 150, min=10, max=2000, help="training: boosting iterations"),
         Param("leaves", "int", 15, min=4, max=255, help="training: leaves per tree"),
@@ -116,6 +118,12 @@ class LearnedVerifier(Verifier):
                     f"this verifier reads version {layout()['version']}); retrain it "
                     "(tsrkit train verifier)"
                 )
+            after = model.info.get("after", "")
+            if after != self.params["after"]:
+                raise ModelError(
+                    f"model {where}: trained after the stage {after!r}, but this verifier runs "
+                    f"after {self.params['after']!r}; set -p after={after} or retrain"
+                )
             self._estimator = load_estimator(model, where)
         return self._estimator
 
@@ -127,6 +135,7 @@ class LearnedVerifier(Verifier):
         return self.estimator.predict_proba(features)[:, 1]
 
     def verify(self, frame: Frame, candidates: Sequence[Candidate]) -> list[Candidate]:
+        candidates = self._stage()(frame, list(candidates))
         probability = self.probabilities(frame, candidates)
         kept = [
             replace(c, score=float(p))
@@ -136,7 +145,7 @@ class LearnedVerifier(Verifier):
         return sorted(kept, key=lambda c: -c.score)
 
     def _stage(self) -> Stage:
-        name = self.params["train_after"]
+        name = self.params["after"]
         if not name:
             return lambda frame, candidates: candidates
         before = get_registry().create("verifier", name)
@@ -188,6 +197,7 @@ class LearnedVerifier(Verifier):
             arrays=estimator_arrays(estimator),
             info={
                 "layout": layout(),
+                "after": self.params["after"],
                 "positives": int(len(positives)),
                 "negatives": int(len(negatives)),
                 "negatives_used": int(len(chosen)),
