@@ -11,8 +11,12 @@ from pathlib import Path
 
 import cv2
 import numpy as np
+from PIL import Image
 
 from tsrkit.errors import TsrkitError
+
+#: Default largest image (decoded pixels) read; ``TSRKIT_MAX_PIXELS`` overrides it.
+MAX_PIXELS = 100_000_000
 
 
 class ImageReadError(TsrkitError):
@@ -34,7 +38,9 @@ def read_image(path: str | os.PathLike) -> np.ndarray:
     Raises
     ------
     ImageReadError
-        With the reason: missing, empty, truncated, or not decodable.
+        With the reason: missing, empty, truncated, larger than :func:`max_pixels` (read from
+        the header before decoding, so a decompression bomb allocates nothing), or not
+        decodable.
     """
     path = Path(path)
     try:
@@ -45,10 +51,15 @@ def read_image(path: str | os.PathLike) -> np.ndarray:
         raise ImageReadError(f"{path}: cannot read ({exc.strerror or exc})") from None
     if data.size == 0:
         raise ImageReadError(f"{path}: empty file")
-    problem = _truncation(data)
+    problem = _truncation(data) or _too_large(path)
     if problem:
         raise ImageReadError(f"{path}: {problem}")
-    image = cv2.imdecode(data, cv2.IMREAD_UNCHANGED)
+    try:
+        image = cv2.imdecode(data, cv2.IMREAD_UNCHANGED)
+    except cv2.error as exc:
+        raise ImageReadError(
+            f"{path}: not decodable ({str(exc).strip().splitlines()[-1]})"
+        ) from None
     if image is None or image.size == 0:
         raise ImageReadError(f"{path}: not a decodable image")
     return to_bgr8(image)
@@ -87,4 +98,29 @@ def _truncation(data: np.ndarray) -> str | None:
         return "truncated JPEG (no end-of-image marker)"
     if head.startswith(b"\x89PNG") and b"IEND" not in tail:
         return "truncated PNG (no IEND chunk)"
+    return None
+
+
+def max_pixels() -> int:
+    """The largest image read, in pixels: ``TSRKIT_MAX_PIXELS`` or :data:`MAX_PIXELS`."""
+    try:
+        return int(os.environ.get("TSRKIT_MAX_PIXELS", MAX_PIXELS))
+    except ValueError:
+        return MAX_PIXELS
+
+
+def _too_large(path: Path) -> str | None:
+    """The refusal of an image whose header declares more than :func:`max_pixels` pixels."""
+    try:
+        with Image.open(path) as image:
+            width, height = image.size
+    except Image.DecompressionBombError as exc:
+        return f"refused: {exc}"
+    except Exception:  # a header Pillow cannot read: OpenCV decides below
+        return None
+    if width * height > max_pixels():
+        return (
+            f"refused: the header declares {width}x{height} = {width * height:,} pixels, more "
+            f"than the limit of {max_pixels():,} (TSRKIT_MAX_PIXELS)"
+        )
     return None

@@ -7,6 +7,7 @@ A plugin lists :class:`Param` objects; values arrive as Python objects (API, YAM
 
 from __future__ import annotations
 
+import math
 import os
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
@@ -155,7 +156,10 @@ def _convert(kind: str, value: Any) -> Any:
     if kind == "float":
         if isinstance(value, bool):
             raise ValueError("not a number")
-        return float(value)
+        number = float(value)
+        if not math.isfinite(number):
+            raise ValueError("not a finite number")
+        return number
     if kind in ("str", "path"):
         if not isinstance(value, str):
             raise ValueError("not a string")

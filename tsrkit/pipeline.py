@@ -5,6 +5,7 @@
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, replace
 from typing import Any
@@ -28,6 +29,17 @@ class FrameResult:
     def to_record(self) -> dict[str, Any]:
         """The JSON Lines record of ``tsrkit detect`` (``FrameRecord.to_json``)."""
         return FrameRecord.from_result(self).to_json()
+
+
+def check_detection(detection: Detection) -> None:
+    """Raise ValueError for a detection whose lens or housing is not finite or has no area
+    (a plugin bug: the frame is then skipped with this reason, the run goes on)."""
+    c = detection.candidate
+    boxes = [c.bbox] + ([c.housing] if c.housing is not None else [])
+    for x0, y0, x1, y1 in boxes:
+        values = (c.x, c.y, c.radius, x0, y0, x1, y1)
+        if not all(math.isfinite(v) for v in values) or x1 < x0 or y1 < y0:
+            raise ValueError(f"invalid detection box {(x0, y0, x1, y1)} at ({c.x}, {c.y})")
 
 
 def as_detections(candidates: list[Candidate]) -> list[Detection]:
@@ -68,6 +80,8 @@ class Pipeline:
             detections = [
                 replace(s, origin=d.origin, track_id=d.track_id) for s, d in zip(states, detections)
             ]
+        for detection in detections:
+            check_detection(detection)
         ms = (time.perf_counter() - start) * 1000.0
         return FrameResult(
             frame.source, frame.index, frame.width, frame.height, ms, tuple(detections)

@@ -7,10 +7,12 @@ The format comes from the registry entry, from the caller, or from the format pl
 from __future__ import annotations
 
 import dataclasses
+import math
 import os
 from collections.abc import Mapping
 from pathlib import Path
 
+from tsrkit.datasets.errors import DatasetError
 from tsrkit.datasets.registry import DatasetEntry, load_registry
 from tsrkit.datasets.states import check_mapping, to_state
 from tsrkit.errors import TsrkitError
@@ -71,9 +73,32 @@ def open_dataset(
 
 
 def read_dataset(path: Path, format: str, images: Path | None = None) -> Dataset:
-    """Read ``path`` with the format plugin called ``format``."""
+    """Read ``path`` with the format plugin called ``format``; every box is checked.
+
+    Raises
+    ------
+    DatasetError
+        A malformed file: the reader's own error, or one made here of what a reader let
+        through (invalid UTF-8, values of the wrong type, a box that is not finite or has no
+        area), naming the file and the problem.
+    """
     reader = get_registry().create("format", format)
-    return reader.read(Path(path), images)
+    try:
+        dataset = reader.read(Path(path), images)
+    except TsrkitError:
+        raise
+    except (UnicodeDecodeError, TypeError, KeyError, IndexError, ValueError, AttributeError) as exc:
+        problem = f"malformed {format} data ({type(exc).__name__}: {exc})"
+        raise DatasetError(path, problem) from None
+    for sample in dataset.samples:
+        for k, ann in enumerate(sample.annotations):
+            x0, y0, x1, y1 = (float(v) for v in ann.bbox)
+            if not all(math.isfinite(v) for v in (x0, y0, x1, y1)) or x1 <= x0 or y1 <= y0:
+                where = f"{Path(sample.source).name}, box {k}"
+                raise DatasetError(
+                    path, f"box {tuple(ann.bbox)} is not finite or has no area", where
+                )
+    return dataset
 
 
 def detect_format(path: Path) -> str:

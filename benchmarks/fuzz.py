@@ -1,0 +1,182 @@
+"""Mutation fuzzing of tsrkit's input surfaces: counts the cases that end in an exception other
+than tsrkit's own clear errors (issue 15: the target is 0).
+
+Surfaces:
+- ``image``: a small PNG and a small JPEG with random byte flips, insertions, deletions,
+  truncations and header-size rewrites, through ``tsrkit.images.read_image`` (allowed:
+  ``ImageReadError``);
+- ``coco``, ``normalized``, ``voc``, ``yolo``: the annotation files tsrkit writes for a 4-frame
+  synthetic set, mutated the same way, through ``open_dataset`` (allowed: ``TsrkitError``);
+- ``params``: random strings and numbers for every parameter type (allowed: ``ParamError``).
+
+    python benchmarks/fuzz.py [--cases 10000] [--seed 0]
+"""
+
+from __future__ import annotations
+
+import argparse
+import shutil
+import tempfile
+import time
+import traceback
+from collections import Counter
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from tsrkit.datasets import open_dataset
+from tsrkit.errors import TsrkitError
+from tsrkit.images import read_image
+from tsrkit.params import Param, validate
+from tsrkit.registry import get_registry
+from tsrkit.synth import generate
+from tsrkit.types import Dataset
+
+
+def mutate(data: bytes, rng: np.random.Generator) -> bytes:
+    """One to four random byte-level mutations of ``data``; new bytes of a text file are
+    printable ASCII 9 times in 10 (so that parsers, not only the UTF-8 decoder, are reached)."""
+    out = bytearray(data)
+    try:
+        data.decode("utf-8")
+        low = 32 if rng.random() < 0.9 else 0
+    except UnicodeDecodeError:
+        low = 0
+    high = 127 if low else 256
+    for _ in range(int(rng.integers(1, 5))):
+        kind = int(rng.integers(0, 5))
+        at = int(rng.integers(0, max(len(out), 1)))
+        if kind == 0 and out:  # flip a byte
+            out[at] = int(rng.integers(low, high))
+        elif kind == 1:  # insert random bytes
+            out[at:at] = rng.integers(low, high, int(rng.integers(1, 9)), dtype=np.uint8).tobytes()
+        elif kind == 2 and out:  # delete a run
+            del out[at : at + int(rng.integers(1, 17))]
+        elif kind == 3:  # truncate
+            del out[at:]
+        else:  # a digit or quote changed (structured text) / a size field made huge (binary)
+            for symbol in (b'"', b"0", b"1", b"<", b","):
+                index = out.find(symbol, at)
+                if index >= 0:
+                    out[index : index + 1] = rng.choice([b"9999999999", b"-1", b"nan", b"", b'"'])
+                    break
+    return bytes(out)
+
+
+def fuzz(name: str, seeds: list[bytes], target, cases: int, rng, allowed) -> Counter:
+    """Run ``cases`` mutations of ``seeds`` through ``target(bytes)``; count outcomes."""
+    counts: Counter = Counter()
+    for k in range(cases):
+        data = mutate(seeds[k % len(seeds)], rng)
+        try:
+            target(data)
+            counts["accepted"] += 1
+        except allowed as exc:
+            counts["clear error"] += 1
+            # the reader let a Python error through and read_dataset's safety net named it
+            counts["net"] += "data (" in str(exc) and "malformed" in str(exc)
+        except Exception as exc:
+            key = f"UNCAUGHT {type(exc).__name__}: {str(exc)[:80]}"
+            if counts[key] == 0:
+                print(f"[{name}] {key}\n{traceback.format_exc(limit=3)}")
+            counts[key] += 1
+    return counts
+
+
+def image_surface(folder: Path):
+    seeds = []
+    image = np.random.default_rng(1).integers(0, 255, (24, 32, 3), dtype=np.uint8)
+    for ext in (".png", ".jpg"):
+        ok, encoded = cv2.imencode(ext, image)
+        assert ok
+        seeds.append(encoded.tobytes())
+    path = folder / "case.img"
+
+    def target(data: bytes) -> None:
+        path.write_bytes(data)
+        read_image(path)
+
+    return seeds, target, TsrkitError
+
+
+def format_surface(folder: Path, fmt: str, dataset: Dataset):
+    out = folder / fmt
+    get_registry().create("format", fmt).write(
+        dataset, out / ("annotations.json" if fmt in ("coco", "normalized") else "data")
+    )
+    files = sorted(
+        p for p in out.rglob("*") if p.is_file() and p.suffix in (".json", ".xml", ".txt", ".yaml")
+    )
+    seeds = [p.read_bytes() for p in files]
+    ref = out / ("annotations.json" if fmt in ("coco", "normalized") else "data")
+
+    def target(data: bytes) -> None:
+        victim = files[target.k % len(files)]  # type: ignore[attr-defined]
+        target.k += 1  # type: ignore[attr-defined]
+        original = victim.read_bytes()
+        victim.write_bytes(data)
+        try:
+            open_dataset(ref, format=fmt)
+        finally:
+            victim.write_bytes(original)
+
+    target.k = 0  # type: ignore[attr-defined]
+    return seeds, target, TsrkitError
+
+
+def params_surface():
+    schema = [
+        Param("f", "float", 0.5, min=0, max=1),
+        Param("i", "int", 3, min=1),
+        Param("fs", "floats", (1.0, 1.0), length=2),
+        Param("is", "ints", (1, 2)),
+        Param("b", "bool", True),
+        Param("s", "str", "max", choices=("max", "min")),
+    ]
+    names = [p.name for p in schema]
+    seeds = [b"0.5", b"3", b"1,1", b"1..3", b"true", b"max"]
+
+    def target(data: bytes) -> None:
+        text = data.decode("utf-8", "replace")
+        validate(schema, {names[target.k % len(names)]: text}, "fuzz")  # type: ignore[attr-defined]
+        target.k += 1  # type: ignore[attr-defined]
+
+    target.k = 0  # type: ignore[attr-defined]
+    from tsrkit.params import ParamError
+
+    return seeds, target, ParamError
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--cases", type=int, default=10000)
+    parser.add_argument("--seed", type=int, default=0)
+    args = parser.parse_args()
+    rng = np.random.default_rng(args.seed)
+    folder = Path(tempfile.mkdtemp(prefix="tsrkit-fuzz-"))
+    try:
+        data = generate(folder / "synth", 4, seed=5, width=96, height=64)
+        surfaces = {"image": image_surface(folder)}
+        for fmt in ("coco", "normalized", "voc", "yolo"):
+            surfaces[fmt] = format_surface(folder, fmt, data)
+        surfaces["params"] = params_surface()
+        total_uncaught = 0
+        for name, (seeds, target, allowed) in surfaces.items():
+            start = time.perf_counter()
+            counts = fuzz(name, seeds, target, args.cases, rng, allowed)
+            uncaught = sum(n for k, n in counts.items() if k.startswith("UNCAUGHT"))
+            total_uncaught += uncaught
+            print(
+                f"{name:10s} {args.cases} cases in {time.perf_counter() - start:5.1f} s: "
+                f"accepted {counts['accepted']}, clear error {counts['clear error']} "
+                f"(of which by the readers' safety net {counts['net']}), uncaught {uncaught}",
+                flush=True,
+            )
+        print(f"total uncaught: {total_uncaught}")
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    main()
