@@ -13,6 +13,7 @@ def register_commands(cli):
     from tsrkit.cli.detect import detect_command
     from tsrkit.cli.plugins_cmd import plugins_command
     from tsrkit.cli.presets_cmd import presets_command
+    from tsrkit.cli.track import track_command
     from tsrkit.cli.train import train_command
 
     for command in (
@@ -23,5 +24,6 @@ def register_commands(cli):
         benchmark_command,
         compare_command,
         presets_command,
+        track_command,
     ):
         cli.add_command(command)

@@ -1,0 +1,144 @@
+"""GPS logs: the whitespace ``dd-Mon-yyyy hh:mm:ss lat lon`` format and CSV, and positions at
+frame times (Zheng 2016, 4.3, Eq. 4.1-4.2)."""
+
+from __future__ import annotations
+
+import csv
+import math
+import os
+from dataclasses import dataclass
+from datetime import UTC, datetime
+from pathlib import Path
+
+import numpy as np
+
+from tsrkit.geo.errors import GeoError
+
+
+@dataclass(frozen=True)
+class Track:
+    """GPS fixes in time order: UTC seconds since the epoch, latitude and longitude (degrees)."""
+
+    source: str
+    time: np.ndarray
+    lat: np.ndarray
+    lon: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.time)
+
+    def at(self, times: np.ndarray, max_gap: float = 5.0) -> tuple[np.ndarray, np.ndarray]:
+        """Latitude and longitude at ``times`` by linear interpolation between the two fixes
+        around each (Eq. 4.2); NaN where the fixes are more than ``max_gap`` seconds apart or
+        ``times`` lie outside the track: a gap is reported, never bridged."""
+        times = np.asarray(times, np.float64)
+        right = np.clip(np.searchsorted(self.time, times), 1, len(self.time) - 1)
+        left = right - 1
+        span = self.time[right] - self.time[left]
+        w = np.where(span > 0, (times - self.time[left]) / np.where(span > 0, span, 1), 0.0)
+        lat = self.lat[left] + w * (self.lat[right] - self.lat[left])
+        lon = self.lon[left] + w * (self.lon[right] - self.lon[left])
+        bad = (span > max_gap) | (times < self.time[0]) | (times > self.time[-1])
+        return np.where(bad, np.nan, lat), np.where(bad, np.nan, lon)
+
+    def gaps(self, max_gap: float = 5.0) -> list[tuple[float, float]]:
+        """(start, end) UTC seconds of every gap between fixes longer than ``max_gap``."""
+        step = np.diff(self.time)
+        return [
+            (float(self.time[i]), float(self.time[i + 1])) for i in np.flatnonzero(step > max_gap)
+        ]
+
+
+def _whitespace_time(date: str, clock: str) -> float:
+    stamp = datetime.strptime(f"{date} {clock}", "%d-%b-%Y %H:%M:%S")
+    return stamp.replace(tzinfo=UTC).timestamp()
+
+
+def _csv_time(text: str) -> float:
+    try:
+        return float(text)
+    except ValueError:
+        stamp = datetime.fromisoformat(text.replace("Z", "+00:00"))
+        if stamp.tzinfo is None:
+            stamp = stamp.replace(tzinfo=UTC)
+        return stamp.timestamp()
+
+
+def _rows(path: Path) -> tuple[list[tuple[int, float, float, float]], str]:
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise GeoError(path, "no such file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise GeoError(path, f"cannot read as UTF-8 text ({exc})") from None
+    lines = text.splitlines()
+    rows = []
+    if path.suffix.lower() == ".csv":
+        reader = csv.reader(lines)
+        header = [h.strip().lower() for h in next(reader, [])]
+        missing = {"time", "lat", "lon"} - set(header)
+        if missing:
+            raise GeoError(path, f"CSV header lacks {', '.join(sorted(missing))}", 1)
+        index = [header.index(k) for k in ("time", "lat", "lon")]
+        for number, fields in enumerate(reader, start=2):
+            if not fields or not "".join(fields).strip():
+                continue
+            if len(fields) < len(header):
+                raise GeoError(path, f"expected {len(header)} columns, got {len(fields)}", number)
+            try:
+                t, la, lo = (
+                    _csv_time(fields[index[0]]),
+                    float(fields[index[1]]),
+                    float(fields[index[2]]),
+                )
+            except ValueError as exc:
+                raise GeoError(
+                    path, f"not a time, latitude and longitude ({exc})", number
+                ) from None
+            rows.append((number, t, la, lo))
+        return rows, "csv"
+    for number, line in enumerate(lines, start=1):
+        fields = line.split()
+        if not fields or fields[0].lower().startswith("date"):
+            continue
+        if len(fields) != 4:
+            raise GeoError(
+                path, f"expected 'dd-Mon-yyyy hh:mm:ss lat lon', got {len(fields)} fields", number
+            )
+        try:
+            rows.append(
+                (number, _whitespace_time(fields[0], fields[1]), float(fields[2]), float(fields[3]))
+            )
+        except ValueError as exc:
+            raise GeoError(
+                path, f"not a date, time, latitude and longitude ({exc})", number
+            ) from None
+    return rows, "whitespace"
+
+
+def read_track(path: str | os.PathLike) -> Track:
+    """Read a GPS log: CSV with a ``time,lat,lon`` header (time as UTC seconds or ISO 8601) or
+    the whitespace ``dd-Mon-yyyy hh:mm:ss lat lon`` lines of the Seattle drive.
+
+    Raises
+    ------
+    GeoError
+        Naming the file and line: missing file, invalid text, wrong column count, a value that
+        is not a number, NaN, a latitude or longitude out of range, times not increasing, or
+        no fix at all.
+    """
+    path = Path(path)
+    rows, _ = _rows(path)
+    if not rows:
+        raise GeoError(path, "no GPS fix in the file")
+    previous = -math.inf
+    for number, t, la, lo in rows:
+        if not all(math.isfinite(v) for v in (t, la, lo)):
+            raise GeoError(path, "time, latitude or longitude is not finite", number)
+        if not -90 <= la <= 90 or not -180 <= lo <= 180:
+            raise GeoError(path, f"latitude {la} / longitude {lo} out of range", number)
+        if t <= previous:
+            raise GeoError(path, "times are not increasing (sort the log)", number)
+        previous = t
+    columns = np.array([row[1:] for row in rows], np.float64)
+    return Track(str(path), columns[:, 0], columns[:, 1], columns[:, 2])
