@@ -114,6 +114,7 @@ def test_writers_list_their_files_and_can_be_chosen(tmp_path):
         "frames.csv",
         "ground_truth.coco.json",
         "headline.csv",
+        "report.html",
         "report.json",
         "summary.md",
     ]
