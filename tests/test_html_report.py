@@ -63,3 +63,23 @@ def test_page_loads_in_chromium_with_the_report_numbers(run_dir, tmp_path):
         browser.close()
     assert (tmp_path / "report.png").stat().st_size > 10_000
     assert errors == []
+
+
+def test_report_verb_re_renders_a_run_and_a_compare_folder(run_dir, tmp_path):
+    from click.testing import CliRunner
+
+    from tsrkit.cli.main import cli
+
+    before = (run_dir / "report.html").read_text()
+    (run_dir / "report.html").unlink()
+    result = CliRunner().invoke(cli, ["report", str(run_dir)])
+    assert result.exit_code == 0, result.output
+    assert (run_dir / "report.html").read_text() == before  # same run, same page
+    out = tmp_path / "cmp"
+    detectors = [tsrkit.detector("gray-tophat"), tsrkit.detector("conspicuity")]
+    tsrkit.compare(tsrkit.dataset("sample"), detectors, out=out, cache=False)
+    assert CliRunner().invoke(cli, ["report", str(out)]).exit_code == 0
+    page = (out / "compare.html").read_text()
+    assert "gray-tophat" in page and 'href="conspicuity/report.html"' in page
+    bad = CliRunner().invoke(cli, ["report", str(tmp_path)])
+    assert bad.exit_code != 0 and "not a run folder" in bad.output

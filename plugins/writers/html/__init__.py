@@ -256,3 +256,10 @@ class HtmlReport(ReportWriter):
 @hookimpl
 def register_report_writers(register):
     register(HtmlReport)
+
+
+@hookimpl
+def register_commands(cli):
+    from tsrkit_plugins.writers.html.verb import report_command
+
+    cli.add_command(report_command)
