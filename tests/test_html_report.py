@@ -83,3 +83,15 @@ def test_report_verb_re_renders_a_run_and_a_compare_folder(run_dir, tmp_path):
     assert "gray-tophat" in page and 'href="conspicuity/report.html"' in page
     bad = CliRunner().invoke(cli, ["report", str(tmp_path)])
     assert bad.exit_code != 0 and "not a run folder" in bad.output
+
+
+def test_compare_html_flag_writes_the_compare_page(tmp_path):
+    from click.testing import CliRunner
+
+    from tsrkit.cli.main import cli
+
+    out = tmp_path / "cmp"
+    args = ["compare", "--detectors", "gray-tophat,conspicuity", "--html", "-q", "-w", "1"]
+    result = CliRunner().invoke(cli, [*args, "-o", str(out), "--no-cache"])
+    assert result.exit_code == 0, result.output
+    assert 'href="gray-tophat/report.html"' in (out / "compare.html").read_text()

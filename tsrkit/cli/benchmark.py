@@ -220,8 +220,15 @@ def benchmark_command(
     help="YAML run configuration or preset name (tsrkit presets): its verifier, classifier "
     "and their params.",
 )
+@click.option(
+    "--html",
+    is_flag=True,
+    help="Also write OUT/compare.html (the `report` verb, when a plugin registers it).",
+)
 @run_options
+@click.pass_context
 def compare_command(
+    ctx,
     dataset_ref,
     format_name,
     images,
@@ -241,6 +248,7 @@ def compare_command(
     quiet,
     eval_box,
     writers,
+    html,
 ) -> None:
     """Benchmark several detectors on the same frames; one report side by side.
 
@@ -262,6 +270,11 @@ def compare_command(
         config=config,
         without_verifier=without_verifier,
     )
+    if html:
+        report = ctx.find_root().command.get_command(ctx, "report")
+        if report is None:
+            raise click.UsageError("--html needs the `report` verb (the html writer plugin)")
+        ctx.invoke(report, run_dir=out)
 
 
 def run_compare(
