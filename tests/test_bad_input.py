@@ -120,3 +120,27 @@ def test_a_detector_returning_an_invalid_box_costs_the_frame_not_the_run():
     sample = Sample("x", image=np.zeros((10, 10, 3), np.uint8))
     record = process_sample(0, sample, Job(NaNDetector(), None, "nan", None))
     assert record.skipped is not None and "invalid detection box" in record.skipped
+
+
+def test_a_run_whose_inputs_were_all_skipped_exits_non_zero(tmp_path):
+    folder = tmp_path / "bad"
+    folder.mkdir()
+    (folder / "a.png").write_bytes(b"not an image")
+    png_header_lie(folder / "b.png", 40000, 40000)
+    result = CliRunner().invoke(cli, ["detect", str(folder), "-d", "gray-tophat"])
+    assert result.exit_code == 1 and "all 2 inputs were skipped" in result.output
+    good = tmp_path / "good"
+    good.mkdir()
+    cv2.imwrite(str(good / "g.png"), np.zeros((20, 20, 3), np.uint8))
+    (good / "a.png").write_bytes(b"not an image")
+    assert CliRunner().invoke(cli, ["detect", str(good), "-d", "gray-tophat"]).exit_code == 0
+
+
+def test_a_benchmark_whose_frames_were_all_skipped_exits_non_zero(tmp_path):
+    (tmp_path / "a.png").write_bytes(b"not an image")
+    boxes = [{"label": "red", "x_min": 1, "y_min": 1, "x_max": 5, "y_max": 5}]
+    entries = [{"file": "a.png", "width": 20, "height": 20, "boxes": boxes}]
+    (tmp_path / "annotations.json").write_text(json.dumps(entries))
+    args = ["benchmark", "--dataset", str(tmp_path / "annotations.json"), "-d", "gray-tophat"]
+    result = CliRunner().invoke(cli, [*args, "-q", "-o", str(tmp_path / "out"), "--no-cache"])
+    assert result.exit_code == 1 and "all 1 inputs were skipped" in result.output

@@ -186,6 +186,9 @@ def benchmark_command(
     )
     print_table([report])
     click.echo(f"report: {os.path.join(out, 'report.json')}", err=True)
+    if report["frames"] == 0 and report["skipped"]:
+        click.echo(f"error: all {len(report['skipped'])} inputs were skipped", err=True)
+        raise SystemExit(1)
 
 
 @click.command("compare")

@@ -139,3 +139,6 @@ def detect_command(
     )
     for item in skipped:
         console.print(f"  skipped {item.source}: {item.reason}", markup=False)
+    if frames == 0 and skipped:
+        console.print(f"error: all {len(skipped)} inputs were skipped", markup=False)
+        raise SystemExit(1)
