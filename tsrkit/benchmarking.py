@@ -12,6 +12,7 @@ them after the metrics are computed.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import time
@@ -24,6 +25,7 @@ import numpy as np
 
 from tsrkit.engine import BenchmarkError, Job, default_cache_dir, plugin_identity, run_records
 from tsrkit.eval.settings import EvalSettings, not_exhaustive_note, resolve_box
+from tsrkit.outlock import locked
 from tsrkit.plugin import Classifier, Detector, Metric, ReportWriter, Verifier
 from tsrkit.records import FrameRecord
 from tsrkit.registry import get_registry
@@ -168,7 +170,8 @@ def run_benchmark(
         verifier,
     )
     label = (detector or classifier).name  # type: ignore[union-attr]
-    with ProgressBar(len(dataset), progress, label) as bar:
+    lock = locked(out) if out is not None else contextlib.nullcontext()
+    with lock, ProgressBar(len(dataset), progress, label) as bar:
         records = bar.track(run_records(dataset.samples, job, workers, engine, scheduler))
         return evaluate(
             dataset,
