@@ -119,6 +119,8 @@ def evaluate(
         "frames_cached": cached,
     }
     notes = [] if settings.exhaustive else [not_exhaustive_note(dataset.name)]
+    counted = sections.get("frame_notes", {}).get("counts", {})
+    notes += [f"{n} of {len(kept)} frames: {text}" for text, n in counted.items()]
 
     def report(files: Sequence[str]) -> dict[str, Any]:
         return build_report(

@@ -134,7 +134,15 @@ def classify_annotations(classifier: Classifier, frame: Frame, sample: Sample) -
     start = time.perf_counter()
     detections = classifier.classify(frame, candidates)
     ms = (time.perf_counter() - start) * 1000.0
-    return FrameResult(frame.source, frame.index, frame.width, frame.height, ms, tuple(detections))
+    return FrameResult(
+        frame.source,
+        frame.index,
+        frame.width,
+        frame.height,
+        ms,
+        tuple(detections),
+        classifier.notes,
+    )
 
 
 _WORKER_JOB: Job | None = None

@@ -25,6 +25,7 @@ class FrameResult:
     height: int
     ms: float
     detections: tuple[Detection, ...]
+    notes: tuple[str, ...] = ()
 
     def to_record(self) -> dict[str, Any]:
         """The JSON Lines record of ``tsrkit detect`` (``FrameRecord.to_json``)."""
@@ -83,6 +84,8 @@ class Pipeline:
         for detection in detections:
             check_detection(detection)
         ms = (time.perf_counter() - start) * 1000.0
+        stages = (self.detector, self.verifier, self.tracker, self.classifier)
+        notes = tuple(n for p in stages if p is not None for n in p.notes)
         return FrameResult(
-            frame.source, frame.index, frame.width, frame.height, ms, tuple(detections)
+            frame.source, frame.index, frame.width, frame.height, ms, tuple(detections), notes
         )

@@ -34,6 +34,9 @@ class Plugin(ABC):  # noqa: B024 - the ABC metaclass serves the kinds' abstract 
     params: ClassVar[tuple[Param, ...]] = ()
     #: Set when the plugin's own version differs from its distribution's.
     version: ClassVar[str | None] = None
+    #: What the plugin has to say about the frame it last processed (e.g. that it fell back to
+    #: a simpler model); the pipeline copies it into the frame's record and reports count it.
+    notes: tuple[str, ...] = ()
 
     def __init__(self, **params):
         self.params = params

@@ -124,6 +124,7 @@ class FrameRecord:
     detections: tuple[DetectionRecord, ...] = ()
     skipped: str | None = None
     cached: bool = field(default=False, compare=False)
+    notes: tuple[str, ...] = ()
 
     @classmethod
     def from_result(cls, result, lighting: str | None = None) -> FrameRecord:
@@ -136,11 +137,12 @@ class FrameRecord:
             result.ms,
             lighting,
             tuple(DetectionRecord.from_detection(d) for d in result.detections),
+            notes=tuple(result.notes),
         )
 
     def to_json(self) -> dict[str, Any]:
-        """``{"source", "frame", "width", "height", "ms", ["lighting"], "detections"}``, or
-        ``{"source", "frame", "skipped"}``."""
+        """``{"source", "frame", "width", "height", "ms", ["lighting"], "detections",
+        ["notes"]}``, or ``{"source", "frame", "skipped"}``."""
         if self.skipped is not None:
             return {"source": self.source, "frame": self.index, "skipped": self.skipped}
         out: dict[str, Any] = {
@@ -153,6 +155,8 @@ class FrameRecord:
         if self.lighting is not None:
             out["lighting"] = self.lighting
         out["detections"] = [d.to_json() for d in self.detections]
+        if self.notes:
+            out["notes"] = list(self.notes)
         return out
 
     @classmethod
@@ -168,4 +172,5 @@ class FrameRecord:
             data["ms"],
             data.get("lighting"),
             tuple(DetectionRecord.from_json(d) for d in data["detections"]),
+            notes=tuple(str(n) for n in data.get("notes", ())),
         )

@@ -32,10 +32,10 @@ def trainable_plugin(name: str) -> PluginInfo:
             f"no trainable plugin called '{name}' (trainable: "
             f"{', '.join(known) or 'none installed'})"
         )
-    info = candidates[0]
-    if not is_trainable(info.cls):
-        raise TsrkitError(f"{info.kind} '{name}' is not trainable")
-    return info
+    trainable = [info for info in candidates if is_trainable(info.cls)]
+    if not trainable:
+        raise TsrkitError(f"{candidates[0].kind} '{name}' is not trainable")
+    return trainable[0]
 
 
 def dataset_checksum(dataset: Dataset) -> str:

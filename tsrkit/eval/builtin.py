@@ -6,6 +6,7 @@ says), so every report has the sections DESIGN.md promises.
 
 from tsrkit.eval.categories import LightingBySize
 from tsrkit.eval.coco import CocoAP
+from tsrkit.eval.notes import FrameNotes
 from tsrkit.eval.overlap import OverlapPR
 from tsrkit.eval.perframe import ZhengPerFrame
 from tsrkit.eval.state import StateMetric
@@ -14,5 +15,5 @@ from tsrkit.hookspecs import hookimpl
 
 @hookimpl
 def register_metrics(register):
-    for metric in (ZhengPerFrame, OverlapPR, CocoAP, StateMetric, LightingBySize):
+    for metric in (ZhengPerFrame, OverlapPR, CocoAP, StateMetric, LightingBySize, FrameNotes):
         register(metric)
