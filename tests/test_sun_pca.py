@@ -146,3 +146,17 @@ def test_a_model_of_the_wrong_shape_is_one_clear_error(tmp_path, scenes):
     classifier = get_registry().create("classifier", "sun-pca", {"model": str(path)})
     with pytest.raises(ModelError, match="not a sun-pca model"):
         classifier.classify(scenes.samples[0].load(), [Candidate.from_circle(5, 5, 3, 1.0)])
+
+
+def test_a_gps_log_and_a_start_time_give_every_video_frame_its_sun(tmp_path, scenes):
+    log = tmp_path / "drive.csv"
+    rows = [f"2016-06-20T15:04:{i:02d}Z,40.4433,{-79.9436 + 1e-4 * i:.6f}" for i in range(10)]
+    log.write_text("time,lat,lon\n" + "\n".join(rows) + "\n")
+    params = {"gps": str(log), "start_utc": "2016-06-20T15:04:00Z"}
+    detector = get_registry().create("detector", "sun-pca", params)
+    frame = scenes.samples[0].load()
+    for timestamp in (0.0, 4.5, 9.0):
+        detector.detect(replace(frame, metadata={}, timestamp=timestamp))
+        assert detector.notes == ()
+    detector.detect(replace(frame, metadata={}, timestamp=60.0))  # past the log's end
+    assert detector.notes == (FALLBACK_NOTE,)

@@ -65,5 +65,7 @@ def test_frame_facts_prefer_the_frame_then_settings_then_the_gps_track():
     own = frame_facts({"heading_deg": 45.0}, 5.0, {"start_utc": 100.0, "heading_deg": 0.0}, track)
     assert own["heading_deg"] == 45.0
     assert frame_facts({}, None, {"lat": 1.0}) == {"lat": 1.0}
+    # At the track's first fix the heading comes from the fixes after it.
+    assert frame_facts({}, 0.0, {"start_utc": 100.0}, track)["heading_deg"] == pytest.approx(90.0)
     # Outside the track: no position, so no Sun view (the fallback).
     assert sun_view(frame_facts({}, 50.0, {"start_utc": 100.0}, track)) is None

@@ -126,9 +126,10 @@ def sun_view(facts: Mapping[str, Any]) -> SunView | None:
 
 def track_facts(track: Track, utc: float, span_s: float = 1.0) -> dict[str, float]:
     """Position and heading at ``utc`` from a GPS track: the interpolated fix (Zheng Eq. 4.2)
-    and the bearing from ``span_s`` before to ``span_s`` after it; empty when the track has no
-    fix there (outside it, or in a gap) or the car stands still."""
-    times = np.array([utc - span_s, utc, utc + span_s])
+    and the bearing from ``span_s`` before to ``span_s`` after it (within the track's ends);
+    empty when the track has no fix there (outside it, or in a gap) or the car stands still."""
+    start, end = float(track.time[0]), float(track.time[-1])
+    times = np.array([max(utc - span_s, start), utc, min(utc + span_s, end)])
     lat, lon = track.at(times)
     if not np.all(np.isfinite(lat)) or (lat[0] == lat[2] and lon[0] == lon[2]):
         return {}
