@@ -41,6 +41,8 @@ def check_detection(detection: Detection) -> None:
         values = (c.x, c.y, c.radius, x0, y0, x1, y1)
         if not all(math.isfinite(v) for v in values) or x1 < x0 or y1 < y0:
             raise ValueError(f"invalid detection box {(x0, y0, x1, y1)} at ({c.x}, {c.y})")
+    if c.distance_m is not None and not (math.isfinite(c.distance_m) and c.distance_m > 0):
+        raise ValueError(f"invalid distance {c.distance_m} m at ({c.x}, {c.y})")
 
 
 def as_detections(candidates: list[Candidate]) -> list[Detection]:

@@ -44,6 +44,7 @@ class DetectionRecord:
     origin: str = "detected"
     housing_score: float | None = None
     track_id: int | None = None
+    distance_m: float | None = None
 
     @classmethod
     def from_detection(cls, detection) -> DetectionRecord:
@@ -61,6 +62,7 @@ class DetectionRecord:
             detection.origin,
             None if c.housing_score is None else round(float(c.housing_score), 4),
             detection.track_id,
+            None if c.distance_m is None else round(float(c.distance_m), DECIMALS),
         )
 
     def box(self, which: str) -> Box:
@@ -86,6 +88,8 @@ class DetectionRecord:
             out["housing_score"] = self.housing_score
         if self.track_id is not None:
             out["track_id"] = self.track_id
+        if self.distance_m is not None:
+            out["distance_m"] = self.distance_m
         return out
 
     @classmethod
@@ -104,6 +108,7 @@ class DetectionRecord:
             data.get("origin", "detected"),
             data.get("housing_score"),
             data.get("track_id"),
+            data.get("distance_m"),
         )
 
 

@@ -42,6 +42,9 @@ class Candidate:
         stage has fitted one; ``bbox`` stays the lens box.
     housing_score : float or None
         How well that housing fits, in [0, 1].
+    distance_m : float or None
+        Distance from the camera in metres, when the detector knows the target's real size
+        (:func:`tsrkit.depth.distance_from_height`).
     """
 
     x: float
@@ -52,6 +55,7 @@ class Candidate:
     state: str | None = None
     housing: Box | None = None
     housing_score: float | None = None
+    distance_m: float | None = None
 
     @property
     def lens_bbox(self) -> Box:
