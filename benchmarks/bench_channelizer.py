@@ -23,8 +23,18 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--frames", type=int, default=200)
     parser.add_argument("--seed", type=int, default=2017)
+    parser.add_argument(
+        "-p",
+        "--param",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="a channelizer parameter, e.g. edge_image=max",
+    )
     args = parser.parse_args()
-    detector = get_registry().create("detector", "channelizer", {})
+    detector = get_registry().create(
+        "detector", "channelizer", dict(kv.split("=", 1) for kv in args.param)
+    )
     data = generate(args.frames, seed=args.seed)
     tp = fp = 0
     truth, found, errors = [], [], []

@@ -99,6 +99,9 @@ class Channelizer(Detector):
         Param("horizon", "float", 0.5, min=0.0, max=1.0, section="3.5",
               help="vanishing point row as a fraction of the height, when the frame's metadata "
               "has no horizon_y; the search looks below it"),
+        Param("edge_image", "str", "max", choices=("gray", "max"), section="3.5 (I not given)",
+              help="the image I the diagonal filters see: gray, or each BGR channel with the "
+              "largest magnitude kept (orange and white differ most in blue)"),
         Param("edge_threshold", "float", 60.0, min=0.0, section="3.5 (value not given; ours)",
               help="I_diag level of a stripe edge"),
         Param("min_column_edges", "int", 3, min=1, help="vertical scan: stripe-edge pixels a "
@@ -125,9 +128,11 @@ class Channelizer(Detector):
         horizon = frame.metadata.get("horizon_y")
         top = int(np.clip(horizon if horizon is not None else self.params["horizon"] * h, 0, h - 2))
         roi = image[top:]
-        edges = (
-            diagonal_edges(cv2.cvtColor(roi, cv2.COLOR_BGR2GRAY)) >= self.params["edge_threshold"]
-        )
+        if self.params["edge_image"] == "gray":
+            magnitude = diagonal_edges(cv2.cvtColor(roi, cv2.COLOR_BGR2GRAY))
+        else:
+            magnitude = np.max([diagonal_edges(roi[..., c]) for c in range(3)], axis=0)
+        edges = magnitude >= self.params["edge_threshold"]
         focal = frame.metadata.get("focal_px") or self.params["focal_px"]
         found = []
         for box in self._boxes(edges, (0, 0, edges.shape[1], edges.shape[0]), passes=4):

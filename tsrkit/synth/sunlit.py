@@ -16,7 +16,13 @@ Eq. 4.9 with the camera facing the target), plus blue sky light; it reflects
 
 Targets are orange work-zone diamonds (state ``orange``) and red stop octagons (``red``),
 facing the camera; distractors are orange cones, a red car, brick facades, trees and a glare
-veil when the camera looks towards a low Sun. Some signs are partly shaded by a pole or a
+veil when the camera looks towards a low Sun. On request a frame also holds traffic lights
+(state ``light_red``, ``light_yellow`` or ``light_green``, boxed on the lit lens, the housing in
+``attributes``): the lit lamp **emits** its colour whatever the Sun does, bright enough that its
+core clips to white; the unlit lenses are dark tinted glass over a reflector, so with the Sun
+behind the camera their retro-reflection makes them glow in their own colour (the "phantom"
+lamps of Lee 4.1.2). And channelizers (state ``channelizer``): Lee 3.5's vertical panels, 45-degree
+orange and retro-reflective white stripes on a post. Some signs are partly shaded by a pole or a
 building (Lee's Figure 4.11). Frames carry the metadata the model reads: ``utc``, ``lat``,
 ``lon``, ``heading_deg`` (and, for checking, ``relative_azimuth_deg_true``).
 """
@@ -47,6 +53,13 @@ ALBEDO = {
     "pole": (0.3, 0.3, 0.3),
     "car_red": (0.05, 0.04, 0.5),
     "concrete": (0.45, 0.47, 0.5),
+    "housing": (0.05, 0.05, 0.05),
+}
+#: Traffic-light lenses by state: (BGR emission when lit, BGR albedo of the unlit tinted glass).
+LENSES = {
+    "light_red": ((0.12, 0.25, 3.0), (0.02, 0.02, 0.12)),
+    "light_yellow": ((0.2, 1.6, 3.0), (0.02, 0.08, 0.14)),
+    "light_green": ((2.2, 3.0, 0.5), (0.1, 0.12, 0.03)),
 }
 #: Pittsburgh, near Lee's test route (4.4.1).
 DEFAULT_PLACE = (40.4433, -79.9436)
@@ -106,6 +119,7 @@ class Layers:
         self.lit = np.ones((height, width), np.float32)
         self.sheen = np.zeros((height, width), np.float32)
         self.retro = np.zeros((height, width), np.float32)
+        self.emit = np.zeros((height, width, 3), np.float32)
 
     def fill(self, points: np.ndarray, albedo, kind: int, **extra: float) -> np.ndarray:
         """Paint a polygon (x, y vertices) and return its mask."""
@@ -193,6 +207,55 @@ def _sign(
     )
 
 
+def _traffic_light(
+    layers: Layers, rng: np.random.Generator, cx: float, cy: float, radius: float
+) -> Annotation:
+    """A vertical three-lens head (red, yellow, green from the top) whose lens ``lit`` (drawn at
+    random) emits; ``(cx, cy)`` is the centre of the middle lens. Returns the lit lens's box."""
+    height = layers.kind.shape[0]
+    pitch = 2.8 * radius
+    housing = _box(cx - pitch / 2, cy - 1.5 * pitch, cx + pitch / 2, cy + 1.5 * pitch)
+    layers.fill(_box(cx - 2, cy + 1.5 * pitch, cx + 2, height), ALBEDO["pole"], Layers.FACING)
+    layers.fill(housing, ALBEDO["housing"], Layers.FACING, sheen=0.3)
+    states = list(LENSES)
+    lit = states[rng.integers(len(states))]
+    box: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
+    for k, state in enumerate(states):
+        y = cy + (k - 1) * pitch
+        angles = np.radians(np.arange(0.0, 360.0, 15.0))
+        disc = np.stack([cx + radius * np.cos(angles), y + radius * np.sin(angles)], axis=1)
+        emission, glass = LENSES[state]
+        on = layers.fill(disc, glass, Layers.FACING, sheen=0.9, retro=1.0)
+        if state == lit:  # brighter at the centre: a clipped white core, a coloured rim
+            yy, xx = np.nonzero(on)
+            falloff = 1.0 - 0.6 * ((xx - cx) ** 2 + (yy - y) ** 2) / radius**2
+            layers.emit[yy, xx] = np.asarray(emission, np.float32) * falloff[:, None]
+            box = (cx - radius, y - radius, cx + radius, y + radius)
+    corners = [float(v) for v in (*housing.min(axis=0), *housing.max(axis=0))]
+    return Annotation(box, lit, {"object": "traffic_light", "housing": corners})
+
+
+def _channelizer(
+    layers: Layers, rng: np.random.Generator, cx: float, bottom: float, panel_h: float
+) -> Annotation:
+    """Lee 3.5's vertical panel (24 x 10 in) on a post standing at image row ``bottom``: 45-degree
+    orange and white stripes (4 in wide), both retro-reflective sheeting."""
+    panel_w = panel_h * 10.0 / 24.0
+    top = bottom - 1.3 * panel_h
+    layers.fill(_box(cx - 1.5, top + panel_h, cx + 1.5, bottom), ALBEDO["pole"], Layers.FACING)
+    on = layers.fill(
+        _box(cx - panel_w / 2, top, cx + panel_w / 2, top + panel_h),
+        ALBEDO["white"], Layers.FACING, sheen=0.4, retro=0.8,
+    )  # fmt: skip
+    yy, xx = np.nonzero(on)
+    stripe = panel_h * 4.0 / 24.0 * math.sqrt(2.0)
+    flip = 1.0 if rng.random() < 0.5 else -1.0
+    orange = np.floor((flip * (xx - cx) + (yy - top)) / stripe) % 2 == 0
+    layers.albedo[yy[orange], xx[orange]] = ALBEDO["orange"]
+    box = (float(cx - panel_w / 2), float(top), float(cx + panel_w / 2), float(top + panel_h))
+    return Annotation(box, "channelizer", {"object": "channelizer"})
+
+
 def expose(layers: Layers, light: Illumination, rng: np.random.Generator) -> np.ndarray:
     """Radiance of every pixel, through the fixed camera: exposure, clipping at saturation,
     sensor noise and the sRGB-like gamma; BGR uint8."""
@@ -217,6 +280,7 @@ def expose(layers: Layers, light: Illumination, rng: np.random.Generator) -> np.
     rows = np.linspace(1.0, 0.6, height, dtype=np.float32)[:, None, None]
     sky = (light.sky * 3.0 + 0.15 * light.sun) * rows
     radiance = np.where((layers.kind == Layers.SKY)[..., None], sky, body + surface + retro)
+    radiance = radiance + layers.emit
     # Looking towards a low Sun: a veil of scattered light over the whole frame (Lee 4.4.2).
     into_sun = max(-math.cos(math.radians(light.relative_azimuth)), 0.0) ** 4
     veil = 0.5 * into_sun * math.exp(-max(light.elevation, 0.0) / 20.0) * light.sun
@@ -227,9 +291,13 @@ def expose(layers: Layers, light: Illumination, rng: np.random.Generator) -> np.
 
 
 def render_frame(
-    rng: np.random.Generator, light: Illumination, width: int = 640, height: int = 480
-) -> tuple[np.ndarray, tuple[Annotation, ...]]:
-    """One frame with one to three signs (orange diamonds and red octagons) and distractors."""
+    rng: np.random.Generator, light: Illumination, width: int = 640, height: int = 480,
+    lights: int = 0, channelizers: int = 0,
+) -> tuple[np.ndarray, tuple[Annotation, ...]]:  # fmt: skip
+    """One frame with one to three signs (orange diamonds and red octagons) and distractors,
+    plus ``lights`` traffic lights hanging above the road and ``channelizers`` panels along its
+    edge (drawn after the rest, so a frame without them is the frame rendered before they
+    existed)."""
     layers = Layers(height, width)
     horizon = int(height * rng.uniform(0.42, 0.52))
     _background(layers, rng, horizon)
@@ -244,17 +312,29 @@ def render_frame(
         cx = (slot + rng.uniform(0.25, 0.75)) * width / 3
         cy = horizon - rng.uniform(0.5, 2.5) * half
         annotations.append(_sign(layers, rng, kind, cx, cy, half))
+    for _ in range(lights):
+        radius = rng.uniform(3.0, 9.0)
+        cx = rng.uniform(0.1, 0.9) * width
+        cy = rng.uniform(0.1, 0.8) * (horizon - 5 * radius) + 1.5 * 2.8 * radius
+        annotations.append(_traffic_light(layers, rng, cx, cy, radius))
+    for _ in range(channelizers):
+        bottom = rng.uniform(horizon + 15, height - 5)
+        panel_h = 8 + 60 * (bottom - horizon) / (height - horizon)
+        cx = rng.uniform(0.1, 0.9) * width
+        annotations.append(_channelizer(layers, rng, cx, bottom, panel_h))
     return expose(layers, light, rng), tuple(annotations)
 
 
 def sweep(
     relative_azimuths, frames_each: int = 8, seed: int = 0, width: int = 640, height: int = 480,
     day: str = "2016-06-20", place: tuple[float, float] = DEFAULT_PLACE, split: str | None = None,
+    lights: int = 0, channelizers: int = 0,
 ) -> Dataset:  # fmt: skip
     """Lee's 4.2 protocol as a data set: for each relative azimuth, ``frames_each`` frames at
     hours through ``day`` (so at the Sun's elevations of that day), the camera heading turned
     so that the Sun lies at that relative azimuth. Frames with the Sun below the horizon are
-    not rendered. Each sample's metadata holds ``utc``, ``lat``, ``lon``, ``heading_deg``."""
+    not rendered. Each sample's metadata holds ``utc``, ``lat``, ``lon``, ``heading_deg``;
+    ``lights`` and ``channelizers`` are passed to :func:`render_frame`."""
     rng = np.random.default_rng(seed)
     lat, lon = place
     start = datetime.fromisoformat(day).replace(tzinfo=UTC).timestamp()
@@ -267,7 +347,9 @@ def sweep(
             if elevation < 5.0:
                 continue
             heading = (azimuth + 180.0 - rel * rng.choice([-1.0, 1.0])) % 360.0
-            image, annotations = render_frame(rng, illumination(elevation, rel), width, height)
+            image, annotations = render_frame(
+                rng, illumination(elevation, rel), width, height, lights, channelizers
+            )
             stamp = datetime.fromtimestamp(utc, UTC).isoformat().replace("+00:00", "Z")
             metadata = {
                 "utc": stamp, "lat": lat, "lon": lon, "heading_deg": round(float(heading), 3),
