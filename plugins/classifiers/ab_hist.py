@@ -11,6 +11,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from tsrkit.errors import TsrkitError
 from tsrkit.hookspecs import hookimpl
 from tsrkit.models import Model, ModelError, load_model
 from tsrkit.params import Param
@@ -235,7 +236,7 @@ class AbHist(Classifier):
             counts[i] += 1
         missing = [s for s, n in zip(self.states, counts) if n == 0]
         if missing:
-            raise ValueError(f"ab-hist: no training samples for {', '.join(missing)}")
+            raise TsrkitError(f"ab-hist: no training samples for {', '.join(missing)}")
         return Model(
             arrays={
                 "histograms": (sums / counts[:, None, None]).astype(np.float32),

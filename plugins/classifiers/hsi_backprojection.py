@@ -13,6 +13,7 @@ import cv2
 import numpy as np
 from scipy.ndimage import gaussian_filter1d
 
+from tsrkit.errors import TsrkitError
 from tsrkit.hookspecs import hookimpl
 from tsrkit.models import Model, ModelError, load_model
 from tsrkit.params import Param
@@ -316,7 +317,7 @@ class HsiBackprojection(Classifier):
             for state, frame, lens in labelled_lenses(samples, self.states, self.params)
         ]
         if not taken:
-            raise ValueError(
+            raise TsrkitError(
                 "hsi-backprojection: no training samples with a red, yellow or green label"
             )
         count = self.params["pixels_per_sample"] or min(len(p) for _, p in taken)
@@ -327,7 +328,7 @@ class HsiBackprojection(Classifier):
         }
         missing = [s for s in self.states if not len(pixels[s])]
         if missing:
-            raise ValueError(f"hsi-backprojection: no training samples for {', '.join(missing)}")
+            raise TsrkitError(f"hsi-backprojection: no training samples for {', '.join(missing)}")
         every = np.concatenate(list(pixels.values()))
         hue = [
             smooth_hue(scaled_histogram(pixels[s][:, 0], HUE_BINS), self.params["hue_smooth"])

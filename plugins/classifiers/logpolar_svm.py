@@ -182,7 +182,7 @@ class LogPolarSVM(Classifier):
                 labels.append(ann.state)
         classes = sorted(set(labels))
         if len(classes) < 2 or len(labels) < p["n_components"]:
-            raise ValueError(
+            raise TsrkitError(
                 f"logpolar-svm needs two classes and at least n_components="
                 f"{p['n_components']} boxes; got {len(classes)} classes, "
                 f"{len(labels)} boxes"

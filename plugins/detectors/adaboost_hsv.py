@@ -221,7 +221,7 @@ def fit_stumps(
         When either class has no pixels.
     """
     if positive.sum() == 0 or negative.sum() == 0:
-        raise ValueError(
+        raise TsrkitError(
             "training needs target and background pixels; found "
             f"{int(positive.sum())} target and {int(negative.sum())} background"
         )

@@ -16,6 +16,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from tsrkit.errors import TsrkitError
 from tsrkit.geo.gps import Track, read_track
 from tsrkit.hookspecs import hookimpl
 from tsrkit.models import Model, ModelError, load_model
@@ -180,7 +181,7 @@ class SunPcaClassifier(SunModelMixin, Classifier):
                     )
                 )
             except ValueError as exc:
-                raise ValueError(f"sun-pca: target '{t}': {exc}") from None
+                raise TsrkitError(f"sun-pca: target '{t}': {exc}") from None
         arrays = {k: np.stack([f[k] for f in fitted]) for k in ARRAYS}
         return Model(
             arrays=arrays,

@@ -11,6 +11,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
+from tsrkit.errors import TsrkitError
 from tsrkit.eval.matching import centre_hits
 from tsrkit.models import Model
 from tsrkit_plugins.detectors.tl_recognizer.tl_recognizer import (
@@ -144,7 +145,7 @@ def fit_model(detector, samples) -> Model:
     """
     samples = list(samples)
     if not samples:
-        raise ValueError("tl-recognizer: cannot train on an empty dataset")
+        raise TsrkitError("tl-recognizer: cannot train on an empty dataset")
     pixels = {colour: np.zeros((0, 3), np.uint8) for colour in PASSES}
     if detector.params["fit_ranges"]:
         pixels = annotated_lens_pixels(samples, detector.params["resize_factor"])
