@@ -13,6 +13,7 @@ import time
 import numpy as np
 
 from tsrkit.eval.overlap import match_by_iou
+from tsrkit.params import parse_assignments
 from tsrkit.registry import get_registry
 from tsrkit.synth.workzone import generate
 
@@ -23,18 +24,9 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--frames", type=int, default=200)
     parser.add_argument("--seed", type=int, default=2017)
-    parser.add_argument(
-        "-p",
-        "--param",
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help="a channelizer parameter, e.g. edge_image=max",
-    )
+    parser.add_argument("-p", "--param", action="append", default=[], help="channelizer KEY=V")
     args = parser.parse_args()
-    detector = get_registry().create(
-        "detector", "channelizer", dict(kv.split("=", 1) for kv in args.param)
-    )
+    detector = get_registry().create("detector", "channelizer", parse_assignments(args.param))
     data = generate(args.frames, seed=args.seed)
     tp = fp = 0
     truth, found, errors = [], [], []
@@ -66,6 +58,9 @@ def main() -> None:
     for low, high in BINS:
         inside = (truth_a >= low) & (truth_a < high)
         e = np.abs(err[(err[:, 0] >= low) & (err[:, 0] < high), 1])
+        if not inside.any() or not len(e):
+            print(f"| {low}-{high} | {inside.sum()} | - | - | - | - | - |")
+            continue
         print(f"| {low}-{high} | {inside.sum()} | {found_a[inside].mean():.3f} | "
               f"{np.median(e):.3f} | {np.percentile(e, 95):.3f} | {e.max():.3f} | "
               f"{np.mean(e <= 0.05):.3f} |")  # fmt: skip

@@ -24,6 +24,7 @@ import numpy as np
 
 from tsrkit.eval.overlap import match_by_iou
 from tsrkit.models import save_model
+from tsrkit.params import parse_assignments
 from tsrkit.registry import get_registry
 from tsrkit.synth.sunlit import LENSES, sweep
 from tsrkit.types import Candidate
@@ -69,14 +70,7 @@ def main() -> None:
     parser.add_argument("--frames", type=int, default=12, help="frames per sequence")
     parser.add_argument("--lights", type=int, default=3, help="traffic lights per frame")
     parser.add_argument("--channelizers", type=int, default=3, help="channelizers per frame")
-    parser.add_argument(
-        "-p",
-        "--param",
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help="a channelizer parameter, e.g. edge_image=max",
-    )
+    parser.add_argument("-p", "--param", action="append", default=[], help="channelizer KEY=V")
     args = parser.parse_args()
     registry = get_registry()
     with tempfile.TemporaryDirectory() as tmp:
@@ -88,7 +82,7 @@ def main() -> None:
             ),
             "ab-hist": registry.create("classifier", "ab-hist", {}),
         }
-        settings = {"horizon": 0.4, **dict(kv.split("=", 1) for kv in args.param)}
+        settings = {"horizon": 0.4, **parse_assignments(args.param)}
         channelizer = registry.create("detector", "channelizer", settings)
         print("| seq | rel. az. | lamps | " + " | ".join(
             f"{name} acc. | red as yellow" for name in classifiers
