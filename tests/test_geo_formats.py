@@ -7,48 +7,18 @@ import sys
 from datetime import UTC, datetime
 from pathlib import Path
 
-import gpxpy.gpx
 import numpy as np
 import pynmea2
 import pytest
 from click.testing import CliRunner
 
 from tsrkit.cli.main import cli
-from tsrkit.geo import GeoError, Track, read_signals, read_track
+from tsrkit.geo import GeoError, read_signals, read_track
+from tsrkit.geo.export import to_gpx, to_nmea
 from tsrkit.geo.osm import _nodes
 
 SET = Path(__file__).resolve().parents[1].parent / "shared/datasets/nk_seattle_gps_bellevue_osm"
 DRIVE, MAP = SET / "gps_data.txt", SET / "map-issue147.osm.gz"
-
-
-def gpx_text(track: Track) -> str:
-    """``track`` as a GPX 1.1 file written by gpxpy."""
-    gpx = gpxpy.gpx.GPX()
-    segment = gpxpy.gpx.GPXTrackSegment()
-    gpx.tracks.append(gpxpy.gpx.GPXTrack())
-    gpx.tracks[0].segments.append(segment)
-    for t, la, lo in zip(track.time, track.lat, track.lon):
-        stamp = datetime.fromtimestamp(t, UTC)
-        segment.points.append(gpxpy.gpx.GPXTrackPoint(la, lo, time=stamp))
-    return gpx.to_xml()
-
-
-def _dm(value: float, width: int) -> str:
-    degrees = int(abs(value))
-    return f"{degrees:0{width}d}{(abs(value) - degrees) * 60:07.4f}"
-
-
-def nmea_text(track: Track, gga_first: bool = False) -> str:
-    """``track`` as GGA + RMC sentences (checksums by pynmea2), one pair per fix."""
-    lines = []
-    for t, la, lo in zip(track.time, track.lat, track.lon):
-        stamp = datetime.fromtimestamp(t, UTC)
-        clock, day = stamp.strftime("%H%M%S"), stamp.strftime("%d%m%y")
-        position = (_dm(la, 2), "N" if la >= 0 else "S", _dm(lo, 3), "E" if lo >= 0 else "W")
-        rmc = pynmea2.RMC("GP", "RMC", (clock, "A", *position, "0.0", "0.0", day, "", ""))
-        gga = pynmea2.GGA("GP", "GGA", (clock, *position, "1", "08", "0.9", "0", "M", "0", "M"))
-        lines += [str(gga), str(rmc)] if gga_first else [str(rmc), str(gga)]
-    return "\n".join(lines) + "\n"
 
 
 @pytest.fixture(scope="module")
@@ -58,7 +28,7 @@ def seattle():
 
 def test_the_seattle_drive_as_gpx_reads_the_same(tmp_path, seattle):
     path = tmp_path / "drive.gpx"
-    path.write_text(gpx_text(seattle))
+    path.write_text(to_gpx(seattle))
     track = read_track(path)
     assert len(track) == len(seattle) == 7531
     np.testing.assert_array_equal(track.time, seattle.time)
@@ -69,7 +39,7 @@ def test_the_seattle_drive_as_gpx_reads_the_same(tmp_path, seattle):
 @pytest.mark.parametrize("gga_first", [False, True])
 def test_the_seattle_drive_as_nmea_reads_the_same(tmp_path, seattle, gga_first):
     path = tmp_path / "drive.log"  # told apart by its content
-    path.write_text(nmea_text(seattle, gga_first))
+    path.write_text(to_nmea(seattle, gga_first))
     track = read_track(path)
     assert len(track) == len(seattle)
     np.testing.assert_array_equal(track.time, seattle.time)
@@ -98,7 +68,7 @@ def test_gga_takes_the_rmc_date_across_midnight(tmp_path):
 
 def test_gpx_and_nmea_logs_work_in_the_track_verb(tmp_path, seattle):
     gpx = tmp_path / "drive.gpx"
-    gpx.write_text(gpx_text(seattle))
+    gpx.write_text(to_gpx(seattle))
     result = CliRunner().invoke(cli, ["track", "--gps", str(gpx), "--map", str(MAP)])
     assert result.exit_code == 0, result.output
     assert "traversals of 30 intersections (7531 fixes)" in result.output
@@ -153,7 +123,7 @@ RMC = "$GPRMC,123519,A,4807.038,N,01131.000,E,022.4,084.4,230394,003.1,W*6A"
         (RMC + "\n" + RMC[:-1] + "B\n", "line 2: not an NMEA sentence"),
         (RMC + "\nhello\n", "line 2: not an NMEA sentence"),
         (str(pynmea2.RMC("GP", "RMC", ("123519", "A", "", "", "", ""))), "line 1: RMC fix without"),
-        (RMC[:-26], "line 1: RMC fix without a time or date"),
+        (RMC[:-26], "line 1: RMC fix without a valid time or date"),
         (
             str(pynmea2.GGA("GP", "GGA", ("123519", "4807.038", "N", "01131.000", "E", "1"))),
             "line 1: GGA fixes carry no date and the log has no RMC",

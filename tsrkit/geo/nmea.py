@@ -49,8 +49,9 @@ def _fixes(path: Path, lines: list[str]) -> list[tuple[int, str, date | None, ti
                 continue
             day = sentence.datestamp if kind == "RMC" else None
             clock = sentence.timestamp
-            if clock is None or (kind == "RMC" and day is None):
-                raise GeoError(path, f"{kind} fix without a time or date", number)
+            # pynmea2 gives None for an empty field and the raw text for one it cannot convert
+            if not isinstance(clock, time) or (kind == "RMC" and not isinstance(day, date)):
+                raise GeoError(path, f"{kind} fix without a valid time or date", number)
             lat, lon = _position(path, sentence, number)
         except (ValueError, TypeError) as exc:
             raise GeoError(path, f"bad {kind} field ({exc})", number) from None

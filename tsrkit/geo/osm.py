@@ -59,6 +59,8 @@ def _xml_nodes(path: Path) -> list[tuple[int, float, float, dict[str, str], str]
         raise GeoError(path, f"not well-formed XML ({exc})", exc.position[0]) from None
     except DefusedXmlException as exc:
         raise GeoError(path, f"refused XML ({type(exc).__name__})") from None
+    except LookupError as exc:  # the XML declaration names an unknown encoding
+        raise GeoError(path, f"cannot decode the XML ({exc})") from None
     except (OSError, EOFError, zlib.error) as exc:
         raise GeoError(path, f"cannot read ({exc})") from None
     nodes = []
