@@ -91,6 +91,10 @@ def _pt(lat="47.6", lon="-122.1", time="2009-01-17T20:27:37Z") -> str:
         ("", "line 1: not well-formed XML"),
         (GPX_HEAD + "<trkpt lat=", "line 1: not well-formed XML"),
         ("<gpx></gpx>", "no GPS fix"),
+        (
+            '<gpx><wpt lat="1" lon="2"/></gpx>',
+            "no track point \\(<trkpt>\\): routes and waypoints are not a drive",
+        ),
         (_points(_pt(), _pt(lat="x")), "track point 2: not a valid GPX file"),
         (_points(_pt(), '<trkpt lon="1"/>'), "track point 2: not a valid GPX file"),
         (_points(_pt(), _pt(time="yesterday")), "track point 2: no valid <time>"),

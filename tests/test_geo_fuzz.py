@@ -202,6 +202,8 @@ def _nmea(body: str) -> str:
         ("d.nmea", _nmea(RMC.format("123519", "2303x4")), "line 1: RMC fix without a valid time"),
         # fuzz_geo.py: an unknown encoding in the XML declaration is a LookupError
         ("e.osm", '<?xml version="1.0" encoding="UTF-e"?><osm/>', "cannot decode the XML"),
+        # found while writing the readers: csv's field size limit raised csv.Error
+        ("big.csv", "time,lat,lon\n" + "x" * 200_000 + ",1,2\n", "line 2: not CSV"),
     ],
 )
 def test_crashes_found_by_fuzzing_are_clear_errors(tmp_path, name, data, fragment):
@@ -209,3 +211,9 @@ def test_crashes_found_by_fuzzing_are_clear_errors(tmp_path, name, data, fragmen
     path.write_text(data)
     with pytest.raises(GeoError, match=fragment):
         (read_signals if name.endswith(".osm") else read_track)(path)
+
+
+def test_a_byte_order_mark_is_not_part_of_the_csv_header(tmp_path):
+    path = tmp_path / "bom.csv"
+    path.write_text("\ufefftime,lat,lon\n0,47,-122\n", encoding="utf-8")
+    assert len(read_track(path)) == 1

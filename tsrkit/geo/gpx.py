@@ -48,6 +48,10 @@ def gpx_rows(path: Path, text: str) -> list[tuple[int | str, float, float, float
         gpx = gpxpy.parse(text)
     except gpxpy.gpx.GPXException as exc:
         raise GeoError(path, f"not a valid GPX file ({exc})", _bad_point(root)) from None
+    if not any(segment.points for track in gpx.tracks for segment in track.segments) and (
+        gpx.routes or gpx.waypoints
+    ):
+        raise GeoError(path, "no track point (<trkpt>): routes and waypoints are not a drive")
     rows: list[tuple[int | str, float, float, float]] = []
     points = (p for track in gpx.tracks for segment in track.segments for p in segment.points)
     for number, point in enumerate(points, start=1):
