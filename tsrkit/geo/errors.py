@@ -1,4 +1,4 @@
-"""The one error of GPS logs and maps: file, line and problem."""
+"""The one error of GPS logs and maps: file, place in the file and problem."""
 
 from __future__ import annotations
 
@@ -10,12 +10,19 @@ from tsrkit.errors import TsrkitError
 class GeoError(TsrkitError):
     """A GPS log or map that is missing or malformed.
 
+    ``line`` is a line number, or the label of a place that has none (a GPX track point, a
+    GeoJSON feature, an OSM node of a binary file).
+
     Examples
     --------
     >>> str(GeoError("drive.csv", "latitude 123.0 out of range", 7))
     'drive.csv: line 7: latitude 123.0 out of range'
+    >>> str(GeoError("drive.gpx", "no time", "track point 3"))
+    'drive.gpx: track point 3: no time'
     """
 
-    def __init__(self, path: str | os.PathLike, problem: str, line: int | None = None):
-        where = f"line {line}: " if line is not None else ""
+    def __init__(
+        self, path: str | os.PathLike, problem: str, line: int | str | None = None
+    ) -> None:
+        where = f"line {line}: " if isinstance(line, int) else f"{line}: " if line else ""
         super().__init__(f"{path}: {where}{problem}")

@@ -1,5 +1,5 @@
-"""GPS logs: the whitespace ``dd-Mon-yyyy hh:mm:ss lat lon`` format and CSV, and positions at
-frame times (Zheng 2016, 4.3, Eq. 4.1-4.2)."""
+"""GPS logs (CSV, the whitespace ``dd-Mon-yyyy hh:mm:ss lat lon`` lines, GPX, NMEA) and
+positions at frame times (Zheng 2016, 4.3, Eq. 4.1-4.2)."""
 
 from __future__ import annotations
 
@@ -13,6 +13,8 @@ from pathlib import Path
 import numpy as np
 
 from tsrkit.geo.errors import GeoError
+from tsrkit.geo.gpx import gpx_rows
+from tsrkit.geo.nmea import nmea_rows
 
 
 @dataclass(frozen=True)
@@ -64,23 +66,32 @@ def _csv_time(text: str) -> float:
         return stamp.timestamp()
 
 
-def _rows(path: Path) -> tuple[list[tuple[int, float, float, float]], str]:
+Rows = list[tuple[int | str, float, float, float]]
+
+#: Log formats by file extension; other extensions are told apart by their first character.
+_BY_SUFFIX = {".csv": "csv", ".gpx": "gpx", ".nmea": "nmea", ".nma": "nmea", ".nme": "nmea"}
+
+
+def _read_text(path: Path) -> str:
     try:
-        text = path.read_text(encoding="utf-8")
+        return path.read_text(encoding="utf-8-sig")
     except FileNotFoundError:
         raise GeoError(path, "no such file") from None
     except (OSError, UnicodeDecodeError) as exc:
         raise GeoError(path, f"cannot read as UTF-8 text ({exc})") from None
-    lines = text.splitlines()
-    rows = []
-    if path.suffix.lower() == ".csv":
-        reader = csv.reader(lines)
+
+
+def _csv_rows(path: Path, lines: list[str]) -> Rows:
+    reader = csv.reader(lines)
+    try:
         header = [h.strip().lower() for h in next(reader, [])]
         missing = {"time", "lat", "lon"} - set(header)
         if missing:
             raise GeoError(path, f"CSV header lacks {', '.join(sorted(missing))}", 1)
         index = [header.index(k) for k in ("time", "lat", "lon")]
-        for number, fields in enumerate(reader, start=2):
+        rows: Rows = []
+        for fields in reader:
+            number = reader.line_num
             if not fields or not "".join(fields).strip():
                 continue
             if len(fields) < len(header):
@@ -91,12 +102,18 @@ def _rows(path: Path) -> tuple[list[tuple[int, float, float, float]], str]:
                     float(fields[index[1]]),
                     float(fields[index[2]]),
                 )
-            except ValueError as exc:
+            except (ValueError, OverflowError) as exc:
                 raise GeoError(
                     path, f"not a time, latitude and longitude ({exc})", number
                 ) from None
             rows.append((number, t, la, lo))
-        return rows, "csv"
+    except csv.Error as exc:
+        raise GeoError(path, f"not CSV ({exc})", reader.line_num) from None
+    return rows
+
+
+def _whitespace_rows(path: Path, lines: list[str]) -> Rows:
+    rows: Rows = []
     for number, line in enumerate(lines, start=1):
         fields = line.split()
         if not fields or fields[0].lower().startswith("date"):
@@ -113,19 +130,47 @@ def _rows(path: Path) -> tuple[list[tuple[int, float, float, float]], str]:
             raise GeoError(
                 path, f"not a date, time, latitude and longitude ({exc})", number
             ) from None
-    return rows, "whitespace"
+    return rows
+
+
+def log_format(path: Path, text: str) -> str:
+    """``csv``, ``gpx``, ``nmea`` or ``whitespace``: by extension, else by the first character
+    (``<`` GPX, ``$`` or ``!`` NMEA, anything else the whitespace lines).
+
+    >>> log_format(Path("drive.log"), "$GPRMC,...")
+    'nmea'
+    """
+    if path.suffix.lower() in _BY_SUFFIX:
+        return _BY_SUFFIX[path.suffix.lower()]
+    head = text.lstrip()[:1]
+    return "gpx" if head == "<" else "nmea" if head in ("$", "!") else "whitespace"
+
+
+def _rows(path: Path) -> tuple[Rows, str]:
+    text = _read_text(path)
+    kind = log_format(path, text)
+    if kind == "gpx":
+        return gpx_rows(path, text), kind
+    lines = text.splitlines()
+    if kind == "nmea":
+        return nmea_rows(path, lines), kind
+    if kind == "csv":
+        return _csv_rows(path, lines), kind
+    return _whitespace_rows(path, lines), kind
 
 
 def read_track(path: str | os.PathLike) -> Track:
-    """Read a GPS log: CSV with a ``time,lat,lon`` header (time as UTC seconds or ISO 8601) or
-    the whitespace ``dd-Mon-yyyy hh:mm:ss lat lon`` lines of the Seattle drive.
+    """Read a GPS log: CSV with a ``time,lat,lon`` header (time as UTC seconds or ISO 8601),
+    the whitespace ``dd-Mon-yyyy hh:mm:ss lat lon`` lines of the Seattle drive, GPX (track
+    points, through gpxpy) or NMEA 0183 (RMC and GGA sentences, through pynmea2); the format
+    is chosen by :func:`log_format`.
 
     Raises
     ------
     GeoError
-        Naming the file and line: missing file, invalid text, wrong column count, a value that
-        is not a number, NaN, a latitude or longitude out of range, times not increasing, or
-        no fix at all.
+        Naming the file and line (GPX: track point): missing file, invalid text, wrong column
+        count or tags, a value that is not a number, NaN, a latitude or longitude out of range,
+        times not increasing, or no fix at all.
     """
     path = Path(path)
     rows, _ = _rows(path)

@@ -8,18 +8,22 @@
 from __future__ import annotations
 
 import gzip
+import math
 import os
+import zlib
 from dataclasses import dataclass
 from pathlib import Path
 from xml.etree.ElementTree import ParseError
 
 import numpy as np
-from defusedxml import ElementTree
+from defusedxml import DefusedXmlException, ElementTree
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from tsrkit.geo.errors import GeoError
+from tsrkit.geo.geojson import geojson_nodes
+from tsrkit.geo.osm_pbf import SIGNAL_TAGS, pbf_nodes
 from tsrkit.geo.projection import LocalProjection
 
 #: Signal nodes closer than this (metres) belong to one intersection.
@@ -44,7 +48,7 @@ class Signals:
         return len(self.ids)
 
 
-def _nodes(path: Path) -> list[tuple[int, float, float, dict[str, str]]]:
+def _xml_nodes(path: Path) -> list[tuple[int, float, float, dict[str, str], str]]:
     opener = gzip.open if path.suffix == ".gz" else open
     try:
         with opener(path, "rb") as fh:
@@ -53,12 +57,16 @@ def _nodes(path: Path) -> list[tuple[int, float, float, dict[str, str]]]:
         raise GeoError(path, "no such file") from None
     except ParseError as exc:
         raise GeoError(path, f"not well-formed XML ({exc})", exc.position[0]) from None
-    except (OSError, EOFError) as exc:
+    except DefusedXmlException as exc:
+        raise GeoError(path, f"refused XML ({type(exc).__name__})") from None
+    except LookupError as exc:  # the XML declaration names an unknown encoding
+        raise GeoError(path, f"cannot decode the XML ({exc})") from None
+    except (OSError, EOFError, zlib.error) as exc:
         raise GeoError(path, f"cannot read ({exc})") from None
     nodes = []
     for node in root.iter("node"):
         tags = {t.get("k", ""): t.get("v", "") for t in node.iter("tag")}
-        if "traffic_signals" not in (tags.get("highway"), tags.get("crossing")):
+        if not any(tags.get(key) == value for key, value in SIGNAL_TAGS):
             continue
         try:
             ident, lat, lon = (
@@ -70,19 +78,53 @@ def _nodes(path: Path) -> list[tuple[int, float, float, dict[str, str]]]:
             raise GeoError(
                 path, f"node {node.get('id')!r}: id, lat or lon is not a number"
             ) from None
-        if not (-90 <= lat <= 90 and -180 <= lon <= 180):
-            raise GeoError(path, f"node {ident}: lat {lat} / lon {lon} out of range")
-        nodes.append((ident, lat, lon, tags))
+        nodes.append((ident, lat, lon, tags, f"node {ident}"))
     return nodes
 
 
+def map_format(path: Path) -> str:
+    """``pbf``, ``geojson`` or ``xml`` (``.osm``, ``.osm.gz`` and any other name), by extension.
+
+    >>> map_format(Path("bellevue.osm.pbf")), map_format(Path("signals.geojson"))
+    ('pbf', 'geojson')
+    """
+    suffix = path.suffix.lower()
+    return "pbf" if suffix == ".pbf" else "geojson" if suffix in (".geojson", ".json") else "xml"
+
+
+def _nodes(path: Path) -> list[tuple[int, float, float, dict[str, str]]]:
+    """``(id, lat, lon, tags)`` of the signal nodes of a map in any :func:`map_format`, with
+    finite coordinates in range."""
+    kind = map_format(path)
+    if kind == "pbf":
+        found = pbf_nodes(path)
+    elif kind == "geojson":
+        try:
+            text = path.read_text(encoding="utf-8-sig")
+        except FileNotFoundError:
+            raise GeoError(path, "no such file") from None
+        except (OSError, UnicodeDecodeError) as exc:
+            raise GeoError(path, f"cannot read as UTF-8 text ({exc})") from None
+        found = geojson_nodes(path, text)
+    else:
+        found = _xml_nodes(path)
+    for _, lat, lon, _, label in found:
+        if not (math.isfinite(lat) and math.isfinite(lon)):
+            raise GeoError(path, f"lat {lat} / lon {lon} not finite", label)
+        if not (-90 <= lat <= 90 and -180 <= lon <= 180):
+            raise GeoError(path, f"lat {lat} / lon {lon} out of range", label)
+    return [n[:4] for n in found]
+
+
 def read_signals(path: str | os.PathLike, merge_m: float = MERGE_M) -> Signals:
-    """Read the signals of an ``.osm`` or ``.osm.gz`` extract (XML parsed with defusedxml).
+    """Read the signals of an ``.osm`` or ``.osm.gz`` extract (XML parsed with defusedxml), an
+    ``.osm.pbf`` extract (through pyosmium, when installed) or a GeoJSON file of signal points.
 
     Raises
     ------
     GeoError
-        Missing file, malformed XML (with its line), or a signal node with bad coordinates.
+        Missing file, malformed XML or JSON (with its line), a malformed PBF file, or a signal
+        node (feature) with bad coordinates.
     """
     path = Path(path)
     nodes = _nodes(path)

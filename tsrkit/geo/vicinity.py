@@ -15,6 +15,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from tsrkit.geo.gps import Track
+from tsrkit.geo.nearest import nearest_extended, nearest_kdtree
 from tsrkit.geo.osm import Signals
 from tsrkit.geo.projection import LocalProjection
 
@@ -51,13 +52,19 @@ class Traversal:
 
 
 def vicinity_profile(
-    track: Track, signals: Signals
+    track: Track, signals: Signals, tau_min: float | None = None
 ) -> tuple[np.ndarray, np.ndarray, LocalProjection]:
-    """Per fix: the index of the nearest intersection and its distance in metres."""
+    """Per fix: the index of the nearest intersection and its distance in metres, by the basic
+    k-d tree query, or by Zheng's extended k-d tree recursion when ``tau_min`` (seconds) is
+    given (:mod:`tsrkit.geo.nearest`)."""
     projection = LocalProjection(float(np.mean(track.lat)), float(np.mean(track.lon)))
     sx, sy = projection(signals.lat, signals.lon)
     tx, ty = projection(track.lat, track.lon)
-    distance, nearest = cKDTree(np.column_stack([sx, sy])).query(np.column_stack([tx, ty]))
+    tree, points = cKDTree(np.column_stack([sx, sy])), np.column_stack([tx, ty])
+    if tau_min is None:
+        nearest, distance = nearest_kdtree(tree, points)
+    else:
+        nearest, distance = nearest_extended(tree, points, track.time, tau_min)
     return nearest, distance, projection
 
 
