@@ -39,6 +39,7 @@ import numpy as np
 from tsrkit.atomic import atomic_open
 from tsrkit.geo.projection import LocalProjection
 from tsrkit.synth.heads import LAMP_COLOURS, render_head
+from tsrkit.synth.scenes import LENS_BGR, add_glow
 from tsrkit.synth.video import video_writer
 
 MOVEMENTS = ("through", "left", "right")
@@ -531,7 +532,9 @@ def draw_signals(
                 ):
                     continue
                 colour = LAMP_COLOURS[state] if facing else (50, 50, 52)
-                drawn = render_head(layer, (u, v), radius, lit=lit, colour=colour)
+                drawn = render_head(
+                    layer, (u, v), radius, lit=lit, colour=colour, white_core=facing
+                )
                 _composite(image, layer, depth, drawn.housing, d)
                 if facing:
                     box = (u - radius, v - radius, u + radius, v + radius)
@@ -664,7 +667,7 @@ def render_frames(drive: Drive) -> Iterator[tuple[np.ndarray, list[Light]]]:
             if math.hypot(node.i * block - camera.x, node.j * block - camera.y) < 160
         ]
         lights = draw_signals(image, depth, camera, options, near, t)
-        image = cv2.GaussianBlur(image, (0, 0), 0.6)
+        image = cv2.GaussianBlur(bloom(image, lights), (0, 0), 0.6)
         jitter = 0.8 * jitter + float(rng.normal(0, options.vibration_px))
         shift = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, jitter]], np.float32)
         image = cv2.warpAffine(
@@ -689,6 +692,17 @@ def render_frames(drive: Drive) -> Iterator[tuple[np.ndarray, list[Light]]]:
             for light in lights
         ]
         yield np.clip(noisy, 0, 255).astype(np.uint8), lights
+
+
+def bloom(image: np.ndarray, lights: list[Light]) -> np.ndarray:
+    """Add the coloured halo a lit lamp spreads around its lens (``scenes.add_glow``, sigma
+    1.2 radii), scaled by the lens's unoccluded share."""
+    glow = np.zeros(image.shape, np.float32)
+    for light in lights:
+        if light.visible > 0:
+            colour = np.asarray(LENS_BGR[light.state], np.float32) * light.visible
+            add_glow(glow, light.x, light.y, colour, light.radius, 0.0, 1.2 * light.radius, 0.45)
+    return np.clip(image + 255 * glow, 0, 255).astype(np.uint8)
 
 
 def to_latlon(options: DriveOptions, x, y) -> tuple[np.ndarray, np.ndarray]:
