@@ -229,10 +229,10 @@ def light_state(options: DriveOptions, node: Node, approach: str, t: float) -> s
 
 
 def drive_profile(options: DriveOptions, route: Route) -> tuple[np.ndarray, np.ndarray]:
-    """Arc length and speed of the car at every frame: cruise, slow for turns, stop for a red
-    or for a yellow it can stop for at 3.5 m/s^2."""
+    """Arc length and speed of the car at every frame: start at cruise speed, slow for turns,
+    stop for a red or for a yellow it can stop for at 3.5 m/s^2, pull away at 2 m/s^2."""
     dt = 1.0 / options.fps
-    s, v, t = 0.0, 0.0, 0.0
+    s, v, t = 0.0, float(route.limit[0]), 0.0
     positions, speeds = [], []
     end = float(route.s[-1])
     while s < end:
