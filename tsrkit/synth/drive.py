@@ -293,11 +293,16 @@ class Camera:
 def _wave(x: np.ndarray, y: np.ndarray, seed: int) -> np.ndarray:
     """Smooth procedural texture in [-1, 1]: a few oblique sinusoids (no aliasing)."""
     rng = np.random.default_rng(seed)
+    x, y = np.asarray(x, np.float32), np.asarray(y, np.float32)
     total = np.zeros(np.broadcast(x, y).shape, np.float32)
     for wavelength in (1.3, 2.9, 6.1):
         angle, phase = rng.uniform(0, math.pi), rng.uniform(0, 2 * math.pi)
         k = 2 * math.pi / wavelength
-        total += np.sin(k * (math.cos(angle) * x + math.sin(angle) * y) + phase)
+        total += np.sin(
+            np.float32(k * math.cos(angle)) * x
+            + np.float32(k * math.sin(angle)) * y
+            + np.float32(phase)
+        )
     return total / 3
 
 
@@ -673,7 +678,7 @@ def render_frames(drive: Drive) -> Iterator[tuple[np.ndarray, list[Light]]]:
         image = cv2.warpAffine(
             image, shift, (options.width, options.height), borderMode=cv2.BORDER_REPLICATE
         )
-        noisy = image + rng.normal(0, options.noise, image.shape)
+        noisy = image + np.float32(options.noise) * rng.standard_normal(image.shape, np.float32)
         lights = [
             replace(
                 light,
