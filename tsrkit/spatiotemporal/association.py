@@ -67,12 +67,16 @@ def pair_score(pcs: float, ccs: float) -> float:
 
 def association_score(first: Point, second: Point, slack: float = 0.0) -> float:
     """``as`` of Eq. 3.35: the best ``as_{c0,c1}`` over every pair of colours, each weighted by
-    the candidates' classification scores.
+    the candidates' classification scores. As printed, ``exp(ccs)`` lies in ``[1, e]``: the
+    position term dominates, and an allowed change without colour evidence still counts.
 
     >>> a = Point(10.0, 10.0, 2.0, "red", {"red": 1.0})
-    >>> b = Point(10.0, 11.0, 2.0, "red", {"red": 0.25})
-    >>> round(association_score(a, b), 4)  # (1 - 0.5) * exp(sqrt(0.25))
-    0.8244
+    >>> b = Point(10.0, 11.0, 2.0, "red", {"red": 0.25, "green": 0.0})
+    >>> round(association_score(a, b), 4)  # red -> green, lens 0.5 radii down: 1 - 0.5/6
+    0.9167
+    >>> c = Point(11.0, 9.8, 2.0, "red", {"red": 0.25})  # right and up: only red -> red
+    >>> round(association_score(a, c), 4)  # (1 - hypot(0.5, 0.1)) * exp(sqrt(0.25))
+    0.808
     """
     scale = min(first.radius, second.radius)
     if scale <= 0:

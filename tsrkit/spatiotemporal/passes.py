@@ -25,8 +25,8 @@ def associate(scores: np.ndarray) -> list[tuple[int, int]]:
 
     >>> associate(np.array([[0.9, 0.0], [0.5, 0.7]]))
     [(0, 0), (1, 1)]
-    >>> associate(np.array([[0.9, 0.8], [0.1, 0.2]]))
-    [(0, 0), (1, 1)]
+    >>> associate(np.array([[0.9, 0.8], [0.1, 0.2]]))  # detection 1 is no track's best
+    [(0, 0)]
     """
     if scores.size == 0:
         return []
