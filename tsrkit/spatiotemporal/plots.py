@@ -77,6 +77,6 @@ def timeline_plot(record: dict[str, Any], path: str | os.PathLike) -> None:
         f"{record['movement']}",
         fontsize=9,
     )
-    ax.legend(loc="upper left", fontsize=7)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=7)
     figure.tight_layout()
     _save(figure, path)

@@ -81,6 +81,7 @@ class Point:
             "status": self.status,
             "state": self.state,
             "confidence": round(self.confidence, 4),
+            "score": round(self.score, 4),
         }
 
 

@@ -143,7 +143,7 @@ def track_video(
         track, signals, start, fps, count, settings.vicinity, settings.upstream, settings.downstream
     )
     pipeline = selection.pipeline()
-    regional = Pipeline(selection.detector, selection.classifier, None, selection.verifier)  # type: ignore[arg-type]
+    regional = Pipeline(pipeline.detector, pipeline.classifier, None, pipeline.verifier)
     key_base = identity(selection, settings)
     for number, item in enumerate(found):
         images, digest = decode_clip(video, item.first, item.last)

@@ -38,6 +38,7 @@ import numpy as np
 
 from tsrkit.atomic import atomic_open
 from tsrkit.geo.projection import LocalProjection
+from tsrkit.spatiotemporal.points import frame_status
 from tsrkit.synth.heads import LAMP_COLOURS, render_head
 from tsrkit.synth.scenes import LENS_BGR, add_glow
 from tsrkit.synth.video import video_writer
@@ -447,16 +448,6 @@ class Light:
         return out
 
 
-def frame_status(bbox, width: int, height: int) -> str:
-    """``in`` when the box lies inside the image, ``partial`` when it overlaps it, else ``out``."""
-    x0, y0, x1, y1 = bbox
-    if x0 >= 0 and y0 >= 0 and x1 <= width and y1 <= height:
-        return "in"
-    if x1 <= 0 or y1 <= 0 or x0 >= width or y0 >= height:
-        return "out"
-    return "partial"
-
-
 def _window(box, shape) -> tuple[slice, slice]:
     h, w = shape[:2]
     x0, y0 = max(int(math.floor(box[0])), 0), max(int(math.floor(box[1])), 0)
@@ -552,7 +543,7 @@ def draw_signals(
                             u,
                             v,
                             radius,
-                            frame_status(box, camera.width, camera.height),
+                            frame_status(u, v, radius, camera.width, camera.height),
                             _unoccluded(depth, box, d),
                         )
                     )
@@ -684,14 +675,7 @@ def render_frames(drive: Drive) -> Iterator[tuple[np.ndarray, list[Light]]]:
                 light,
                 y=light.y + jitter,
                 status=frame_status(
-                    (
-                        light.x - light.radius,
-                        light.y + jitter - light.radius,
-                        light.x + light.radius,
-                        light.y + jitter + light.radius,
-                    ),
-                    options.width,
-                    options.height,
+                    light.x, light.y + jitter, light.radius, options.width, options.height
                 ),
             )
             for light in lights
