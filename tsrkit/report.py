@@ -59,8 +59,8 @@ class ProgressBar:
     def __exit__(self, *exc) -> None:
         self.progress.stop()
 
-    def advance(self) -> None:
-        self.progress.advance(self.task)
+    def advance(self, amount: int = 1) -> None:
+        self.progress.advance(self.task, amount)
         speed = self.progress.tasks[0].speed
         self.progress.update(self.task, rate=f"{speed:.1f}" if speed else "-")
 
