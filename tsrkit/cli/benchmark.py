@@ -12,7 +12,7 @@ from collections.abc import Sequence
 
 import click
 
-from tsrkit.cli.common import UserError, plugin_options
+from tsrkit.cli.common import FiniteFloatRange, UserError, plugin_options
 from tsrkit.eval.settings import BOX_OPTIONS
 from tsrkit.report import print_table
 from tsrkit.selection import build, build_compare
@@ -83,7 +83,7 @@ def run_options(func):
         click.option(
             "--iou",
             "iou_threshold",
-            type=click.FloatRange(0, 1, max_open=True),
+            type=FiniteFloatRange(0, 1, max_open=True),
             default=0.5,
             show_default=True,
             help="IoU threshold of the report's 'iou' section (Lee 3.6.2).",

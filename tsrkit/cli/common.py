@@ -3,6 +3,8 @@ one-line user error. Building the chosen plugins is :func:`tsrkit.selection.buil
 
 from __future__ import annotations
 
+import math
+
 import click
 
 from tsrkit.selection import DEFAULT_DETECTOR
@@ -48,3 +50,27 @@ class UserError(click.ClickException):
     """Raised by commands for mistakes that need no traceback."""
 
     exit_code = 2
+
+
+def describe_os_error(exc: OSError) -> str:
+    """One line for a file-system error: the path(s) and the reason.
+
+    Examples
+    --------
+    >>> describe_os_error(NotADirectoryError(20, "Not a directory", "out/x"))
+    'cannot use out/x: Not a directory'
+    """
+    paths = " -> ".join(str(p) for p in (exc.filename, exc.filename2) if p is not None)
+    reason = exc.strerror or str(exc)
+    return f"cannot use {paths}: {reason}" if paths else f"file system error: {reason}"
+
+
+class FiniteFloatRange(click.FloatRange):
+    """``click.FloatRange`` that also refuses ``nan`` (which every comparison lets through)
+    and infinities."""
+
+    def convert(self, value, param, ctx):
+        number = super().convert(value, param, ctx)
+        if not math.isfinite(number):
+            self.fail(f"{value!r} is not a finite number", param, ctx)
+        return number

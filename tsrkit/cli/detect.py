@@ -132,7 +132,7 @@ def detect_command(
         frames, found, skipped = run_detect(
             pipeline, inputs, stream, draw_dir, every, start, end, workers
         )
-    console = Console(stderr=True)
+    console = Console(stderr=True, soft_wrap=True)  # one line per skipped input, never wrapped
     console.print(
         f"[bold]{frames}[/bold] frames, [bold]{found}[/bold] detections, "
         f"[bold]{len(skipped)}[/bold] skipped" + (f" -> {out}" if out else "")
@@ -141,4 +141,7 @@ def detect_command(
         console.print(f"  skipped {item.source}: {item.reason}", markup=False)
     if frames == 0 and skipped:
         console.print(f"error: all {len(skipped)} inputs were skipped", markup=False)
+        raise SystemExit(1)
+    if frames == 0:
+        console.print(f"error: no input found in {', '.join(inputs)}", markup=False)
         raise SystemExit(1)

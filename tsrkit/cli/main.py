@@ -4,19 +4,22 @@ from __future__ import annotations
 
 import click
 
-from tsrkit.cli.common import UserError
+from tsrkit.cli.common import UserError, describe_os_error
 from tsrkit.errors import TsrkitError
 from tsrkit.registry import INTERNAL, PluginFailure, get_registry
 
 
 class TsrkitGroup(click.Group):
-    """A click group that reports :class:`TsrkitError` as one line and exit status 2."""
+    """A click group that reports :class:`TsrkitError` and operating-system errors (an
+    unwritable ``--out``, a full disk) as one line and exit status 2."""
 
     def invoke(self, ctx: click.Context):
         try:
             return super().invoke(ctx)
         except TsrkitError as exc:
             raise UserError(str(exc)) from None
+        except OSError as exc:
+            raise UserError(describe_os_error(exc)) from None
 
 
 @click.group(

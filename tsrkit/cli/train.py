@@ -5,6 +5,7 @@ from __future__ import annotations
 import click
 from rich.console import Console
 
+from tsrkit.errors import TsrkitError
 from tsrkit.params import parse_assignments
 from tsrkit.registry import get_registry
 from tsrkit.training import train
@@ -68,7 +69,12 @@ def train_command(plugin, dataset_refs, format_name, images, split, params, out,
         raise click.UsageError("detector.KEY=VALUE parameters need --detector")
     det = get_registry().create("detector", detector, detector_params) if detector else None
     dataset = open_datasets(dataset_refs, split, format=format_name, images=images)
-    path = train(plugin, dataset, out, own, det)
+    try:
+        path = train(plugin, dataset, out, own, det)
+    except TsrkitError:
+        raise
+    except ValueError as exc:  # the data cannot train this plugin (a class without samples...)
+        raise TsrkitError(f"cannot train {plugin} on {dataset.name}: {exc}") from None
     Console(stderr=True).print(
         f"trained {plugin} on {len(dataset)} samples of {dataset.name} -> {path}"
     )
