@@ -240,7 +240,7 @@ def load_config(path: str | os.PathLike) -> dict[str, Any]:
     except UnicodeDecodeError as exc:
         raise ParamError(f"config {path}: not valid UTF-8 (byte offset {exc.start})") from None
     except yaml.YAMLError as exc:
-        raise ParamError(f"config {path}: not valid YAML ({exc})".replace("\n", " ")) from None
+        raise ParamError(f"config {path}: not valid YAML ({' '.join(str(exc).split())})") from None
     if not isinstance(data, dict):
         raise ParamError(f"config {path}: expected a mapping at the top level")
     _string_keys(data, f"config {path}")

@@ -88,8 +88,9 @@ def read_yaml(path: str | os.PathLike, missing: str = "file not found") -> Any:
         return yaml.load(text, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
+        reason = " ".join(str(getattr(exc, "problem", None) or exc).split())  # one line
         raise DatasetError(
             path,
-            f"not valid YAML ({getattr(exc, 'problem', None) or exc})",
+            f"not valid YAML ({reason})",
             f"line {mark.line + 1}" if mark else "",
         ) from None
