@@ -12,7 +12,8 @@ from collections.abc import Sequence
 
 import click
 
-from tsrkit.cli.common import FiniteFloatRange, UserError, plugin_options
+from tsrkit.cli.common import FiniteFloatRange, plugin_options
+from tsrkit.cli.errors import UserError
 from tsrkit.eval.settings import BOX_OPTIONS
 from tsrkit.report import print_table
 from tsrkit.selection import build, build_compare

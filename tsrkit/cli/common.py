@@ -1,5 +1,6 @@
-"""Options shared by the verbs that run plugins (selection, ``--param``, ``--config``) and the
-one-line user error. Building the chosen plugins is :func:`tsrkit.selection.build`."""
+"""Options shared by the verbs that run plugins (selection, ``--param``, ``--config``) and a
+float option type that refuses NaN. Building the chosen plugins is
+:func:`tsrkit.selection.build`."""
 
 from __future__ import annotations
 
@@ -44,25 +45,6 @@ def plugin_options(func):
     for option in reversed(options):
         func = option(func)
     return func
-
-
-class UserError(click.ClickException):
-    """Raised by commands for mistakes that need no traceback."""
-
-    exit_code = 2
-
-
-def describe_os_error(exc: OSError) -> str:
-    """One line for a file-system error: the path(s) and the reason.
-
-    Examples
-    --------
-    >>> describe_os_error(NotADirectoryError(20, "Not a directory", "out/x"))
-    'cannot use out/x: Not a directory'
-    """
-    paths = " -> ".join(str(p) for p in (exc.filename, exc.filename2) if p is not None)
-    reason = exc.strerror or str(exc)
-    return f"cannot use {paths}: {reason}" if paths else f"file system error: {reason}"
 
 
 class FiniteFloatRange(click.FloatRange):
