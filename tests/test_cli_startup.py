@@ -55,3 +55,5 @@ def test_the_python_api_names_resolve_on_first_use():
 
     assert Candidate.__module__ == "tsrkit.types" and callable(hookimpl)
     assert set(tsrkit.__all__) <= set(dir(tsrkit))
+    assert tsrkit.datasets.open_datasets.__module__ == "tsrkit.datasets.concat"
+    assert not hasattr(tsrkit, "no_such_name")

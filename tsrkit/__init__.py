@@ -103,6 +103,11 @@ def __getattr__(name: str) -> Any:
         value = getattr(_importlib.import_module(_LAZY[name]), name)
         globals()[name] = value
         return value
+    try:  # a subpackage, as ``tsrkit.datasets.open_datasets`` (imported on first use)
+        return _importlib.import_module(f"{__name__}.{name}")
+    except ModuleNotFoundError as exc:
+        if exc.name != f"{__name__}.{name}":
+            raise
     raise AttributeError(f"module 'tsrkit' has no attribute {name!r}")
 
 
