@@ -7,6 +7,11 @@ Surfaces:
   ``ImageReadError``);
 - ``coco``, ``normalized``, ``voc``, ``yolo``: the annotation files tsrkit writes for a 4-frame
   synthetic set, mutated the same way, through ``open_dataset`` (allowed: ``TsrkitError``);
+- ``gtsrb``, ``lisa``, ``bosch``, ``crops``, ``dtld``, ``lara``: a small valid file of each
+  read-only format (:data:`SEED_FILES`), mutated the same way;
+- ``config``: a run configuration YAML through ``load_config`` (allowed: ``ParamError``);
+- ``model``: the ``.json`` and ``.npz`` of a saved model through ``load_model`` (allowed:
+  ``ModelError``);
 - ``params``: random strings and numbers for every parameter type (allowed: ``ParamError``).
 
     python benchmarks/fuzz.py [--cases 10000] [--seed 0]
@@ -125,6 +130,99 @@ def format_surface(folder: Path, fmt: str, dataset: Dataset):
     return seeds, target, TsrkitError
 
 
+#: A small valid annotation file of each read-only format (one 24x24 image ``a.png``).
+SEED_FILES = {
+    "gtsrb": (
+        "GT-00000.csv",
+        "Filename;Width;Height;Roi.X1;Roi.Y1;Roi.X2;Roi.Y2;ClassId\na.png;24;24;1;1;20;20;0\n"
+        "a.png;24;24;2;2;9;9;14\n",
+    ),
+    "lisa": (
+        "frameAnnotationsBOX.csv",
+        "Filename;Annotation tag;Upper left corner X;Upper left corner Y;Lower right corner X;"
+        "Lower right corner Y;Origin file;Origin frame number;Origin track;Origin track frame "
+        "number\na.png;go;1;1;10;10;x;0;x;0\na.png;stopLeft;3;3;12;12;x;0;x;0\n",
+    ),
+    "bosch": (
+        "test.yaml",
+        "- path: a.png\n  boxes:\n  - {label: Red, occluded: false, x_min: 1, y_min: 1, "
+        "x_max: 10, y_max: 10}\n  - {label: off, occluded: true, x_min: 2, y_min: 2, x_max: 5, "
+        "y_max: 9}\n",
+    ),
+    "crops": ("labels.csv", "file,label,split,width,height,condition\na.png,red,train,24,24,day\n"),
+    "dtld": (
+        "dtld.json",
+        '{"images": [{"image_path": "a.png", "time_stamp": 1.5, "labels": [{"x": 1, "y": 1, '
+        '"w": 9, "h": 9, "unique_id": 3, "attributes": {"state": "red_yellow", '
+        '"direction": "front"}}]}]}',
+    ),
+    "lara": ("gt.txt", "# LaRA\n0.5 / 0 1 1 10 10 0 'Traffic Light' 'go'\n"),
+}
+
+
+def seed_file_surface(folder: Path, fmt: str):
+    """Mutations of :data:`SEED_FILES`' file of ``fmt`` read through ``open_dataset``."""
+    out = folder / f"seed-{fmt}"
+    out.mkdir()
+    image = np.zeros((24, 24, 3), np.uint8)
+    for name in ("a.png", "Lara3D_UrbanSeq1_JPG/frame_000000.jpg"):
+        (out / name).parent.mkdir(exist_ok=True)
+        cv2.imwrite(str(out / name), image)
+    name, text = SEED_FILES[fmt]
+    path = out / name
+
+    def target(data: bytes) -> None:
+        path.write_bytes(data)
+        open_dataset(path, format=fmt)
+
+    return [text.encode()], target, TsrkitError
+
+
+def config_surface(folder: Path):
+    from tsrkit.params import ParamError, load_config
+
+    path = folder / "run.yaml"
+    seeds = [
+        b"detector: {name: lab-frst, params: {top: 15}}\nverifier: {name: verifier, params: "
+        b"{threshold: 0.3}}\nclassifier: ab-hist\ndescription: a run\n"
+    ]
+
+    def target(data: bytes) -> None:
+        path.write_bytes(data)
+        load_config(path)
+
+    return seeds, target, ParamError
+
+
+def model_surface(folder: Path):
+    from tsrkit.models import Model, ModelError, load_model, save_model
+
+    base = folder / "model"
+    save_model(
+        base,
+        Model({"w": np.arange(6.0).reshape(2, 3)}, {"classes": ["red"]}),
+        plugin="p",
+        plugin_version="1",
+        params={"bins": 8},
+        training={"samples": 3},
+    )
+    files = [folder / "model.json", folder / "model.npz"]
+    seeds = [f.read_bytes() for f in files]
+
+    def target(data: bytes) -> None:
+        victim = files[target.k % len(files)]  # type: ignore[attr-defined]
+        target.k += 1  # type: ignore[attr-defined]
+        original = victim.read_bytes()
+        victim.write_bytes(data)
+        try:
+            load_model(base, plugin="p")
+        finally:
+            victim.write_bytes(original)
+
+    target.k = 0  # type: ignore[attr-defined]
+    return seeds, target, ModelError
+
+
 def params_surface():
     schema = [
         Param("f", "float", 0.5, min=0, max=1),
@@ -160,6 +258,10 @@ def main() -> None:
         surfaces = {"image": image_surface(folder)}
         for fmt in ("coco", "normalized", "voc", "yolo"):
             surfaces[fmt] = format_surface(folder, fmt, data)
+        for fmt in SEED_FILES:
+            surfaces[fmt] = seed_file_surface(folder, fmt)
+        surfaces["config"] = config_surface(folder)
+        surfaces["model"] = model_surface(folder)
         surfaces["params"] = params_surface()
         total_uncaught = 0
         for name, (seeds, target, allowed) in surfaces.items():

@@ -66,8 +66,8 @@ def test_a_header_lie_in_a_folder_of_good_images_skips_only_that_frame(tmp_path)
 @pytest.mark.parametrize(
     "content,fragment",
     [
-        (b"\xff\xfe not utf-8 \x80", "malformed"),
-        (json.dumps({"images": 5}).encode(), "malformed"),
+        (b"\xff\xfe not utf-8 \x80", "line 1: not valid UTF-8 \\(byte 0xff at offset 0\\)"),
+        (json.dumps({"images": 5}).encode(), "expected a list of image records"),
         (
             json.dumps(
                 [

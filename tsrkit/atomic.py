@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import math
 import os
 import tempfile
 from pathlib import Path
@@ -37,6 +38,29 @@ def _umask() -> int:
     mask = os.umask(0)
     os.umask(mask)
     return mask
+
+
+def finite(data: Any) -> Any:
+    """``data`` with every NaN or infinite float replaced by None, so that JSON written from it
+    holds no ``NaN`` / ``Infinity`` tokens (which are not JSON).
+
+    Examples
+    --------
+    >>> finite({"score": float("nan"), "box": [1.0, float("inf")], "n": 2})
+    {'score': None, 'box': [1.0, None], 'n': 2}
+    """
+    if isinstance(data, float):
+        return data if math.isfinite(data) else None
+    if isinstance(data, dict):
+        return {key: finite(value) for key, value in data.items()}
+    if isinstance(data, (list, tuple)):
+        return [finite(value) for value in data]
+    return data
+
+
+def json_line(data: Any) -> str:
+    """One JSON Lines record (no newline), with non-finite numbers as null."""
+    return json.dumps(finite(data), allow_nan=False)
 
 
 def write_json(path: str | os.PathLike, data: Any) -> None:

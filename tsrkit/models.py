@@ -121,7 +121,13 @@ def load_model(path: str | os.PathLike, plugin: str) -> Model:
         meta = json.loads(json_path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise ModelError(f"model {json_path}: unreadable metadata ({exc})") from None
-    if not isinstance(meta, dict) or "arrays" not in meta or "plugin" not in meta:
+    if (
+        not isinstance(meta, dict)
+        or not isinstance(meta.get("plugin"), str)
+        or not isinstance(meta.get("arrays"), dict)
+        or not all(isinstance(entry, dict) for entry in meta["arrays"].values())
+        or not isinstance(meta.get("info", {}), dict)
+    ):
         raise ModelError(f"model {json_path}: not tsrkit model metadata")
     if meta["plugin"] != plugin:
         raise ModelError(f"model {npz_path} was trained for '{meta['plugin']}', not '{plugin}'")

@@ -235,19 +235,32 @@ def load_config(path: str | os.PathLike) -> dict[str, Any]:
     try:
         with open(path, encoding="utf-8") as fh:
             data = yaml.safe_load(fh) or {}
-    except (OSError, yaml.YAMLError) as exc:
-        raise ParamError(f"config {path}: {exc}") from None
+    except OSError as exc:
+        raise ParamError(f"config {path}: cannot read ({exc.strerror or exc})") from None
+    except UnicodeDecodeError as exc:
+        raise ParamError(f"config {path}: not valid UTF-8 (byte offset {exc.start})") from None
+    except yaml.YAMLError as exc:
+        raise ParamError(f"config {path}: not valid YAML ({' '.join(str(exc).split())})") from None
     if not isinstance(data, dict):
         raise ParamError(f"config {path}: expected a mapping at the top level")
-    for kind in ("detector", "classifier", "tracker"):
+    _string_keys(data, f"config {path}")
+    for kind in ("detector", "verifier", "classifier", "tracker"):
         entry = data.get(kind)
         if isinstance(entry, str):
             data[kind] = {"name": entry, "params": {}}
         elif entry is not None:
-            if not isinstance(entry, dict) or "name" not in entry:
+            if not isinstance(entry, dict) or not isinstance(entry.get("name"), str):
                 raise ParamError(f"config {path}: '{kind}' must be a name or have a 'name' key")
             params = entry.get("params") or {}
             if not isinstance(params, dict):
                 raise ParamError(f"config {path}: '{kind}.params' must be a mapping")
+            _string_keys(params, f"config {path}: '{kind}.params'")
             data[kind] = {"name": entry["name"], "params": params}
     return data
+
+
+def _string_keys(mapping: Mapping[Any, Any], owner: str) -> None:
+    """Refuse a mapping with a key that is not a string (YAML reads ``1:`` as an integer)."""
+    for key in mapping:
+        if not isinstance(key, str):
+            raise ParamError(f"{owner}: key {key!r} is not a name (keys must be strings)")

@@ -21,6 +21,7 @@ from typing import Any, Literal, overload
 import pluggy
 
 from tsrkit import hookspecs
+from tsrkit.cli.verbs import ENTRY_POINT_GROUP
 from tsrkit.errors import TsrkitError
 from tsrkit.params import ParamError, validate
 from tsrkit.plugin import (
@@ -35,7 +36,6 @@ from tsrkit.plugin import (
     is_trainable,
 )
 
-ENTRY_POINT_GROUP = "tsrkit"
 LOAD_ENV = "TSRKIT_LOAD_PLUGINS"
 KINDS = {
     "detector": "register_detectors",

@@ -20,6 +20,7 @@ from tsrkit.plugin import DatasetFormat
 from tsrkit.types import Dataset, Sample
 from tsrkit_plugins.formats.common import (
     annotation,
+    attributes,
     checked_box,
     class_names,
     explicit_state,
@@ -27,6 +28,7 @@ from tsrkit_plugins.formats.common import (
     field,
     json_safe,
     numbers,
+    optional,
     raw_label,
     read_json,
     relative_source,
@@ -54,26 +56,27 @@ class Coco(DatasetFormat):
         if not _is_coco(data):
             raise DatasetError(path, "expected an object with images, annotations, categories")
         categories = {}
-        for i, cat in enumerate(data["categories"]):
+        for i, cat in enumerate(field(data, "categories", list, path, "")):
             categories[field(cat, "id", int, path, f"categories[{i}]")] = str(
                 field(cat, "name", (str, int), path, f"categories[{i}]")
             )
         by_image = defaultdict(list)
-        for i, ann in enumerate(data["annotations"]):
+        for i, ann in enumerate(field(data, "annotations", list, path, "")):
             by_image[field(ann, "image_id", int, path, f"annotations[{i}]")].append(
                 _annotation(path, ann, f"annotations[{i}]", categories)
             )
         samples = []
-        for i, image in enumerate(data["images"]):
+        for i, image in enumerate(field(data, "images", list, path, "")):
             where = f"images[{i}]"
             image_id = field(image, "id", int, path, where)
             size = {k: image[k] for k in ("width", "height") if isinstance(image.get(k), int)}
+            metadata = optional(image, "metadata", dict, path, where) or {}
             samples.append(
                 Sample(
                     resolve_image(path.parent, field(image, "file_name", str, path, where), images),
                     tuple(by_image.pop(image_id, ())),
-                    split=image.get("split"),
-                    metadata={**(image.get("metadata") or {}), "coco_id": image_id},
+                    split=optional(image, "split", str, path, where),
+                    metadata={**metadata, "coco_id": image_id},
                     **size,
                 )
             )
@@ -127,7 +130,7 @@ def _annotation(path: Path, ann, where: str, categories: dict):
         bbox,
         categories[category],
         explicit_state(ann, path, where),
-        **(ann.get("attributes") or {}),
+        **attributes(ann, path, where),
     )
 
 

@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import Any
 
 from tsrkit.datasets import DatasetError, to_state
+from tsrkit.datasets.errors import read_text
 from tsrkit.types import STATES, Annotation, Dataset
 
 
@@ -34,15 +35,17 @@ def relative_source(source: str, folder: Path) -> str:
 
 
 def annotation(
-    bbox: Sequence[float], label: Any, state: str | None = None, **attributes: Any
+    bbox: Sequence[float], label: Any, state: str | None = None, /, **attributes: Any
 ) -> Annotation:
     """An annotation whose raw ``label`` is kept in ``attributes["label"]``.
 
-    ``state`` defaults to :func:`tsrkit.datasets.to_state` of the label.
+    ``state`` defaults to :func:`tsrkit.datasets.to_state` of the label. An attribute read
+    from a file may be called ``label``, ``bbox`` or ``state`` without clashing (the raw label
+    wins).
     """
     label = str(label)
     return Annotation(
-        tuple(float(v) for v in bbox), state or to_state(label), {"label": label, **attributes}
+        tuple(float(v) for v in bbox), state or to_state(label), {**attributes, "label": label}
     )
 
 
@@ -102,11 +105,9 @@ def explicit_state(record: Mapping[str, Any], path: Path, where: str) -> str | N
 
 def read_json(path: Path) -> Any:
     """Parse a JSON file; a DatasetError names the line and column of a syntax error."""
+    text = read_text(path)
     try:
-        with open(path, encoding="utf-8") as fh:
-            return json.load(fh)
-    except FileNotFoundError:
-        raise DatasetError(path, "file not found") from None
+        return json.loads(text)
     except json.JSONDecodeError as exc:
         raise DatasetError(
             path, f"not valid JSON ({exc.msg})", f"line {exc.lineno} column {exc.colno}"
@@ -125,6 +126,18 @@ def field(record: Any, key: str, kind: type | tuple[type, ...], path: Path, wher
         names = kind.__name__ if isinstance(kind, type) else " or ".join(k.__name__ for k in kind)
         raise DatasetError(path, f"'{key}' must be {names}, got {value!r}", where)
     return value
+
+
+def optional(
+    record: Mapping[str, Any], key: str, kind: type | tuple[type, ...], path: Path, where: str
+) -> Any:
+    """``record[key]`` when present and not null, checked like :func:`field`; else None."""
+    return field(record, key, kind, path, where) if record.get(key) is not None else None
+
+
+def attributes(record: Mapping[str, Any], path: Path, where: str) -> dict[str, Any]:
+    """The optional ``"attributes"`` object tsrkit writers add to a box (empty when absent)."""
+    return dict(optional(record, "attributes", dict, path, where) or {})
 
 
 def sniff_json(path: Path, test) -> bool:

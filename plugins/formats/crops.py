@@ -10,9 +10,11 @@ with split one of train, valid, val, test.
 from __future__ import annotations
 
 import csv
+import io
 from pathlib import Path
 
 from tsrkit.datasets import DatasetError
+from tsrkit.datasets.errors import read_text
 from tsrkit.datasets.imagesize import image_size
 from tsrkit.hookspecs import hookimpl
 from tsrkit.inputs import IMAGE_EXTENSIONS
@@ -27,7 +29,7 @@ ANNOTATION_SUFFIXES = {".json", ".yaml", ".yml", ".xml", ".csv", ".txt"}
 
 
 def _header(path: Path) -> list[str]:
-    with open(path, newline="", encoding="utf-8") as fh:
+    with open(path, newline="", encoding="utf-8", errors="replace") as fh:
         return next(csv.reader(fh), [])
 
 
@@ -91,7 +93,7 @@ class Crops(DatasetFormat):
 
 def _from_csv(file: Path, images: Path | None) -> list[Sample]:
     samples = []
-    with open(file, newline="", encoding="utf-8") as fh:
+    with io.StringIO(read_text(file), newline="") as fh:
         reader = csv.DictReader(fh)
         missing = {"file", "label"} - set(reader.fieldnames or ())
         if missing:

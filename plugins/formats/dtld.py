@@ -83,7 +83,7 @@ def _sample(file: Path, entry, where: str, images: Path | None) -> Sample:
             )
         extra = json_safe({k: v for k, v in attributes.items() if k != "state"})
         ids = {k: label[k] for k in ("unique_id", "track_id") if k in label}
-        annotations.append(annotation(bbox, state, STATES[state], **extra, **ids))
+        annotations.append(annotation(bbox, state, STATES[state], **{**extra, **ids}))
     metadata = {"timestamp": entry["time_stamp"]} if "time_stamp" in entry else {}
     return Sample(
         resolve_image(file.parent, field(entry, "image_path", str, file, where), images),

@@ -15,9 +15,11 @@ text) and ``attributes["class_id"]`` the integer class id.
 from __future__ import annotations
 
 import csv
+import io
 from pathlib import Path
 
 from tsrkit.datasets import DatasetError
+from tsrkit.datasets.errors import read_text
 from tsrkit.hookspecs import hookimpl
 from tsrkit.plugin import DatasetFormat
 from tsrkit.types import Dataset, Sample
@@ -59,7 +61,7 @@ def class_names(folder: Path) -> dict[int, str]:
     if not file.is_file():
         return {}
     names = {}
-    for number, line in enumerate(file.read_text(encoding="utf-8").splitlines(), 1):
+    for number, line in enumerate(read_text(file).splitlines(), 1):
         first, sep, name = line.strip().partition(";")
         if sep and first.strip().isdigit():
             names[int(first)] = name.strip()
@@ -102,13 +104,19 @@ class Gtsrb(DatasetFormat):
 
 
 def _rows(file: Path, delimiter: str, columns: tuple[str, ...]):
-    with open(file, newline="", encoding="utf-8") as fh:
-        reader = csv.DictReader(fh, delimiter=delimiter)
-        missing = [c for c in columns if c not in (reader.fieldnames or ())]
-        if missing:
-            raise DatasetError(file, f"missing column(s) {', '.join(missing)}", "line 1")
-        for row in reader:
-            yield f"line {reader.line_num}", row
+    reader = csv.DictReader(io.StringIO(read_text(file), newline=""), delimiter=delimiter)
+    missing = [c for c in columns if c not in (reader.fieldnames or ())]
+    if missing:
+        raise DatasetError(file, f"missing column(s) {', '.join(missing)}", "line 1")
+    for row in reader:
+        where = f"line {reader.line_num}"
+        if any(row.get(c) is None for c in columns):
+            raise DatasetError(
+                file,
+                f"expected {len(reader.fieldnames or ())} '{delimiter}'-separated fields",
+                where,
+            )
+        yield where, row
 
 
 def _class_id(file: Path, value: str, where: str) -> int:

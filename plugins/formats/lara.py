@@ -14,6 +14,7 @@ import shlex
 from pathlib import Path
 
 from tsrkit.datasets import DatasetError
+from tsrkit.datasets.errors import read_text
 from tsrkit.hookspecs import hookimpl
 from tsrkit.params import Param
 from tsrkit.plugin import DatasetFormat
@@ -41,21 +42,20 @@ def _tokens(file: Path, line: str, where: str) -> list[str]:
 
 
 def _lines(file: Path):
-    with open(file, encoding="utf-8", errors="replace") as fh:
-        for number, line in enumerate(fh, 1):
-            if line.strip() and not line.lstrip().startswith("#"):
-                yield number, line
+    for number, line in enumerate(read_text(file).split("\n"), 1):
+        if line.strip() and not line.lstrip().startswith("#"):
+            yield number, line
 
 
 def _is_lara(path: Path) -> bool:
     if not (path.is_file() and path.suffix.lower() == ".txt"):
         return False
-    for number, line in _lines(path):
-        try:
+    try:
+        for number, line in _lines(path):
             _tokens(path, line, f"line {number}")
-        except DatasetError:
-            return False
-        return True
+            return True
+    except DatasetError:
+        return False
     return False
 
 

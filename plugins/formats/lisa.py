@@ -13,9 +13,11 @@ given, else ``Filename`` as written, relative to the CSV's folder. A folder is r
 from __future__ import annotations
 
 import csv
+import io
 from pathlib import Path
 
 from tsrkit.datasets import DatasetError
+from tsrkit.datasets.errors import read_text
 from tsrkit.hookspecs import hookimpl
 from tsrkit.params import Param
 from tsrkit.plugin import DatasetFormat
@@ -81,7 +83,7 @@ class Lisa(DatasetFormat):
 
 
 def _rows(file: Path, images: Path | None):
-    with open(file, newline="", encoding="utf-8") as fh:
+    with io.StringIO(read_text(file), newline="") as fh:
         reader = csv.DictReader(fh, delimiter=";")
         missing = [c for c in COLUMNS if c not in (reader.fieldnames or ())]
         if missing:

@@ -17,11 +17,13 @@ from tsrkit.plugin import DatasetFormat
 from tsrkit.types import Dataset, Sample
 from tsrkit_plugins.formats.common import (
     annotation,
+    attributes,
     checked_box,
     explicit_state,
     extra_attributes,
     field,
     json_safe,
+    optional,
     raw_label,
     read_json,
     relative_source,
@@ -79,14 +81,14 @@ def _sample(file: Path, record, where: str, images: Path | None) -> Sample:
         label = str(field(box, "label", (str, int), file, at))
         bbox = checked_box([field(box, k, (int, float), file, at) for k in COORDS], file, at)
         annotations.append(
-            annotation(bbox, label, explicit_state(box, file, at), **(box.get("attributes") or {}))
+            annotation(bbox, label, explicit_state(box, file, at), **attributes(box, file, at))
         )
     size = {k: record[k] for k in ("width", "height") if isinstance(record.get(k), int)}
     return Sample(
         resolve_image(file.parent, name, images),
         tuple(annotations),
-        split=record.get("split"),
-        metadata=dict(record.get("metadata") or {}),
+        split=optional(record, "split", str, file, where),
+        metadata=dict(optional(record, "metadata", dict, file, where) or {}),
         **size,
     )
 

@@ -19,6 +19,7 @@ from defusedxml import DefusedXmlException
 
 from tsrkit.atomic import atomic_open
 from tsrkit.datasets import DatasetError, to_state
+from tsrkit.datasets.errors import read_text
 from tsrkit.hookspecs import hookimpl
 from tsrkit.plugin import DatasetFormat
 from tsrkit.types import Dataset, Sample
@@ -102,9 +103,7 @@ def _splits(root: Path) -> dict[str, str]:
         listed = sets / f"{split_file}.txt"
         if listed.is_file():
             out.update(
-                (line.split()[0], split)
-                for line in listed.read_text(encoding="utf-8").splitlines()
-                if line.strip()
+                (line.split()[0], split) for line in read_text(listed).splitlines() if line.strip()
             )
     return out
 

@@ -19,7 +19,7 @@ import yaml
 
 from tsrkit.atomic import atomic_open
 from tsrkit.datasets import DatasetError
-from tsrkit.datasets.errors import read_yaml
+from tsrkit.datasets.errors import read_text, read_yaml
 from tsrkit.datasets.imagesize import image_size
 from tsrkit.hookspecs import hookimpl
 from tsrkit.inputs import IMAGE_EXTENSIONS
@@ -50,11 +50,18 @@ def read_data_yaml(file: Path) -> dict:
     return data
 
 
-def class_table(data: dict) -> dict[int, str]:
-    """``{class id: name}`` from the ``names`` of a data.yaml."""
+def class_table(data: dict, file: Path) -> dict[int, str]:
+    """``{class id: name}`` from the ``names`` of the data.yaml ``file``."""
     names = data["names"]
     pairs = names.items() if isinstance(names, dict) else enumerate(names)
-    return {int(k): str(v) for k, v in pairs}
+    table = {}
+    for key, name in pairs:
+        if isinstance(key, str) and key.strip().isdigit():
+            key = int(key)
+        if isinstance(key, bool) or not isinstance(key, int):
+            raise DatasetError(file, f"class id {key!r} is not an integer", "names")
+        table[key] = str(name)
+    return table
 
 
 def labels_path(image: Path) -> Path:
@@ -100,17 +107,23 @@ class Yolo(DatasetFormat):
     def read(self, path: Path, images: Path | None = None) -> Dataset:
         file = _data_yaml(Path(path))
         data = read_data_yaml(file)
-        classes = class_table(data)
+        classes = class_table(data, file)
         base = file.parent / str(data.get("path") or ".")
         samples, missing = [], []
         for key, split in SPLIT_KEYS.items():
             if not data.get(key):
                 continue
-            found = _split_images(base, str(data[key]), images)
-            if found is None:
-                missing.append(split)
-                continue
-            samples.extend(_sample(image, split, classes, file) for image in found)
+            entries = data[key] if isinstance(data[key], list) else [data[key]]
+            for entry in entries:
+                if not isinstance(entry, str):
+                    raise DatasetError(
+                        file, f"'{key}' must be a folder or list file, got {entry!r}"
+                    )
+                found = _split_images(base, entry, images)
+                if found is None:
+                    missing.append(split)
+                    continue
+                samples.extend(_sample(image, split, classes, file) for image in found)
         if not samples:
             raise DatasetError(file, "no images found under its train/val/test entries")
         info = {"classes": [classes[k] for k in sorted(classes)], "missing_splits": missing}
@@ -155,7 +168,7 @@ def _split_images(base: Path, entry: str, images: Path | None) -> list[Path] | N
         root = images if images is not None else target.parent
         return [
             Path(absolute(root / line.strip()))
-            for line in target.read_text(encoding="utf-8").splitlines()
+            for line in read_text(target).splitlines()
             if line.strip()
         ]
     return None
@@ -163,7 +176,7 @@ def _split_images(base: Path, entry: str, images: Path | None) -> list[Path] | N
 
 def _sample(image: Path, split: str, classes: dict[int, str], data_file: Path) -> Sample:
     label_file = labels_path(image)
-    lines = label_file.read_text(encoding="utf-8").splitlines() if label_file.is_file() else []
+    lines = read_text(label_file).splitlines() if label_file.is_file() else []
     rows = [(n, line.split()) for n, line in enumerate(lines, 1) if line.strip()]
     if not rows:
         return Sample(absolute(image), (), split=split)

@@ -1,7 +1,9 @@
 """Report writer ``coco``: the evaluated frames as COCO ground truth and COCO detection results.
 
 ``ground_truth.coco.json`` and ``detections.coco.json`` are the dictionaries the ``coco-ap``
-metric gave pycocotools, with the evaluated box (``report.json``'s ``evaluated_box``).
+metric gave pycocotools, with the evaluated box (``report.json``'s ``evaluated_box``), built
+afresh (none of the keys pycocotools adds while evaluating) and with each image's ``file_name``
+relative to the dataset's root folder, as COCO tools expect.
 """
 
 from __future__ import annotations
@@ -11,6 +13,7 @@ from pathlib import Path
 from tsrkit import ReportWriter, RunResult, hookimpl
 from tsrkit.atomic import write_json
 from tsrkit.eval.coco import coco_run
+from tsrkit_plugins.formats.common import relative_source
 
 
 class CocoFiles(ReportWriter):
@@ -22,6 +25,9 @@ class CocoFiles(ReportWriter):
 
     def write(self, run: RunResult, folder: Path) -> None:
         truth, results = coco_run(run.settings.dataset, run.pairs(), run.settings.box)
+        if run.dataset.root:
+            for image in truth["images"]:
+                image["file_name"] = relative_source(image["file_name"], Path(run.dataset.root))
         write_json(folder / "ground_truth.coco.json", truth)
         write_json(folder / "detections.coco.json", results)
 

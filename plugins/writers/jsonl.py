@@ -1,13 +1,13 @@
 """Report writer ``jsonl``: ``detections.jsonl``, one ``tsrkit detect`` record per evaluated frame
-(plus its lighting), in dataset order."""
+(plus its lighting), in dataset order; a number that is not finite is written as null (JSON has
+no NaN)."""
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 from tsrkit import ReportWriter, RunResult, hookimpl
-from tsrkit.atomic import atomic_open
+from tsrkit.atomic import atomic_open, json_line
 
 
 class JsonLines(ReportWriter):
@@ -20,7 +20,7 @@ class JsonLines(ReportWriter):
     def write(self, run: RunResult, folder: Path) -> None:
         with atomic_open(folder / "detections.jsonl") as fh:
             for record in run.records:
-                fh.write(json.dumps(record.to_json()) + "\n")
+                fh.write(json_line(record.to_json()) + "\n")
 
 
 @hookimpl

@@ -12,7 +12,9 @@ from collections.abc import Sequence
 
 import click
 
-from tsrkit.cli.common import UserError, plugin_options
+from tsrkit.cli.common import FiniteFloatRange, plugin_options
+from tsrkit.cli.completion import dataset_names, plugin_list, plugin_names, preset_or_file
+from tsrkit.cli.errors import UserError
 from tsrkit.eval.settings import BOX_OPTIONS
 from tsrkit.report import print_table
 from tsrkit.selection import build, build_compare
@@ -30,12 +32,14 @@ def dataset_options(func):
             default="sample",
             show_default=True,
             help="Registry name, path, or 'sample' (the bundled synthetic sample).",
+            shell_complete=dataset_names,
         ),
         click.option(
             "--format",
             "format_name",
             default=None,
             help="Dataset format when the path is ambiguous.",
+            shell_complete=plugin_names("format"),
         ),
         click.option(
             "--images",
@@ -52,7 +56,7 @@ def dataset_options(func):
 
 def run_options(func):
     """``--workers``, ``--engine``, ``--scheduler``, ``--out``, ``--no-cache``, ``--iou``,
-    ``--quiet``, ``--eval-box``, ``--writer``."""
+    ``--quiet``, ``--eval-box``, ``--writer``, ``--no-plots``."""
     options = [
         click.option(
             "--workers",
@@ -83,7 +87,7 @@ def run_options(func):
         click.option(
             "--iou",
             "iou_threshold",
-            type=click.FloatRange(0, 1, max_open=True),
+            type=FiniteFloatRange(0, 1, max_open=True),
             default=0.5,
             show_default=True,
             help="IoU threshold of the report's 'iou' section (Lee 3.6.2).",
@@ -103,6 +107,12 @@ def run_options(func):
             multiple=True,
             metavar="NAME",
             help="Report writer to run (repeatable; default: every default writer).",
+            shell_complete=plugin_names("writer"),
+        ),
+        click.option(
+            "--no-plots",
+            is_flag=True,
+            help="Write no plot files (skips the plots writer; report.html still embeds them).",
         ),
     ]
     for option in reversed(options):
@@ -123,8 +133,10 @@ def load_dataset(ref: str, format_name: str | None, images: str | None, split: s
 
 
 def _run_kwargs(
-    workers, engine, scheduler, no_cache, iou_threshold, quiet, eval_box, writers
+    workers, engine, scheduler, no_cache, iou_threshold, quiet, eval_box, writers, no_plots
 ) -> dict:
+    if no_plots:
+        writers = [name for name in writers or default_writers() if name != "plots"]
     return {
         "workers": workers or os.cpu_count() or 1,
         "engine": engine,
@@ -137,9 +149,16 @@ def _run_kwargs(
     }
 
 
+def default_writers() -> list[str]:
+    """The report writers that run when ``--writer`` is not given."""
+    from tsrkit.registry import get_registry
+
+    return [i.name for i in get_registry().plugins("writer") if getattr(i.cls, "default", False)]
+
+
 @click.command("benchmark")
 @dataset_options
-@plugin_options
+@plugin_options(tracker=False)
 @run_options
 def benchmark_command(
     dataset_ref,
@@ -149,7 +168,6 @@ def benchmark_command(
     detector,
     verifier,
     classifier,
-    tracker,
     params,
     config,
     workers,
@@ -161,17 +179,24 @@ def benchmark_command(
     quiet,
     eval_box,
     writers,
+    no_plots,
 ) -> None:
     """Run a detector (and classifier) over a dataset and write an evaluated report.
 
     With --classifier alone, classifies the ground-truth boxes (crop datasets) and reports
     accuracy, per-class figures and the confusion matrix. The report writers write
-    OUT/report.json, summary.md, detections.jsonl, the COCO files, CSV tables and plots/.
+    OUT/report.json, summary.md, detections.jsonl, the COCO files, CSV tables (headline.csv,
+    frames.csv) and plots/. Frames are evaluated independently (no --tracker).
+
+    \b
+    Examples:
+      tsrkit benchmark                                   # conspicuity on the bundled sample
+      tsrkit benchmark --dataset roboflow_traffic_light_kr --split test -d lab-frst -o out/kr
+      tsrkit benchmark --dataset gtsrb_test_35px_subset -c logpolar-svm   # classifier alone
+      tsrkit benchmark --dataset frames/coco.json --images frames/ --config recommended
     """
     from tsrkit.benchmarking import benchmark
 
-    if tracker:
-        raise UserError("benchmark evaluates frames independently; --tracker is not supported")
     chosen = build(detector, verifier, classifier, None, params, config, classifier_alone=True)
     dataset = load_dataset(dataset_ref, format_name, images, split)
     report = benchmark(
@@ -181,7 +206,7 @@ def benchmark_command(
         out=out,
         verifier=chosen.verifier,
         **_run_kwargs(
-            workers, engine, scheduler, no_cache, iou_threshold, quiet, eval_box, writers
+            workers, engine, scheduler, no_cache, iou_threshold, quiet, eval_box, writers, no_plots
         ),
     )
     print_table([report])
@@ -199,14 +224,27 @@ def benchmark_command(
     default=",".join(DEFAULT_COMPARE),
     show_default=True,
     help="Comma-separated detector plugins.",
+    shell_complete=plugin_list("detector"),
 )
-@click.option("--verifier", "-V", default=None, help="Verifier plugin for every run.")
+@click.option(
+    "--verifier",
+    "-V",
+    default=None,
+    help="Verifier plugin for every run.",
+    shell_complete=plugin_names("verifier"),
+)
 @click.option(
     "--without-verifier",
     is_flag=True,
     help="Also run every detector without the verifier (paired tests show what it adds).",
 )
-@click.option("--classifier", "-c", default=None, help="Classifier plugin for every run.")
+@click.option(
+    "--classifier",
+    "-c",
+    default=None,
+    help="Classifier plugin for every run.",
+    shell_complete=plugin_names("classifier"),
+)
 @click.option(
     "--param",
     "-p",
@@ -222,6 +260,7 @@ def benchmark_command(
     default=None,
     help="YAML run configuration or preset name (tsrkit presets): its verifier, classifier "
     "and their params.",
+    shell_complete=preset_or_file,
 )
 @click.option(
     "--html",
@@ -251,6 +290,7 @@ def compare_command(
     quiet,
     eval_box,
     writers,
+    no_plots,
     html,
 ) -> None:
     """Benchmark several detectors on the same frames; one report side by side.
@@ -258,6 +298,13 @@ def compare_command(
     Writes OUT/<run>/ for each run plus OUT/compare.json and OUT/compare.md with a paired
     test (Wilcoxon signed-rank on per-frame recall) for every pair and each run's AP50 on the
     lens box and on the housing box.
+
+    \b
+    Examples:
+      tsrkit compare                                   # the three built-ins on the sample
+      tsrkit compare --dataset roboflow_cinta_v2_id --split test --detectors lab-frst,gray-tophat
+      tsrkit compare --config recommended --without-verifier --html -o out/verifier
+      tsrkit compare -p conspicuity.weights=1,1,2 -p gray-tophat.h_peak=0.8
     """
     run_compare(
         dataset_ref,
@@ -268,7 +315,9 @@ def compare_command(
         classifier,
         params,
         out,
-        _run_kwargs(workers, engine, scheduler, no_cache, iou_threshold, quiet, eval_box, writers),
+        _run_kwargs(
+            workers, engine, scheduler, no_cache, iou_threshold, quiet, eval_box, writers, no_plots
+        ),
         verifier,
         config=config,
         without_verifier=without_verifier,

@@ -1,28 +1,58 @@
-"""Options shared by the verbs that run plugins (selection, ``--param``, ``--config``) and the
-one-line user error. Building the chosen plugins is :func:`tsrkit.selection.build`."""
+"""Options shared by the verbs that run plugins (selection, ``--param``, ``--config``) and a
+float option type that refuses NaN. Building the chosen plugins is
+:func:`tsrkit.selection.build`."""
 
 from __future__ import annotations
 
+import math
+
 import click
 
+from tsrkit.cli.completion import plugin_names, preset_or_file
 from tsrkit.selection import DEFAULT_DETECTOR
 
 
-def plugin_options(func):
-    """Add ``--detector``, ``--verifier``, ``--classifier``, ``--tracker``, ``--param``,
+def plugin_options(func=None, *, tracker: bool = True):
+    """Add ``--detector``, ``--verifier``, ``--classifier``, ``--tracker`` (unless
+    ``tracker=False``: a verb that cannot use one does not offer it), ``--param``,
     ``--config``."""
+    if func is None:
+        return lambda f: plugin_options(f, tracker=tracker)
     options = [
         click.option(
-            "--detector", "-d", default=None, help=f"Detector plugin (default {DEFAULT_DETECTOR})."
+            "--detector",
+            "-d",
+            default=None,
+            help=f"Detector plugin (default {DEFAULT_DETECTOR}).",
+            shell_complete=plugin_names("detector"),
         ),
         click.option(
             "--verifier",
             "-V",
             default=None,
             help="Verifier plugin: rescores, refines or rejects candidates.",
+            shell_complete=plugin_names("verifier"),
         ),
-        click.option("--classifier", "-c", default=None, help="Classifier plugin."),
-        click.option("--tracker", "-t", default=None, help="Tracker plugin (videos)."),
+        click.option(
+            "--classifier",
+            "-c",
+            default=None,
+            help="Classifier plugin.",
+            shell_complete=plugin_names("classifier"),
+        ),
+        *(
+            [
+                click.option(
+                    "--tracker",
+                    "-t",
+                    default=None,
+                    help="Tracker plugin (videos).",
+                    shell_complete=plugin_names("tracker"),
+                )
+            ]
+            if tracker
+            else []
+        ),
         click.option(
             "--param",
             "-p",
@@ -36,7 +66,9 @@ def plugin_options(func):
             "--config",
             type=click.Path(dir_okay=False),
             default=None,
-            help="YAML run configuration (plugins and their params).",
+            help="YAML run configuration (plugins and their params) or a preset name "
+            "(tsrkit presets).",
+            shell_complete=preset_or_file,
         ),
     ]
     for option in reversed(options):
@@ -44,7 +76,12 @@ def plugin_options(func):
     return func
 
 
-class UserError(click.ClickException):
-    """Raised by commands for mistakes that need no traceback."""
+class FiniteFloatRange(click.FloatRange):
+    """``click.FloatRange`` that also refuses ``nan`` (which every comparison lets through)
+    and infinities."""
 
-    exit_code = 2
+    def convert(self, value, param, ctx):
+        number = super().convert(value, param, ctx)
+        if not math.isfinite(number):
+            self.fail(f"{value!r} is not a finite number", param, ctx)
+        return number

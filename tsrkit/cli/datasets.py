@@ -4,12 +4,14 @@ from __future__ import annotations
 
 import json
 from collections import Counter
+from contextlib import nullcontext
 from pathlib import Path
 
 import click
 from rich.console import Console
 from rich.table import Table
 
+from tsrkit.cli.completion import dataset_names, plugin_names
 from tsrkit.cli.synth import synth_command
 from tsrkit.datasets import (
     DatasetError,
@@ -21,17 +23,32 @@ from tsrkit.datasets import (
 )
 from tsrkit.datasets.registry import GENERATED_SAMPLE
 from tsrkit.errors import TsrkitError
+from tsrkit.types import Dataset
 
 
 @click.group("datasets")
 def datasets_group() -> None:
-    """The dataset registry (datasets.yaml): list, info NAME, verify NAME, convert SRC."""
+    """The dataset registry (datasets.yaml): list, info NAME, verify NAME, convert SRC.
+
+    \b
+    Examples:
+      tsrkit datasets list
+      tsrkit datasets info roboflow_traffic_light_kr
+      tsrkit datasets convert roboflow_traffic_light_kr --to yolo --out kr-yolo/
+      tsrkit datasets synth --out synth/ --frames 100
+    """
 
 
 @datasets_group.command("list")
 @click.option("--json", "as_json", is_flag=True, help="Print JSON.")
 def list_command(as_json: bool) -> None:
-    """Registered datasets: name, format, task, box convention, licence, and whether present."""
+    """Registered datasets: name, format, task, box convention, licence, and whether present.
+
+    \b
+    Examples:
+      tsrkit datasets list
+      tsrkit datasets list --json
+    """
     rows = []
     for entry in load_registry().values():
         rows.append({**entry.to_info(), "present": _present(entry)})
@@ -54,10 +71,18 @@ def list_command(as_json: bool) -> None:
 
 
 @datasets_group.command("info")
-@click.argument("name")
+@click.argument("name", shell_complete=dataset_names)
 @click.option("--json", "as_json", is_flag=True, help="Print JSON.")
 def info_command(name: str, as_json: bool) -> None:
-    """Registry facts of NAME plus counts of samples, boxes, splits and states."""
+    """Registry facts of NAME plus counts of samples, boxes, splits and states.
+
+    NAME is a registered dataset, 'sample', or a path (format detected).
+
+    \b
+    Examples:
+      tsrkit datasets info dtld_fridtjofs
+      tsrkit datasets info my-export/coco.json --json
+    """
     dataset = open_dataset(name)
     states = Counter(a.state for s in dataset for a in s.annotations)
     labels = Counter(a.attributes.get("label", a.state) for s in dataset for a in s.annotations)
@@ -87,10 +112,15 @@ def info_command(name: str, as_json: bool) -> None:
 
 
 @datasets_group.command("verify")
-@click.argument("name")
+@click.argument("name", shell_complete=dataset_names)
 @click.pass_context
 def verify_command(ctx: click.Context, name: str) -> None:
-    """Check every file of NAME against its sha256 manifest; exit 1 if any is missing/altered."""
+    """Check every file of NAME against its sha256 manifest; exit 1 if any is missing/altered.
+
+    \b
+    Examples:
+      tsrkit datasets verify roboflow_traffic_light_kr
+    """
     registry = load_registry()
     if name not in registry:
         raise TsrkitError(f"no registered dataset '{name}' (known: {', '.join(registry)})")
@@ -112,8 +142,14 @@ def verify_command(ctx: click.Context, name: str) -> None:
 
 
 @datasets_group.command("convert")
-@click.argument("src")
-@click.option("--to", "to_format", required=True, help="Format plugin to write.")
+@click.argument("src", shell_complete=dataset_names)
+@click.option(
+    "--to",
+    "to_format",
+    required=True,
+    help="Format plugin to write (coco, normalized, voc, yolo).",
+    shell_complete=plugin_names("format"),
+)
 @click.option(
     "--out",
     required=True,
@@ -121,7 +157,11 @@ def verify_command(ctx: click.Context, name: str) -> None:
     help="Output file (coco, normalized) or folder (yolo, voc).",
 )
 @click.option(
-    "--format", "src_format", default=None, help="Format of SRC (detected when unambiguous)."
+    "--format",
+    "src_format",
+    default=None,
+    help="Format of SRC (detected when unambiguous).",
+    shell_complete=plugin_names("format"),
 )
 @click.option(
     "--images",
@@ -129,14 +169,53 @@ def verify_command(ctx: click.Context, name: str) -> None:
     default=None,
     help="Folder that image paths in SRC resolve against.",
 )
+@click.option("--quiet", "-q", is_flag=True, help="No progress indicator.")
 def convert_command(
-    src: str, to_format: str, out: Path, src_format: str | None, images: Path | None
+    src: str, to_format: str, out: Path, src_format: str | None, images: Path | None, quiet: bool
 ) -> None:
-    """Read SRC (registry name or path) and write it in another format at --out."""
-    dataset = open_dataset(src, format=src_format, images=images)
-    write_dataset(dataset, to_format, out)
+    """Read SRC (registry name or path) and write it in another format at --out.
+
+    The written files are read back: a state the target format cannot hold (a raw label
+    that the source's states: mapping gave another state, e.g. KR's left arrows) is reported
+    as a warning with the counts before and after.
+
+    \b
+    Examples:
+      tsrkit datasets convert roboflow_traffic_light_kr --to coco --out kr.coco.json
+      tsrkit datasets convert labels/ --format voc --images JPEGImages/ --to yolo --out yolo/
+    """
+    console = Console(stderr=True, soft_wrap=True)
+    with console.status(f"converting {src} to {to_format}...") if not quiet else nullcontext():
+        dataset = open_dataset(src, format=src_format, images=images)
+        write_dataset(dataset, to_format, out)
+        changes = state_changes(dataset, open_dataset(out, format=to_format))
     boxes = sum(len(s.annotations) for s in dataset)
     click.echo(f"wrote {len(dataset)} images, {boxes} boxes as {to_format} to {out}")
+    if changes:
+        console.print(
+            f"warning: {to_format} cannot hold every state of {dataset.name}; read back, "
+            + ", ".join(changes),
+            markup=False,
+        )
+
+
+def state_changes(before: Dataset, after: Dataset) -> list[str]:
+    """``"STATE n -> m"`` for each state whose box count differs between two datasets.
+
+    Examples
+    --------
+    >>> from tsrkit.types import Annotation, Sample
+    >>> def one(state):
+    ...     return Dataset("d", (Sample("a.png", (Annotation((0, 0, 1, 1), state),)),))
+    >>> state_changes(one("green"), one("unknown"))
+    ['green 1 -> 0', 'unknown 0 -> 1']
+    """
+    counts = [Counter(a.state for s in d for a in s.annotations) for d in (before, after)]
+    return [
+        f"{state} {counts[0][state]} -> {counts[1][state]}"
+        for state in sorted(set(counts[0]) | set(counts[1]))
+        if counts[0][state] != counts[1][state]
+    ]
 
 
 def _present(entry) -> str:

@@ -2,20 +2,24 @@
 
 from __future__ import annotations
 
-import json
+import contextlib
+import os
 import sys
+from collections.abc import Iterator
 from contextlib import nullcontext
 from pathlib import Path
+from typing import TextIO
 
 import click
 import cv2
 from rich.console import Console
 
-from tsrkit.atomic import atomic_open
+from tsrkit.atomic import atomic_open, json_line
 from tsrkit.cli.common import plugin_options
 from tsrkit.draw import draw_detections
 from tsrkit.errors import TsrkitError
 from tsrkit.pipeline import Pipeline
+from tsrkit.report import ProgressBar
 from tsrkit.selection import build
 from tsrkit.streams import run_pipeline
 from tsrkit.types import Frame, Skipped
@@ -30,13 +34,15 @@ def run_detect(
     start: int = 0,
     end: int | None = None,
     workers: int = 1,
+    progress: bool = False,
 ) -> tuple[int, int, list[Skipped]]:
     """Write one JSON Lines record per frame to the text stream ``out``, in input order.
 
     A frame on which a plugin crashes is reported as skipped and the run goes on; a
     :class:`TsrkitError` from a plugin (a setup problem such as a mismatched model) stops it.
     ``workers`` > 1 runs the pipeline in worker processes (:func:`tsrkit.streams.run_pipeline`);
-    overlays (``draw``) need the frames here, so they need one worker.
+    overlays (``draw``) need the frames here, so they need one worker. ``progress`` shows a
+    progress bar (frames done, frames/s) on stderr.
 
     Returns
     -------
@@ -47,16 +53,36 @@ def run_detect(
     frames = detections = 0
     skipped: list[Skipped] = []
     stream = run_pipeline(pipeline, paths, every=every, start=start, end=end, workers=workers)
-    for result, frame in stream:
-        if isinstance(result, Skipped):
-            skipped.append(result)
-            continue
-        out.write(json.dumps(result.to_record()) + "\n")
-        frames += 1
-        detections += len(result.detections)
-        if draw is not None and frame is not None:
-            _write_overlay(draw, frame, frames, result.detections)
+    with ProgressBar(None, progress, "detect") as bar:  # type: ignore[arg-type]
+        for result, frame in bar.track(stream):
+            if isinstance(result, Skipped):
+                skipped.append(result)
+                continue
+            out.write(json_line(result.to_record()) + "\n")
+            frames += 1
+            detections += len(result.detections)
+            if draw is not None and frame is not None:
+                _write_overlay(draw, frame, frames, result.detections)
     return frames, detections, skipped
+
+
+@contextlib.contextmanager
+def flushed_output(out: Path) -> Iterator[TextIO]:
+    """Write ``OUT.partial`` one flushed line per frame, renamed to ``OUT`` when the run ends.
+
+    A run that aborts (an error, Ctrl-C) keeps ``OUT.partial`` with every frame done so far and
+    says so; ``OUT`` itself is only ever a complete run's output.
+    """
+    partial = out.with_name(out.name + ".partial")
+    partial.parent.mkdir(parents=True, exist_ok=True)
+    with open(partial, "w", encoding="utf-8", buffering=1) as fh:  # line-buffered: flushed
+        try:
+            yield fh
+        except BaseException:
+            fh.flush()
+            click.echo(f"aborted: the frames done so far are in {partial}", err=True)
+            raise
+    os.replace(partial, out)
 
 
 def _write_overlay(folder: Path, frame: Frame, number: int, detections) -> None:
@@ -82,9 +108,10 @@ def default_inputs() -> list[str]:
 @click.option(
     "--out",
     "-o",
-    type=click.Path(dir_okay=False),
+    type=click.Path(dir_okay=False, path_type=Path),
     default=None,
-    help="JSON Lines output file (written atomically); default stdout.",
+    help="JSON Lines output file; default stdout. Written as OUT.partial, one line per frame "
+    "as it completes, and renamed to OUT at the end (an aborted run keeps OUT.partial).",
 )
 @click.option(
     "--draw",
@@ -102,6 +129,12 @@ def default_inputs() -> list[str]:
     default=1,
     help="Worker processes; each decodes its own images or 64-frame video chunks.",
 )
+@click.option(
+    "--quiet",
+    "-q",
+    is_flag=True,
+    help="No progress bar (there is none when stderr is not a terminal).",
+)
 def detect_command(
     paths,
     detector,
@@ -116,23 +149,33 @@ def detect_command(
     start,
     end,
     workers,
+    quiet,
 ) -> None:
     """Detect lit signal lenses in images, folders (recursive) or videos.
 
     Writes one JSON record per frame: source, frame, width, height, ms and detections (x, y,
     radius, bbox, score, state, state_scores). With no PATHS, runs on the bundled sample.
+    Unreadable inputs are skipped with their reason; exit status 1 when every one was.
+
+    \b
+    Examples:
+      tsrkit detect frames/ -o detections.jsonl
+      tsrkit detect drive.mp4 -d lab-frst -c ab-hist -t meanshift --every 2 -o drive.jsonl
+      tsrkit detect frames/ --config recommended --draw overlays/ -q
+      tsrkit detect frames/ -d conspicuity -p weights=1,1,2 -w 2 -o d.jsonl
     """
     pipeline = build(detector, verifier, classifier, tracker, params, config).pipeline()
     inputs = list(paths) or default_inputs()
     draw_dir = Path(draw) if draw else None
     if draw_dir is not None:
         draw_dir.mkdir(parents=True, exist_ok=True)
-    sink = atomic_open(out) if out else nullcontext(sys.stdout)
+    sink = flushed_output(out) if out else nullcontext(sys.stdout)
+    progress = not quiet and Console(stderr=True).is_terminal  # no bar in redirected logs
     with sink as stream:
         frames, found, skipped = run_detect(
-            pipeline, inputs, stream, draw_dir, every, start, end, workers
+            pipeline, inputs, stream, draw_dir, every, start, end, workers, progress
         )
-    console = Console(stderr=True)
+    console = Console(stderr=True, soft_wrap=True)  # one line per skipped input, never wrapped
     console.print(
         f"[bold]{frames}[/bold] frames, [bold]{found}[/bold] detections, "
         f"[bold]{len(skipped)}[/bold] skipped" + (f" -> {out}" if out else "")
@@ -141,4 +184,7 @@ def detect_command(
         console.print(f"  skipped {item.source}: {item.reason}", markup=False)
     if frames == 0 and skipped:
         console.print(f"error: all {len(skipped)} inputs were skipped", markup=False)
+        raise SystemExit(1)
+    if frames == 0:
+        console.print(f"error: no input found in {', '.join(inputs)}", markup=False)
         raise SystemExit(1)

@@ -1,22 +1,72 @@
-"""The ``tsrkit`` click group; every verb, built-in or not, is added via ``register_commands``."""
+"""The ``tsrkit`` click group; every verb, built-in or not, is added via ``register_commands``.
+
+Start-up is lazy: ``tsrkit --help`` lists the verbs shipped with tsrkit from
+:data:`tsrkit.cli.verbs.VERBS` without importing them, and a verb's module (with NumPy, OpenCV
+and the plugins) is imported only when that verb runs. The plugin registry is loaded for a verb
+that is not one of tsrkit's own, or to list the verbs when a package other than tsrkit declares
+``tsrkit`` entry points (its verbs come through the ``register_commands`` hook).
+"""
 
 from __future__ import annotations
 
+import importlib
+from importlib import metadata
+
 import click
 
-from tsrkit.cli.common import UserError
+from tsrkit.cli.errors import UserError, describe_os_error
+from tsrkit.cli.verbs import ENTRY_POINT_GROUP, VERBS
 from tsrkit.errors import TsrkitError
-from tsrkit.registry import INTERNAL, PluginFailure, get_registry
 
 
 class TsrkitGroup(click.Group):
-    """A click group that reports :class:`TsrkitError` as one line and exit status 2."""
+    """A click group that loads verbs on demand and reports :class:`TsrkitError` and
+    operating-system errors (an unwritable ``--out``, a full disk) as one line and exit
+    status 2."""
 
     def invoke(self, ctx: click.Context):
         try:
             return super().invoke(ctx)
         except TsrkitError as exc:
             raise UserError(str(exc)) from None
+        except OSError as exc:
+            raise UserError(describe_os_error(exc)) from None
+
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        if _foreign_entry_points():
+            _add_commands()
+        return sorted({*self.commands, *VERBS})
+
+    def get_command(self, ctx: click.Context, cmd_name: str) -> click.Command | None:
+        if cmd_name not in self.commands:
+            verb = VERBS.get(cmd_name)
+            if verb is not None:
+                module = importlib.import_module(verb.module)
+                self.add_command(getattr(module, verb.attribute), cmd_name)
+            else:
+                _add_commands()
+        return self.commands.get(cmd_name)
+
+    def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+        """The verb list, with the summaries of :data:`VERBS` for verbs not loaded yet."""
+        names = [
+            name
+            for name in self.list_commands(ctx)
+            if name not in self.commands or not self.commands[name].hidden
+        ]
+        limit = formatter.width - 6 - max(map(len, names), default=0)
+        rows = []
+        for name in names:
+            command = self.commands.get(name)
+            summary = (
+                command.get_short_help_str(limit)
+                if command is not None
+                else click.Command(name, help=VERBS[name].summary).get_short_help_str(limit)
+            )
+            rows.append((name, summary))
+        if rows:
+            with formatter.section("Commands"):
+                formatter.write_dl(rows)
 
 
 @click.group(
@@ -30,6 +80,12 @@ def cli(ctx: click.Context) -> None:
     """Traffic signal recognition: detect, classify, track and benchmark methods side by side.
 
     With no verb, compares the built-in detectors on the bundled synthetic sample.
+
+    \b
+    Examples:
+      tsrkit detect frames/ -o detections.jsonl
+      tsrkit benchmark --dataset roboflow_traffic_light_kr --split test -d lab-frst
+      tsrkit plugins
     """
     if ctx.invoked_subcommand is None:
         from tsrkit.cli.benchmark import run_default
@@ -37,8 +93,22 @@ def cli(ctx: click.Context) -> None:
         ctx.invoke(run_default)
 
 
+def _foreign_entry_points() -> bool:
+    """Whether a package other than tsrkit declares ``tsrkit`` plugins (which may add verbs)."""
+    return any(
+        ep.dist is not None and ep.dist.name != "tsrkit"
+        for ep in metadata.entry_points(group=ENTRY_POINT_GROUP)
+    )
+
+
 def _add_commands() -> None:
-    """Every verb: the built-in ones (:mod:`tsrkit.cli.commands`) and the plugins'."""
+    """Every verb registered through ``register_commands`` (the built-in ones via
+    :mod:`tsrkit.cli.commands`, and the plugins'); runs once."""
+    from tsrkit.registry import INTERNAL, PluginFailure, get_registry
+
+    if getattr(cli, "_hooks_done", False):
+        return
+    cli._hooks_done = True  # type: ignore[attr-defined]
     registry = get_registry()
     for impl in registry.pm.hook.register_commands.get_hookimpls():
         try:
@@ -51,9 +121,6 @@ def _add_commands() -> None:
             )
             if impl.plugin_name in INTERNAL:  # the core's own verbs must not fail silently
                 raise
-
-
-_add_commands()
 
 
 def main() -> None:

@@ -18,7 +18,16 @@ from tsrkit.registry import KINDS
     "--kind", type=click.Choice(list(KINDS)), default=None, help="Only plugins of this kind."
 )
 def plugins_command(as_json: bool, kind: str | None) -> None:
-    """List installed plugins: name, kind, package, version and summary."""
+    """List installed plugins: name, kind, package, version and summary.
+
+    Plugins that failed to load are listed in red with the reason.
+
+    \b
+    Examples:
+      tsrkit plugins
+      tsrkit plugins --kind detector
+      tsrkit plugins --json        # with every parameter's type, default, range and source
+    """
     found = tsrkit.plugins(kind)
     if as_json:
         click.echo(json.dumps(found, indent=2))

@@ -6,13 +6,28 @@ import click
 from rich.console import Console
 from rich.table import Table
 
+from tsrkit.cli.completion import preset_names_only
 from tsrkit.presets import describe, preset_names, preset_path
 
 
 @click.command("presets")
-@click.option("--show", "show", default=None, metavar="NAME", help="Print the preset's YAML.")
+@click.option(
+    "--show",
+    "show",
+    default=None,
+    metavar="NAME",
+    help="Print the preset's YAML.",
+    shell_complete=preset_names_only,
+)
 def presets_command(show: str | None) -> None:
-    """List the shipped presets; use one with --config NAME on detect, benchmark or compare."""
+    """List the shipped presets; use one with --config NAME on detect, benchmark or compare.
+
+    \b
+    Examples:
+      tsrkit presets
+      tsrkit presets --show recommended > my-run.yaml
+      tsrkit detect frames/ --config recommended
+    """
     if show is not None:
         click.echo(preset_path(show).read_text(encoding="utf-8"), nl=False)
         return

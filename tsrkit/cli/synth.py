@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 from collections import Counter
+from contextlib import nullcontext
 from pathlib import Path
 
 import click
+from rich.console import Console
 
 from tsrkit.errors import TsrkitError
 from tsrkit.synth import LIGHTINGS, generate
@@ -37,6 +39,7 @@ from tsrkit.synth import LIGHTINGS, generate
     type=click.Path(dir_okay=False, path_type=Path),
     help="Also write the frames, in order, as an MPEG-4 video (10 frames/s).",
 )
+@click.option("--quiet", "-q", is_flag=True, help="No progress indicator.")
 def synth_command(
     out: Path,
     frames: int,
@@ -46,17 +49,26 @@ def synth_command(
     lighting: str,
     overwrite: bool,
     video: Path | None,
+    quiet: bool,
 ) -> None:
     """Render FRAMES road scenes with lit signal lenses of known centre, radius and state.
 
     Same arguments give byte-identical files. Frames alternate day / dusk / night (or the
     --lighting list) and are split 50/50 into train and test.
+
+    \b
+    Examples:
+      tsrkit datasets synth --out synth/ --frames 200 --seed 3
+      tsrkit datasets synth --out night/ --lighting night --width 1280 --height 720
+      tsrkit datasets synth --out clip/ --frames 60 --video clip.mp4
     """
     conditions = tuple(c.strip() for c in lighting.split(",") if c.strip())
+    status = Console(stderr=True).status(f"rendering {frames} frames into {out}...")
     try:
-        dataset = generate(
-            out, frames, seed, width, height, overwrite=overwrite, lighting=conditions
-        )
+        with status if not quiet else nullcontext():
+            dataset = generate(
+                out, frames, seed, width, height, overwrite=overwrite, lighting=conditions
+            )
     except ValueError as exc:  # bad option values: one line, like every TsrkitError
         raise TsrkitError(str(exc)) from None
     states = Counter(a.state for s in dataset for a in s.annotations)

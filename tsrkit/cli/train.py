@@ -2,27 +2,36 @@
 
 from __future__ import annotations
 
+from contextlib import nullcontext
+
 import click
 from rich.console import Console
 
+from tsrkit.cli.completion import dataset_names, plugin_names, trainable_names
+from tsrkit.errors import TsrkitError
 from tsrkit.params import parse_assignments
 from tsrkit.registry import get_registry
 from tsrkit.training import train
 
 
 @click.command("train")
-@click.argument("plugin")
+@click.argument("plugin", shell_complete=trainable_names)
 @click.option(
     "--dataset",
     "dataset_refs",
     required=True,
     multiple=True,
     metavar="NAME[:SPLIT]",
+    shell_complete=dataset_names,
     help="Registry name or path of the training data, optionally with its split; repeatable "
     "(the datasets are concatenated).",
 )
 @click.option(
-    "--format", "format_name", default=None, help="Dataset format when a path is ambiguous."
+    "--format",
+    "format_name",
+    default=None,
+    help="Dataset format when a path is ambiguous.",
+    shell_complete=plugin_names("format"),
 )
 @click.option(
     "--images",
@@ -53,10 +62,22 @@ from tsrkit.training import train
     default=None,
     help="Detector whose candidates a trainable verifier learns on (its parameters: "
     "-p detector.KEY=VALUE).",
+    shell_complete=plugin_names("detector"),
 )
-def train_command(plugin, dataset_refs, format_name, images, split, params, out, detector) -> None:
+@click.option("--quiet", "-q", is_flag=True, help="No progress indicator.")
+def train_command(
+    plugin, dataset_refs, format_name, images, split, params, out, detector, quiet
+) -> None:
     """Fit PLUGIN (a trainable detector, verifier or classifier) and save the model for
-    --param model=."""
+    --param model=.
+
+    \b
+    Examples:
+      tsrkit train ab-hist --dataset udacity_mit_tl_crops:train --out models/ab
+      tsrkit detect frames/ -c ab-hist -p model=models/ab.npz
+      tsrkit train verifier --dataset roboflow_traffic_light_kr:valid -d lab-frst \\
+          -p detector.top=15 --out models/verifier
+    """
     from tsrkit.datasets import open_datasets
 
     assignments = parse_assignments(params)
@@ -68,7 +89,16 @@ def train_command(plugin, dataset_refs, format_name, images, split, params, out,
         raise click.UsageError("detector.KEY=VALUE parameters need --detector")
     det = get_registry().create("detector", detector, detector_params) if detector else None
     dataset = open_datasets(dataset_refs, split, format=format_name, images=images)
-    path = train(plugin, dataset, out, own, det)
+    status = Console(stderr=True).status(
+        f"training {plugin} on {len(dataset)} samples of {dataset.name}...", spinner="dots"
+    )
+    try:
+        with status if not quiet else nullcontext():
+            path = train(plugin, dataset, out, own, det)
+    except TsrkitError:
+        raise
+    except ValueError as exc:  # the data cannot train this plugin (a class without samples...)
+        raise TsrkitError(f"cannot train {plugin} on {dataset.name}: {exc}") from None
     Console(stderr=True).print(
         f"trained {plugin} on {len(dataset)} samples of {dataset.name} -> {path}"
     )

@@ -39,24 +39,58 @@ class DatasetError(TsrkitError):
         super().__init__(": ".join(part for part in (self.path, where, problem) if part))
 
 
+def read_text(path: str | os.PathLike, missing: str = "file not found") -> str:
+    """The whole text of a UTF-8 file.
+
+    Raises
+    ------
+    DatasetError
+        ``missing`` when the file does not exist, the reason when it cannot be read, and
+        "not valid UTF-8" with the line and the offending byte when it does not decode.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.NamedTemporaryFile(suffix=".csv", delete=False) as fh:
+    ...     _ = fh.write(b"a,b\\nc,\\xff\\n")
+    >>> read_text(fh.name)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    tsrkit.datasets.errors.DatasetError: ...csv: line 2: not valid UTF-8 (byte 0xff at offset 6)
+    """
+    path = Path(path)
+    try:
+        data = path.read_bytes()
+    except FileNotFoundError:
+        raise DatasetError(path, missing) from None
+    except OSError as exc:
+        raise DatasetError(path, f"cannot read ({exc.strerror or exc})") from None
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = data.count(b"\n", 0, exc.start) + 1
+        problem = f"not valid UTF-8 (byte 0x{data[exc.start]:02x} at offset {exc.start})"
+        raise DatasetError(path, problem, f"line {line}") from None
+
+
 def read_yaml(path: str | os.PathLike, missing: str = "file not found") -> Any:
     """Parse a YAML file with the C loader when available.
 
     Raises
     ------
     DatasetError
-        ``missing`` when the file does not exist; "not valid YAML" with the line otherwise.
+        ``missing`` when the file does not exist; "not valid UTF-8" or "not valid YAML" with
+        the line otherwise.
     """
     path = Path(path)
+    text = read_text(path, missing)
     try:
-        with open(path, encoding="utf-8") as fh:
-            return yaml.load(fh, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
-    except FileNotFoundError:
-        raise DatasetError(path, missing) from None
+        return yaml.load(text, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
+        reason = " ".join(str(getattr(exc, "problem", None) or exc).split())  # one line
         raise DatasetError(
             path,
-            f"not valid YAML ({getattr(exc, 'problem', None) or exc})",
+            f"not valid YAML ({reason})",
             f"line {mark.line + 1}" if mark else "",
         ) from None
