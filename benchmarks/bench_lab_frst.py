@@ -4,7 +4,10 @@ Frames are the Korean Roboflow scenes resized to each size. Also times the fast 
 loop oracle of tests/oracles on the same feature maps (one frame) and checks they agree, and
 the detector against its straightforward version (``lab_frst_straightforward.py``) at both
 sizes, interleaved, with how many of the reference's candidates it reproduces.
+``--baseline COMMIT`` also times the FRST of both feature-map parts against ``frst.py`` as of
+that commit (interleaved, maps checked equal).
 Run: python benchmarks/bench_lab_frst.py [--frames N] [--repeats R] [--reference-frames N]
+[--baseline 74eb292]
 """
 
 from __future__ import annotations
@@ -30,6 +33,7 @@ sys.path.insert(0, str(REPO / "tests"))
 from oracles.frst_oracle import frst_oracle  # noqa: E402
 
 sys.path.insert(0, str(REPO / "benchmarks"))
+from at_commit import module_at  # noqa: E402
 from lab_frst_straightforward import lab_frst_straightforward  # noqa: E402
 
 import tsrkit  # noqa: E402
@@ -127,12 +131,41 @@ def reference_comparison(
     }
 
 
+def baseline_comparison(images: list[np.ndarray], commit: str, repeats: int) -> dict[str, float]:
+    """Median wall and CPU ms of the FRST of both feature-map parts, now and at ``commit``
+    (interleaved), and the number of frames whose transforms differ."""
+    old = module_at(commit, "plugins/detectors/frst/frst.py").frst
+    wall: dict[str, list[float]] = {"now": [], "baseline": []}
+    cpu: dict[str, list[float]] = {"now": [], "baseline": []}
+    differ = 0
+    for image in images:
+        feature = lab_feature_map(image)
+        parts = ((np.maximum(feature, 0), "bright"), (np.minimum(feature, 0), "dark"))
+        differ += any(
+            not np.array_equal(frst(p, alpha=3.0, mode=m), old(p, alpha=3.0, mode=m))
+            for p, m in parts
+        )
+        for _ in range(repeats):
+            for name, transform in (("now", frst), ("baseline", old)):
+                start, start_cpu = time.perf_counter(), time.process_time()
+                for part, mode in parts:
+                    transform(part, alpha=3.0, mode=mode)
+                wall[name].append((time.perf_counter() - start) * 1000)
+                cpu[name].append((time.process_time() - start_cpu) * 1000)
+    return {
+        **{f"{k}_wall": statistics.median(v) for k, v in wall.items()},
+        **{f"{k}_cpu": statistics.median(v) for k, v in cpu.items()},
+        "differ": differ,
+    }
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--frames", type=int, default=10)
     parser.add_argument("--repeats", type=int, default=10)
     parser.add_argument("--beta", type=float, default=None, help="override the beta default")
     parser.add_argument("--reference-frames", type=int, default=3)
+    parser.add_argument("--baseline", default="", help="commit whose FRST is timed alongside")
     args = parser.parse_args()
     cv2.setNumThreads(1)
     images = scenes(args.frames)
@@ -175,6 +208,19 @@ def main() -> None:
                 f"{width}x{height}: detect {ref['shipped']:.1f} ms, straightforward "
                 f"{ref['reference']:.1f} ms: {ref['reference'] / ref['shipped']:.1f}x; "
                 f"{ref['same']} of {ref['total']} reference candidates reproduced"
+            )
+    if args.baseline:
+        for width, height in SIZES:
+            sized = [
+                cv2.resize(im, (width, height), interpolation=cv2.INTER_AREA)
+                for im in images[: args.reference_frames]
+            ]
+            ab = baseline_comparison(sized, args.baseline, args.repeats)
+            print(
+                f"{width}x{height}: FRST of both parts now {ab['now_wall']:.1f} ms (CPU "
+                f"{ab['now_cpu']:.1f}), at {args.baseline} {ab['baseline_wall']:.1f} ms (CPU "
+                f"{ab['baseline_cpu']:.1f}): {ab['baseline_wall'] / ab['now_wall']:.2f}x wall, "
+                f"{ab['baseline_cpu'] / ab['now_cpu']:.2f}x CPU; frames differing: {ab['differ']}"
             )
 
 

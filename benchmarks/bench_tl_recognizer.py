@@ -39,6 +39,7 @@ from tsrkit.geometry import iou_matrix  # noqa: E402
 from tsrkit.types import Annotation, Dataset, Frame, Sample  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+from at_commit import module_at  # noqa: E402
 from tl_recognizer_straightforward import tl_recognizer_straightforward  # noqa: E402
 
 WIDTH, HEIGHT = 1413, 1884
@@ -81,15 +82,26 @@ def agreement(shipped, reference) -> tuple[int, int]:
     return int(np.count_nonzero(((overlap >= 0.5) & same).any(axis=1))), len(reference)
 
 
-def reference_comparison(params: dict, frames: int, blobs: int, repeats: int) -> None:
-    """Shipped detector against the straightforward version, road and cluttered scenes."""
+def baseline_detector(commit: str, params: dict):
+    """TL-recognizer as of ``commit`` (its ``tl_recognizer.py``), with ``params`` over the
+    defaults."""
+    cls = module_at(commit, "plugins/detectors/tl_recognizer/tl_recognizer.py").TlRecognizer
+    return cls(**{**{p.name: p.default for p in cls.params}, **params})
+
+
+def reference_comparison(
+    params: dict, frames: int, blobs: int, repeats: int, baseline: str
+) -> None:
+    """Shipped detector against the straightforward version (and against the detector of
+    commit ``baseline`` unless empty), road and cluttered scenes."""
     detector = tsrkit.detector("tl-recognizer", **params)
+    old = baseline_detector(baseline, params) if baseline else None
     sets = {
         "road 1280x720": road_scenes(frames),
         f"cluttered 1280x720 ({blobs} blobs)": [cluttered_scene(s, blobs) for s in range(frames)],
     }
     print(
-        f"{'scenes':>34} {'contours':>9} {'shipped ms':>10} {'reference ms':>12} {'ratio':>6} "
+        f"{'scenes':>34} {'scored':>9} {'shipped ms':>10} {'reference ms':>12} {'ratio':>6} "
         f"{'candidates':>10} {'agree':>7}"
     )
     for name, images in sets.items():
@@ -98,6 +110,10 @@ def reference_comparison(params: dict, frames: int, blobs: int, repeats: int) ->
             "shipped": detector.detect,
             "reference": lambda f: tl_recognizer_straightforward(detector, f),
         }
+        if old is not None:
+            calls["baseline"] = old.detect
+            differ = sum(old.scored(f) != detector.scored(f) for f in frames_)
+            print(f"{name}: frames whose candidates differ from {baseline}'s: {differ}")
         ms = interleaved_ms(calls, frames_, repeats)
         contours = np.mean([len(detector.scored(f)) for f in frames_])
         found = [
@@ -110,6 +126,11 @@ def reference_comparison(params: dict, frames: int, blobs: int, repeats: int) ->
             f"{ms['reference'] / ms['shipped']:>6.2f} {shipped_count:>10d} "
             f"{sum(a for a, _ in found)}/{sum(b for _, b in found)}"
         )
+        if old is not None:
+            print(
+                f"{'':>34} {baseline} detector {ms['baseline']:.1f} ms: "
+                f"{ms['baseline'] / ms['shipped']:.2f}x the shipped time"
+            )
 
 
 def stretched(dataset: Dataset) -> Dataset:
@@ -169,12 +190,15 @@ def main() -> None:
     parser.add_argument("--reference", action="store_true", help="time against the reference")
     parser.add_argument("--frames", type=int, default=5, help="frames per set (--reference)")
     parser.add_argument("--blobs", type=int, default=1500, help="blobs per cluttered scene")
+    parser.add_argument(
+        "--baseline", default="74eb292", help="commit timed alongside with --reference ('' to skip)"
+    )
     args = parser.parse_args()
     params = parsed(args.param)
     cv2.setNumThreads(1)
     if args.reference:
         print(f"tl-recognizer params {params or 'default'}, {args.repeats} repetitions, one thread")
-        reference_comparison(params, args.frames, args.blobs, args.repeats)
+        reference_comparison(params, args.frames, args.blobs, args.repeats, args.baseline)
         return
     data = stretched(tsrkit.dataset(args.dataset))
     frames = [s.load() for s in data]
