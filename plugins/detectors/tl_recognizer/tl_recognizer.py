@@ -534,6 +534,7 @@ class TlRecognizer(Detector):
         """
         size = self.params["template_size"]
         state = colour
+        lens = None
         if colour == "yellowred":
             lens = extract_patch(image, box_uv, roll, centre, size)
             state = red_or_yellow(
@@ -544,7 +545,7 @@ class TlRecognizer(Detector):
                 self.params["yellow_h"],
             )
         score = max(
-            self._orientation_score(image, box_uv, state, orientation, roll, centre)
+            self._orientation_score(image, box_uv, state, orientation, roll, centre, lens)
             for orientation in self.orientations
         )
         return score, state
@@ -557,10 +558,19 @@ class TlRecognizer(Detector):
         orientation: str,
         roll: float,
         centre: tuple[float, float],
+        lens: np.ndarray | None = None,
     ) -> float:
-        """NCC of the patch a lens of ``state`` implies in a head of ``orientation``."""
+        """NCC of the patch a lens of ``state`` implies in a head of ``orientation``.
+
+        ``lens`` is the lens MBR already sampled at template size, if any; when the patch is
+        that very rectangle at that size (the bare-lens layout), it is reused, not sampled again.
+        """
         box = patch_box(box_uv, state, orientation, self.layout)
-        patch = extract_patch(image, box, roll, centre, patch_size(orientation, self.layout))
+        size = patch_size(orientation, self.layout)
+        if lens is not None and box == tuple(box_uv) and size == lens.shape[1::-1]:
+            patch = lens
+        else:
+            patch = extract_patch(image, box, roll, centre, size)
         return ncc(patch, self.templates[state, orientation])
 
     def fit(self, samples: Iterable[Sample], *, detector: Detector | None = None) -> Model:
