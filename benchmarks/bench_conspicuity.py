@@ -1,13 +1,14 @@
-"""Speed of the conspicuity and GRAY-TOPHAT detectors against the direct-correlation oracle
+"""Speed of the conspicuity and GRAY-TOPHAT detectors against the direct-correlation oracle,
 against the straightforward OpenCV ``filter2D`` map (``conspicuity_filter2d.py``) and against an
-earlier commit's conspicuity map (A/B in the same run).
+earlier commit's conspicuity detector (its map, localization and kernel modules loaded from git:
+A/B in the same run, outputs checked equal).
 
 Frames: roboflow_traffic_light_kr road scenes resized to 480x356 (the thesis's size) and
 1280x720. Single thread. The timed calls are interleaved (every repetition runs each call on
 every frame in turn), so load from other processes falls on all of them alike. Prints the
 first-call cost (numba compile or cache load), medians of wall and CPU time per frame and the
 ratios measured in this run.
-Usage: python benchmarks/bench_conspicuity.py [--frames 8] [--reps 5] [--baseline e57479b]
+Usage: python benchmarks/bench_conspicuity.py [--frames 8] [--reps 5] [--baseline d213fc8]
 """
 
 import os
@@ -18,6 +19,7 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 import argparse  # noqa: E402
 import importlib.util  # noqa: E402
 import json  # noqa: E402
+import re  # noqa: E402
 import subprocess  # noqa: E402
 import sys  # noqa: E402
 import tempfile  # noqa: E402
@@ -57,20 +59,51 @@ def first_call_seconds():
     return time.perf_counter() - start
 
 
-def baseline_map(commit):
-    """``conspicuity_map`` of ``plugins/detectors/conspicuity.py`` at ``commit`` (git show)."""
-    source = subprocess.run(
-        ["git", "-C", str(REPO), "show", f"{commit}:plugins/detectors/conspicuity.py"],
-        check=True,
-        capture_output=True,
-        text=True,
-    ).stdout
-    path = Path(tempfile.mkdtemp()) / "conspicuity_baseline.py"
-    path.write_text(source)
-    spec = importlib.util.spec_from_file_location("conspicuity_baseline", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module.conspicuity_map
+#: The modules of the conspicuity detector, in import order.
+BASELINE_MODULES = ("conspicuity_kernel", "localization", "conspicuity")
+
+
+def baseline_module(commit):
+    """The conspicuity module of ``commit`` with the kernel and localization of that commit
+    (``git show``, old flat or new package layout), imported as a package of its own."""
+    package = f"conspicuity_at_{commit}"
+    root = Path(tempfile.mkdtemp())
+    (root / package).mkdir()
+    (root / package / "__init__.py").write_text("")
+    own = re.compile(
+        r"tsrkit_plugins\.detectors\.(?:conspicuity\.)?(" + "|".join(BASELINE_MODULES) + r")\b"
+    )
+    for module in BASELINE_MODULES:
+        for path in (
+            f"plugins/detectors/{module}.py",
+            f"plugins/detectors/conspicuity/{module}.py",
+        ):
+            shown = subprocess.run(
+                ["git", "-C", str(REPO), "show", f"{commit}:{path}"], capture_output=True, text=True
+            )
+            if shown.returncode == 0:
+                break
+        else:
+            raise SystemExit(f"commit {commit} has no {module}.py")
+        (root / package / f"{module}.py").write_text(own.sub(rf"{package}.\1", shown.stdout))
+    sys.path.insert(0, str(root))
+    return importlib.import_module(f"{package}.conspicuity")
+
+
+def baseline_detector(module):
+    """The baseline module's detector with its default parameters."""
+    cls = module.Conspicuity
+    return cls(**{p.name: p.default for p in cls.params})
+
+
+def same_output(old, new, detect_old, detect_new, images):
+    """Frames on which the baseline's map or candidates differ from the current ones."""
+    differ = 0
+    for image in images:
+        a, b = old(image), new(image)
+        equal = np.array_equal(a.values, b.values) and np.array_equal(a.radius, b.radius)
+        differ += not (equal and detect_old(image) == detect_new(image))
+    return differ
 
 
 def interleaved(calls, reps):
@@ -98,8 +131,8 @@ def main():
     parser.add_argument("--oracle-frames", type=int, default=2)
     parser.add_argument(
         "--baseline",
-        default="e57479b",
-        help="commit whose conspicuity map is timed alongside ('' to skip)",
+        default="d213fc8",
+        help="commit whose conspicuity detector is timed alongside ('' to skip)",
     )
     args = parser.parse_args()
     print(f"first conspicuity_map call: {first_call_seconds():.2f} s")
@@ -127,10 +160,17 @@ def main():
         "gray-tophat 1280x720": (detect(tophat), large),
     }
     if args.baseline:
-        old_map = baseline_map(args.baseline)
-        calls[f"baseline {args.baseline} map"] = (old_map, small)
-        differ = sum(not np.array_equal(old_map(im).values, m.values) for im, m in zip(small, maps))
-        print(f"frames whose map differs from {args.baseline}'s: {differ} of {len(small)}")
+        module = baseline_module(args.baseline)
+        old = detect(baseline_detector(module))
+        calls[f"baseline {args.baseline} map"] = (module.conspicuity_map, small)
+        calls["  baseline map 1280x720"] = (module.conspicuity_map, large)
+        calls["  baseline detect 1280x720"] = (old, large)
+        new = detect(conspicuity)
+        differ = same_output(module.conspicuity_map, conspicuity_map, old, new, small + large)
+        print(
+            f"frames whose map or candidates differ from {args.baseline}'s: "
+            f"{differ} of {len(small) + len(large)}"
+        )
     results = interleaved(calls, args.reps)
     oracle_images = small[: args.oracle_frames]
     results["oracle map 480x356"] = interleaved(
@@ -163,8 +203,13 @@ def main():
             f"480x356, {ratio('filter2D map 1280x720', '  map only 1280x720'):.1f}x at 1280x720"
         )
         if args.baseline:
-            baseline = ratio(f"baseline {args.baseline} map", "  map only")
-            line += f"; baseline map / map: {baseline:.2f}x"
+            small_map = ratio(f"baseline {args.baseline} map", "  map only")
+            large_map = ratio("  baseline map 1280x720", "  map only 1280x720")
+            large_detect = ratio("  baseline detect 1280x720", "conspicuity 1280x720")
+            line += (
+                f"; {args.baseline} / now: map {small_map:.2f}x at 480x356, {large_map:.2f}x at "
+                f"1280x720, detect {large_detect:.2f}x at 1280x720"
+            )
         print(line)
 
 

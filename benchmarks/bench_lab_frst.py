@@ -1,8 +1,13 @@
 """Time the lab-frst detector on real road scenes at 480x356 and 1280x720, one thread.
 
 Frames are the Korean Roboflow scenes resized to each size. Also times the fast FRST against the
-loop oracle of tests/oracles on the same feature maps (one frame) and checks they agree.
-Run: python benchmarks/bench_lab_frst.py [--frames N] [--repeats R]
+loop oracle of tests/oracles on the same feature maps (one frame) and checks they agree, and
+the detector against its straightforward version (``lab_frst_straightforward.py``) at both
+sizes, interleaved, with how many of the reference's candidates it reproduces.
+``--baseline COMMIT`` also times the FRST of both feature-map parts against ``frst.py`` as of
+that commit (interleaved, maps checked equal).
+Run: python benchmarks/bench_lab_frst.py [--frames N] [--repeats R] [--reference-frames N]
+[--baseline 74eb292]
 """
 
 from __future__ import annotations
@@ -26,6 +31,10 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "tests"))
 
 from oracles.frst_oracle import frst_oracle  # noqa: E402
+
+sys.path.insert(0, str(REPO / "benchmarks"))
+from at_commit import module_at  # noqa: E402
+from lab_frst_straightforward import lab_frst_straightforward  # noqa: E402
 
 import tsrkit  # noqa: E402
 from tsrkit.types import Frame  # noqa: E402
@@ -89,11 +98,74 @@ def oracle_comparison(image: np.ndarray) -> dict[str, float]:
     }
 
 
+def reference_comparison(
+    detector: tsrkit.Detector, images: list[np.ndarray], repeats: int
+) -> dict[str, float]:
+    """Median wall ms of the detector and of the straightforward version (interleaved, every
+    repetition runs both on every frame), and the reference candidates it reproduces (same
+    state, centre within 0.01 px)."""
+    times: dict[str, list[float]] = {"shipped": [], "reference": []}
+    calls = {
+        "shipped": lambda image: detector.detect(Frame(image, "bench")),
+        "reference": lab_frst_straightforward,
+    }
+    for _ in range(repeats):
+        for image in images:
+            for name, call in calls.items():
+                start = time.perf_counter()
+                call(image)
+                times[name].append((time.perf_counter() - start) * 1000)
+    same = total = 0
+    for image in images:
+        shipped = calls["shipped"](image)
+        for ref in lab_frst_straightforward(image):
+            total += 1
+            same += any(
+                c.state == ref.state and abs(c.x - ref.x) + abs(c.y - ref.y) < 0.01 for c in shipped
+            )
+    return {
+        "shipped": statistics.median(times["shipped"]),
+        "reference": statistics.median(times["reference"]),
+        "same": same,
+        "total": total,
+    }
+
+
+def baseline_comparison(images: list[np.ndarray], commit: str, repeats: int) -> dict[str, float]:
+    """Median wall and CPU ms of the FRST of both feature-map parts, now and at ``commit``
+    (interleaved), and the number of frames whose transforms differ."""
+    old = module_at(commit, "plugins/detectors/frst/frst.py").frst
+    wall: dict[str, list[float]] = {"now": [], "baseline": []}
+    cpu: dict[str, list[float]] = {"now": [], "baseline": []}
+    differ = 0
+    for image in images:
+        feature = lab_feature_map(image)
+        parts = ((np.maximum(feature, 0), "bright"), (np.minimum(feature, 0), "dark"))
+        differ += any(
+            not np.array_equal(frst(p, alpha=3.0, mode=m), old(p, alpha=3.0, mode=m))
+            for p, m in parts
+        )
+        for _ in range(repeats):
+            for name, transform in (("now", frst), ("baseline", old)):
+                start, start_cpu = time.perf_counter(), time.process_time()
+                for part, mode in parts:
+                    transform(part, alpha=3.0, mode=mode)
+                wall[name].append((time.perf_counter() - start) * 1000)
+                cpu[name].append((time.process_time() - start_cpu) * 1000)
+    return {
+        **{f"{k}_wall": statistics.median(v) for k, v in wall.items()},
+        **{f"{k}_cpu": statistics.median(v) for k, v in cpu.items()},
+        "differ": differ,
+    }
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--frames", type=int, default=10)
     parser.add_argument("--repeats", type=int, default=10)
     parser.add_argument("--beta", type=float, default=None, help="override the beta default")
+    parser.add_argument("--reference-frames", type=int, default=3)
+    parser.add_argument("--baseline", default="", help="commit whose FRST is timed alongside")
     args = parser.parse_args()
     cv2.setNumThreads(1)
     images = scenes(args.frames)
@@ -125,6 +197,31 @@ def main() -> None:
         f"speed-up {check['speedup']:.0f}x, max abs diff {check['max_abs_diff']:.2e} "
         f"(max |S| {check['max_abs_value']:.3g})"
     )
+    if args.beta is None:
+        for width, height in SIZES:
+            sized = [
+                cv2.resize(im, (width, height), interpolation=cv2.INTER_AREA)
+                for im in images[: args.reference_frames]
+            ]
+            ref = reference_comparison(detector, sized, max(1, args.repeats // 5))
+            print(
+                f"{width}x{height}: detect {ref['shipped']:.1f} ms, straightforward "
+                f"{ref['reference']:.1f} ms: {ref['reference'] / ref['shipped']:.1f}x; "
+                f"{ref['same']} of {ref['total']} reference candidates reproduced"
+            )
+    if args.baseline:
+        for width, height in SIZES:
+            sized = [
+                cv2.resize(im, (width, height), interpolation=cv2.INTER_AREA)
+                for im in images[: args.reference_frames]
+            ]
+            ab = baseline_comparison(sized, args.baseline, args.repeats)
+            print(
+                f"{width}x{height}: FRST of both parts now {ab['now_wall']:.1f} ms (CPU "
+                f"{ab['now_cpu']:.1f}), at {args.baseline} {ab['baseline_wall']:.1f} ms (CPU "
+                f"{ab['baseline_cpu']:.1f}): {ab['baseline_wall'] / ab['now_wall']:.2f}x wall, "
+                f"{ab['baseline_cpu'] / ab['now_cpu']:.2f}x CPU; frames differing: {ab['differ']}"
+            )
 
 
 if __name__ == "__main__":

@@ -6,6 +6,14 @@ per frame (single thread; the factors are interleaved within every repetition of
 machine load falls on all of them alike) and the per-frame recall and precision that tsrkit's
 runner measures on those frames. Usage: ``python benchmarks/bench_tl_recognizer.py
 [-p context=housing ...]``.
+
+``--reference`` instead times the detector against its straightforward version
+(``tl_recognizer_straightforward.py``) at 1280x720, separately on the road scenes and on
+synthetic cluttered scenes (``--blobs`` saturated red, yellow and green blobs of 2-23 px on a
+grey background, each a contour the detector must prune or validate), interleaved, and prints
+the contour and candidate counts and how many of the reference's candidates the detector also
+finds (same state, IoU >= 0.5); "scored" counts the contours per frame that survive pruning and
+are validated.
 """
 
 from __future__ import annotations
@@ -16,16 +24,113 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ[_var] = "1"
 
 import argparse  # noqa: E402
+import json  # noqa: E402
 import statistics  # noqa: E402
+import sys  # noqa: E402
 import tempfile  # noqa: E402
 import time  # noqa: E402
+from pathlib import Path  # noqa: E402
 
 import cv2  # noqa: E402
+import numpy as np  # noqa: E402
 
 import tsrkit  # noqa: E402
-from tsrkit.types import Annotation, Dataset, Sample  # noqa: E402
+from tsrkit.geometry import iou_matrix  # noqa: E402
+from tsrkit.types import Annotation, Dataset, Frame, Sample  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from at_commit import module_at  # noqa: E402
+from tl_recognizer_straightforward import tl_recognizer_straightforward  # noqa: E402
 
 WIDTH, HEIGHT = 1413, 1884
+REPO = Path(__file__).resolve().parents[1]
+DATA = Path(os.environ.get("TSRKIT_DATA_DIR", REPO.parent / "shared" / "datasets"))
+#: Hues (OpenCV scale) of the cluttered scenes' blobs: red, orange-yellow, green, magenta-red.
+CLUTTER_HUES = (5, 20, 80, 175)
+
+
+def cluttered_scene(seed: int, blobs: int, size=(720, 1280)) -> np.ndarray:
+    """A grey textured frame with ``blobs`` filled ellipses of saturated traffic-light hues
+    (half-axes 1-11 px, any angle, overlapping at random): many contours per colour pass."""
+    rng = np.random.default_rng(seed)
+    image = cv2.GaussianBlur(rng.integers(60, 140, (*size, 3), dtype=np.uint8), (0, 0), 3)
+    for hue in rng.choice(CLUTTER_HUES, blobs):
+        hsv = np.uint8([[[hue, rng.integers(150, 256), rng.integers(120, 256)]]])
+        colour = tuple(int(c) for c in cv2.cvtColor(hsv, cv2.COLOR_HSV2BGR)[0, 0])
+        centre = (int(rng.integers(0, size[1])), int(rng.integers(0, size[0])))
+        axes = (int(rng.integers(1, 12)), int(rng.integers(1, 12)))
+        cv2.ellipse(image, centre, axes, float(rng.uniform(0, 180)), 0, 360, colour, -1)
+    return image
+
+
+def road_scenes(count: int, size=(1280, 720)) -> list[np.ndarray]:
+    """The first ``count`` roboflow_traffic_light_kr frames resized to ``size``."""
+    root = DATA / "roboflow_traffic_light_kr"
+    entries = json.loads((root / "annotations.json").read_text())[:count]
+    return [
+        cv2.resize(cv2.imread(str(root / e["file"])), size, interpolation=cv2.INTER_AREA)
+        for e in entries
+    ]
+
+
+def agreement(shipped, reference) -> tuple[int, int]:
+    """Reference candidates with a shipped one of the same state at IoU >= 0.5, and all."""
+    if not shipped or not reference:
+        return 0, len(reference)
+    overlap = iou_matrix([r.bbox for r in reference], [c.bbox for c in shipped])
+    same = np.array([[r.state == c.state for c in shipped] for r in reference])
+    return int(np.count_nonzero(((overlap >= 0.5) & same).any(axis=1))), len(reference)
+
+
+def baseline_detector(commit: str, params: dict):
+    """TL-recognizer as of ``commit`` (its ``tl_recognizer.py``), with ``params`` over the
+    defaults."""
+    cls = module_at(commit, "plugins/detectors/tl_recognizer/tl_recognizer.py").TlRecognizer
+    return cls(**{**{p.name: p.default for p in cls.params}, **params})
+
+
+def reference_comparison(
+    params: dict, frames: int, blobs: int, repeats: int, baseline: str
+) -> None:
+    """Shipped detector against the straightforward version (and against the detector of
+    commit ``baseline`` unless empty), road and cluttered scenes."""
+    detector = tsrkit.detector("tl-recognizer", **params)
+    old = baseline_detector(baseline, params) if baseline else None
+    sets = {
+        "road 1280x720": road_scenes(frames),
+        f"cluttered 1280x720 ({blobs} blobs)": [cluttered_scene(s, blobs) for s in range(frames)],
+    }
+    print(
+        f"{'scenes':>34} {'scored':>9} {'shipped ms':>10} {'reference ms':>12} {'ratio':>6} "
+        f"{'candidates':>10} {'agree':>7}"
+    )
+    for name, images in sets.items():
+        frames_ = [Frame(image, f"{name} {k}") for k, image in enumerate(images)]
+        calls = {
+            "shipped": detector.detect,
+            "reference": lambda f: tl_recognizer_straightforward(detector, f),
+        }
+        if old is not None:
+            calls["baseline"] = old.detect
+            differ = sum(old.scored(f) != detector.scored(f) for f in frames_)
+            print(f"{name}: frames whose candidates differ from {baseline}'s: {differ}")
+        ms = interleaved_ms(calls, frames_, repeats)
+        contours = np.mean([len(detector.scored(f)) for f in frames_])
+        found = [
+            agreement(detector.detect(f), tl_recognizer_straightforward(detector, f))
+            for f in frames_
+        ]
+        shipped_count = sum(len(detector.detect(f)) for f in frames_)
+        print(
+            f"{name:>34} {contours:>9.0f} {ms['shipped']:>10.1f} {ms['reference']:>12.1f} "
+            f"{ms['reference'] / ms['shipped']:>6.2f} {shipped_count:>10d} "
+            f"{sum(a for a, _ in found)}/{sum(b for _, b in found)}"
+        )
+        if old is not None:
+            print(
+                f"{'':>34} {baseline} detector {ms['baseline']:.1f} ms: "
+                f"{ms['baseline'] / ms['shipped']:.2f}x the shipped time"
+            )
 
 
 def stretched(dataset: Dataset) -> Dataset:
@@ -59,7 +164,7 @@ def interleaved_ms(detectors: dict, frames, repeats: int) -> dict:
         for _ in range(repeats):
             for key, detector in detectors.items():
                 start = time.perf_counter()
-                detector.detect(frame)
+                (detector if callable(detector) else detector.detect)(frame)
                 times[key].append((time.perf_counter() - start) * 1000)
         for key in detectors:
             per_frame[key].append(statistics.median(times[key]))
@@ -82,9 +187,19 @@ def main() -> None:
         default=[],
         help="detector parameter KEY=VALUE (repeatable)",
     )
+    parser.add_argument("--reference", action="store_true", help="time against the reference")
+    parser.add_argument("--frames", type=int, default=5, help="frames per set (--reference)")
+    parser.add_argument("--blobs", type=int, default=1500, help="blobs per cluttered scene")
+    parser.add_argument(
+        "--baseline", default="74eb292", help="commit timed alongside with --reference ('' to skip)"
+    )
     args = parser.parse_args()
     params = parsed(args.param)
     cv2.setNumThreads(1)
+    if args.reference:
+        print(f"tl-recognizer params {params or 'default'}, {args.repeats} repetitions, one thread")
+        reference_comparison(params, args.frames, args.blobs, args.repeats, args.baseline)
+        return
     data = stretched(tsrkit.dataset(args.dataset))
     frames = [s.load() for s in data]
     print(

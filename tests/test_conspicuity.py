@@ -59,6 +59,14 @@ def test_fast_map_matches_oracle_on_a_real_frame(shared_datasets):
     assert_matches_oracle(np.ascontiguousarray(image[y0 : y0 + 60, x0 : x0 + 70]))
 
 
+def kernel_window(tables, terms, row, col, count, out):
+    """The kernel's sum of one window's terms at table row ``row``, columns ``col ..``."""
+    mid = ck.positive_ends(terms, np.array([0, len(terms)]))[0]
+    offsets = ck.flat_offsets(terms, tables.shape)
+    base = row * tables.shape[2] + col
+    ck.window_sum(tables.reshape(-1), offsets, 0, mid, len(terms), base, count, out)
+
+
 def window_sums(channel, pad, windows, row, prefix=ck.LIGHT_PREFIX):
     """Kernel sums of several planned windows on one row of a channel mirrored by ``pad``."""
     padded = cs.mirror(channel, pad)
@@ -66,8 +74,22 @@ def window_sums(channel, pad, windows, row, prefix=ck.LIGHT_PREFIX):
     out = np.zeros((len(windows), channel.shape[1]), np.int32)
     for window, plan in zip(out, windows):
         terms = np.array(cs.kernel_terms(plan, prefix), np.int32)
-        ck.window_sum(tables, terms, 0, len(terms), pad + 1 + row, pad, channel.shape[1], window)
+        kernel_window(tables, terms, pad + 1 + row, pad, channel.shape[1], window)
     return out
+
+
+def test_prefix_tables_are_row_prefixes_and_their_column_integrals():
+    light, sat = cs.lightness(random_image(7)), cs.saturation(random_image(7))
+    tables = ck.prefix_tables(light, sat)
+    for channel, prefix, integral in (
+        (light, ck.LIGHT_PREFIX, ck.LIGHT_INTEGRAL),
+        (sat, ck.SAT_PREFIX, ck.SAT_INTEGRAL),
+    ):
+        rows = np.cumsum(channel, axis=1, dtype=np.int64)
+        assert not tables[prefix, 0].any() and not tables[prefix, :, 0].any()
+        assert np.array_equal(tables[prefix, 1:, 1:], rows)
+        assert np.array_equal(tables[integral, 1:, 1:], np.cumsum(rows, axis=0))
+        assert not tables[integral, 0].any() and not tables[integral, :, 0].any()
 
 
 def test_window_sums_are_exact_integer_sums():
@@ -99,7 +121,7 @@ def test_window_sums_survive_wrapping_integrals():
     assert tables[ck.LIGHT_INTEGRAL].min() < 0
     terms = np.array(cs.kernel_terms(cs.disk_plan(3), ck.LIGHT_PREFIX), np.int32)
     out = np.zeros(4, np.int32)
-    ck.window_sum(tables, terms, 0, len(terms), 2990, 2990, 4, out)
+    kernel_window(tables, terms, 2990, 2990, 4, out)
     assert np.all(out == 255 * cs.disk_size(3))
 
 

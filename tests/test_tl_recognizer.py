@@ -14,6 +14,7 @@ from tsrkit.registry import get_registry
 from tsrkit.types import Annotation, Frame, Sample
 from tsrkit_plugins.detectors.tl_recognizer import TlRecognizer, enclosed_cores, red_or_yellow
 from tsrkit_plugins.detectors.tl_recognizer import tl_geometry as geo
+from tsrkit_plugins.detectors.tl_recognizer.tl_recognizer import image_boxes, levelled_boxes
 from tsrkit_plugins.detectors.tl_recognizer.tl_templates import disc_template, extract_patch, ncc
 from tsrkit_plugins.detectors.tl_recognizer.tl_tuning import (
     patch_scores,
@@ -443,3 +444,23 @@ def test_real_frames_run_and_states_are_valid(shared_datasets):
     for path in images:
         for c in det.detect(Frame(read_image(path), str(path))):
             assert c.state in ("red", "yellow", "green") and c.score > det.threshold
+
+
+def test_levelled_boxes_hand_worked_and_like_one_contour_at_a_time():
+    # Reduced pixel (0, 0) at factor 2 covers full-resolution pixels 0-1: edges -0.5 .. 1.5.
+    single = [np.array([[[0, 0]]], np.int32), np.array([[[3, 1]], [[4, 2]]], np.int32)]
+    boxes = levelled_boxes(single, (2.0, 2.0), 0.0, (0.0, 0.0))
+    assert boxes.tolist() == [[-0.5, -0.5, 1.5, 1.5], [5.5, 1.5, 9.5, 5.5]]
+    assert image_boxes(boxes, 0.0, (10.0, 5.0)).tolist() == [
+        [9.5, 4.5, 11.5, 6.5],
+        [15.5, 6.5, 19.5, 10.5],
+    ]
+    rng = np.random.default_rng(3)
+    contours = [rng.integers(0, 90, (n, 1, 2)).astype(np.int32) for n in (1, 4, 9, 2)]
+    roll, centre, scale = 0.3, (44.5, 30.0), (3.0, 2.5)
+    boxes = levelled_boxes(contours, scale, roll, centre)
+    for contour, box in zip(contours, boxes):
+        uv = geo.level_coordinates((contour.reshape(-1, 2) + 0.5) * scale - 0.5, roll, centre)
+        (u0, v0), (u1, v1) = uv.min(axis=0), uv.max(axis=0)
+        assert box.tolist() == [u0 - 1.5, v0 - 1.25, u1 + 1.5, v1 + 1.25]
+    assert levelled_boxes([], scale, roll, centre).shape == (0, 4)

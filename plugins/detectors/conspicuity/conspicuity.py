@@ -48,6 +48,8 @@ from tsrkit_plugins.detectors.conspicuity.conspicuity_kernel import (
     LIGHT_PREFIX,
     SAT_PREFIX,
     best_products,
+    flat_offsets,
+    positive_ends,
     prefix_tables,
 )
 from tsrkit_plugins.detectors.localization import (
@@ -192,8 +194,10 @@ class KernelPlan:
 
     light_terms: np.ndarray
     light_starts: np.ndarray
+    light_mids: np.ndarray
     sat_terms: np.ndarray
     sat_starts: np.ndarray
+    sat_mids: np.ndarray
     sat_inner: np.ndarray
     sat_outer: np.ndarray
     radii: np.ndarray
@@ -236,9 +240,15 @@ def kernel_plan(radii: tuple[int, ...], margin: int) -> KernelPlan:
         )
         for r, nq, nb in zip(radii, n_quarter, n_box)
     ]
+    light_terms, light_starts = concatenated(light)
+    sat_terms, sat_starts = concatenated(sat)
     return KernelPlan(
-        *concatenated(light),
-        *concatenated(sat),
+        light_terms,
+        light_starts,
+        positive_ends(light_terms, light_starts),
+        sat_terms,
+        sat_starts,
+        positive_ends(sat_terms, sat_starts),
         np.array([sat_radii.index(r) for r in radii], np.int64),
         np.array([sat_radii.index(2 * r) for r in radii], np.int64),
         np.array(radii, np.int32),
@@ -355,10 +365,12 @@ def products_on_runs(
         tables,
         pad,
         runs,
-        plan.light_terms,
+        flat_offsets(plan.light_terms, tables.shape),
         plan.light_starts,
-        plan.sat_terms,
+        plan.light_mids,
+        flat_offsets(plan.sat_terms, tables.shape),
         plan.sat_starts,
+        plan.sat_mids,
         plan.sat_inner,
         plan.sat_outer,
         plan.radii,

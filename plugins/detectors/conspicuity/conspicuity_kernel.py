@@ -12,9 +12,17 @@ the values are bit for bit the same (other weights use ``powf`` instead of ``cv2
 
 Integer sums wrap modulo 2**32 in the int32 buffers like the int32 tables do, so the true sums
 (which are small) come out exact even when the column integrals of a large frame overflow.
+
+Speed (issue 16): the tables are built in one compiled pass per channel; every term is a flat
+offset into the flattened tables, so each read is a contiguous run the compiler vectorises; and
+a window adds its terms in groups of four, reading and writing its buffer once per group. Being
+integer sums, none of this changes a value (``bench_conspicuity.py --baseline`` checks the maps
+and the candidates against an earlier commit's).
 """
 
 from __future__ import annotations
+
+from itertools import pairwise
 
 import numpy as np
 from numba import njit
@@ -37,29 +45,103 @@ def prefix_tables(light: np.ndarray, sat: np.ndarray) -> np.ndarray:
     """
     height, width = light.shape
     stack = np.zeros((4, height + 1, width + 1), np.int32)
-    for channel, (prefix, integral) in zip(
-        (light, sat), ((LIGHT_PREFIX, LIGHT_INTEGRAL), (SAT_PREFIX, SAT_INTEGRAL))
-    ):
-        np.cumsum(channel, axis=1, dtype=np.int32, out=stack[prefix, 1:, 1:])
-        np.cumsum(stack[prefix], axis=0, dtype=np.int32, out=stack[integral])
+    fill_tables(light, stack[LIGHT_PREFIX], stack[LIGHT_INTEGRAL])
+    fill_tables(sat, stack[SAT_PREFIX], stack[SAT_INTEGRAL])
     return stack
 
 
 @njit(cache=True, nogil=True)
-def window_sum(tables, terms, first, last, row, col, count, out):
-    """``out[:count]`` = the signed sum of ``terms[first:last]`` = (table, dy, dc, sign) read at
-    pixel row ``row`` (table row ``row + dy``) and columns ``col + dc ..``."""
-    out[:count] = 0
-    for t in range(first, last):
-        y, c = row + terms[t, 1], col + terms[t, 2]
-        source = tables[terms[t, 0], y, c : c + count]
-        target = out[:count]
-        if terms[t, 3] > 0:
-            for x in range(count):
-                target[x] = np.int32(target[x] + source[x])
-        else:
-            for x in range(count):
-                target[x] = np.int32(target[x] - source[x])
+def fill_tables(channel, prefix, integral):
+    """Row prefix sums of ``channel`` into ``prefix`` and their running column sums into
+    ``integral`` (both zero on entry), in one pass over the rows; int32 stores wrap."""
+    height, width = channel.shape
+    for y in range(height):
+        total = 0
+        row = prefix[y + 1]
+        for x in range(width):
+            total += channel[y, x]
+            row[x + 1] = total
+        above, below = integral[y], integral[y + 1]
+        for x in range(width + 1):
+            below[x] = above[x] + row[x]
+
+
+def flat_offsets(terms: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
+    """Offsets of terms (table, dy, dc, sign) in the flattened table stack of ``shape``,
+    relative to a pixel's flat index in the first table."""
+    terms = terms.astype(np.int64)
+    return (terms[:, 0] * shape[1] + terms[:, 1]) * shape[2] + terms[:, 2]
+
+
+def positive_ends(terms: np.ndarray, starts: np.ndarray) -> np.ndarray:
+    """Per window, the index after its positive terms (a plan lists them first)."""
+    return np.array(
+        [a + int(np.count_nonzero(terms[a:b, 3] > 0)) for a, b in pairwise(starts)],
+        np.int64,
+    )
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _source(flat, offsets, t, base, count):
+    """The ``count`` contiguous table entries term ``t`` reads for the pixels from ``base``."""
+    start = base + offsets[t]
+    return flat[start : start + count]
+
+
+@njit(cache=True, nogil=True)
+def window_sum(flat, offsets, first, mid, last, base, count, out):
+    """``out[:count]`` = the sum of the table entries of terms ``first:mid`` minus those of
+    terms ``mid:last``, each read at flat ``offsets[t]`` from ``base`` (a pixel's flat index)
+    in the flattened ``flat`` tables.
+
+    Terms are added four at a time, or two positive and two negative ones, so that ``out`` is
+    read and written once per group rather than once per term; int32 sums wrap, so the
+    grouping does not change the result.
+    """
+    target = out[:count]
+    target[:] = 0
+    p, q = first, mid
+    while mid - p >= 4:
+        a, b = _source(flat, offsets, p, base, count), _source(flat, offsets, p + 1, base, count)
+        c, d = (
+            _source(flat, offsets, p + 2, base, count),
+            _source(flat, offsets, p + 3, base, count),
+        )
+        for x in range(count):
+            target[x] += (a[x] + b[x]) + (c[x] + d[x])
+        p += 4
+    while last - q >= 4:
+        a, b = _source(flat, offsets, q, base, count), _source(flat, offsets, q + 1, base, count)
+        c, d = (
+            _source(flat, offsets, q + 2, base, count),
+            _source(flat, offsets, q + 3, base, count),
+        )
+        for x in range(count):
+            target[x] -= (a[x] + b[x]) + (c[x] + d[x])
+        q += 4
+    while mid - p >= 2 and last - q >= 2:
+        a, b = _source(flat, offsets, p, base, count), _source(flat, offsets, p + 1, base, count)
+        c, d = _source(flat, offsets, q, base, count), _source(flat, offsets, q + 1, base, count)
+        for x in range(count):
+            target[x] += (a[x] + b[x]) - (c[x] + d[x])
+        p += 2
+        q += 2
+    while p < mid and q < last:
+        a, c = _source(flat, offsets, p, base, count), _source(flat, offsets, q, base, count)
+        for x in range(count):
+            target[x] += a[x] - c[x]
+        p += 1
+        q += 1
+    while p < mid:
+        a = _source(flat, offsets, p, base, count)
+        for x in range(count):
+            target[x] += a[x]
+        p += 1
+    while q < last:
+        a = _source(flat, offsets, q, base, count)
+        for x in range(count):
+            target[x] -= a[x]
+        q += 1
 
 
 @njit(cache=True, nogil=True)
@@ -130,14 +212,58 @@ def keep_best(product, radius, count, best, best_radius):
 
 
 @njit(cache=True, nogil=True)
+def unit_max_product(
+    light, inner, outer, n_quarter, n_box, scales, radius, count, best, best_radius
+):
+    """:func:`lightness_contrast` (printed maximum), :func:`disk_from_quarters`,
+    :func:`saturation_feature`, :func:`weighted_product` (unit weights) and :func:`keep_best`
+    fused into one pass per pixel, with the same integer and float32 operations in the same
+    order (the paper's defaults, Table 5-1): the same values, one loop instead of nine."""
+    l0, l1, l2, l3, l4, l5, l6, l7, l8 = (
+        light[0],
+        light[1],
+        light[2],
+        light[3],
+        light[4],
+        light[5],
+        light[6],
+        light[7],
+        light[8],
+    )
+    nq, nb = np.int64(n_quarter), np.int64(n_box)
+    for x in range(count):
+        contrast = max(
+            max(
+                nb * np.int64(l0[x]) - nq * np.int64(l4[x]),
+                nb * np.int64(l1[x]) - nq * np.int64(l5[x]),
+            ),
+            max(
+                nb * np.int64(l2[x]) - nq * np.int64(l6[x]),
+                nb * np.int64(l3[x]) - nq * np.int64(l7[x]),
+            ),
+        )
+        contrast = max(contrast, np.int64(0))
+        disk = np.int64(l0[x]) + l1[x] + l2[x] + l3[x] + l8[x]
+        product = (np.float32(disk) * scales[0]) * (np.float32(contrast) * scales[1])
+        product *= max(
+            np.float32(inner[x]) * scales[2], np.float32(np.int64(outer[x]) - inner[x]) * scales[3]
+        )
+        if product > best[x]:
+            best[x] = product
+            best_radius[x] = radius
+
+
+@njit(cache=True, nogil=True)
 def best_products(
     tables,
     pad,
     runs,
-    light_terms,
+    light_offsets,
     light_starts,
-    sat_terms,
+    light_mids,
+    sat_offsets,
     sat_starts,
+    sat_mids,
     sat_inner,
     sat_outer,
     radii,
@@ -160,12 +286,13 @@ def best_products(
         Mirror padding of the tables.
     runs : ndarray
         int64 (N, 3): row, first column, end column (exclusive) of the pixels to compute.
-    light_terms, light_starts : ndarray
-        Terms (table, dy, dc, sign) of the ``LIGHT_WINDOWS`` windows of each radius, window
-        ``w`` of radius index ``k`` spanning ``light_starts[k * LIGHT_WINDOWS + w]`` to the
-        next start.
-    sat_terms, sat_starts : ndarray
-        Terms of the saturation disks, disk ``d`` spanning ``sat_starts[d:d + 2]``.
+    light_offsets, light_starts, light_mids : ndarray
+        Flat offsets (:func:`flat_offsets`) of the terms of the ``LIGHT_WINDOWS`` windows of
+        each radius, window ``w`` of radius index ``k`` spanning
+        ``light_starts[k * LIGHT_WINDOWS + w]`` to the next start, its positive terms ending at
+        ``light_mids[k * LIGHT_WINDOWS + w]``.
+    sat_offsets, sat_starts, sat_mids : ndarray
+        The same for the saturation disks, disk ``d`` spanning ``sat_starts[d:d + 2]``.
     sat_inner, sat_outer : ndarray
         Per radius index, the saturation disk of radius ``r`` and of ``2 r``.
     radii, n_quarter, n_box : ndarray
@@ -185,32 +312,56 @@ def best_products(
     disk = np.zeros(longest, np.int32)
     features = np.zeros((3, longest), np.float32)
     product = np.zeros(longest, np.float32)
+    flat = tables.reshape(tables.size)
+    unit_max = not use_min and weights[0] == 1 and weights[1] == 1 and weights[2] == 1
     for run in range(runs.shape[0]):
         i, x0, count = runs[run, 0], runs[run, 1], runs[run, 2] - runs[run, 1]
-        row, col = pad + 1 + i, pad + x0
+        base = (pad + 1 + i) * tables.shape[2] + pad + x0
         for d in range(sat.shape[0]):
-            window_sum(tables, sat_terms, sat_starts[d], sat_starts[d + 1], row, col, count, sat[d])
+            window_sum(
+                flat,
+                sat_offsets,
+                sat_starts[d],
+                sat_mids[d],
+                sat_starts[d + 1],
+                base,
+                count,
+                sat[d],
+            )
         for k in range(radii.shape[0]):
             for w in range(LIGHT_WINDOWS):
                 start = k * LIGHT_WINDOWS + w
                 window_sum(
-                    tables,
-                    light_terms,
+                    flat,
+                    light_offsets,
                     light_starts[start],
+                    light_mids[start],
                     light_starts[start + 1],
-                    row,
-                    col,
+                    base,
                     count,
                     light[w],
                 )
+            inner, outer = sat[sat_inner[k]], sat[sat_outer[k]]
+            if unit_max:
+                unit_max_product(
+                    light,
+                    inner,
+                    outer,
+                    n_quarter[k],
+                    n_box[k],
+                    scales[k],
+                    radii[k],
+                    count,
+                    best[i, x0 : x0 + count],
+                    best_radius[i, x0 : x0 + count],
+                )
+                continue
             lightness_contrast(light, n_quarter[k], n_box[k], use_min, count, contrast)
             disk_from_quarters(light, count, disk)
             for x in range(count):
                 features[0, x] = np.float32(disk[x]) * scales[k, 0]
                 features[1, x] = np.float32(contrast[x]) * scales[k, 1]
-            saturation_feature(
-                sat[sat_inner[k]], sat[sat_outer[k]], scales[k, 2], scales[k, 3], count, features[2]
-            )
+            saturation_feature(inner, outer, scales[k, 2], scales[k, 3], count, features[2])
             weighted_product(features[0], features[1], features[2], weights, count, product)
             keep_best(
                 product, radii[k], count, best[i, x0 : x0 + count], best_radius[i, x0 : x0 + count]

@@ -6,7 +6,7 @@ transform of any 2-D float map (``frst.py``); ``lab_frst.py`` is Siogkas et al.'
 """
 
 from tsrkit_plugins.detectors.frst.frst import (
-    affected_pixels,
+    cast_votes,
     frst,
     kappa,
     orientation_strength,
@@ -16,7 +16,7 @@ from tsrkit_plugins.detectors.frst.frst import (
 )
 
 __all__ = [
-    "affected_pixels",
+    "cast_votes",
     "frst",
     "kappa",
     "orientation_strength",

@@ -2,7 +2,10 @@
 
 Every pixel with a strong enough gradient votes for the pixels ``n`` steps along (and against)
 its gradient direction; the votes, clipped and sharpened, are smoothed and summed over radii.
-Reusable: any detector may call :func:`frst` on a 2-D float map.
+Reusable: any detector may call :func:`frst` on a 2-D float map. The votes are cast by a
+compiled loop (:func:`cast_votes`) that finds each affected pixel and adds to it in one pass, with
+no per-radius index arrays; it sums in the order ``np.bincount`` does, so the transform is the
+same to the last bit (issue 16).
 
 Source: G. Loy and A. Zelinsky, "Fast radial symmetry for detecting points of interest",
 IEEE PAMI 25(8), 2003: the definition of the transform and its refinements
@@ -20,6 +23,7 @@ from functools import reduce
 
 import cv2
 import numpy as np
+from numba import njit
 
 #: Which affected pixels receive votes: both, positively-affected only, negatively-affected only.
 MODES = ("both", "bright", "dark")
@@ -81,35 +85,21 @@ def select_voters(gx: np.ndarray, gy: np.ndarray, beta: float, pad: int) -> Vote
     return Voters(index, gx[index] / mag, gy[index] / mag, mag, shape, pad)
 
 
-def affected_pixels(voters: Voters, n: int, sign: int) -> np.ndarray:
-    """Flat grid indices of the affected pixels ``p +- round(g(p)/||g(p)|| * n)``.
+@njit(cache=True, nogil=True)
+def cast_votes(index, ux, uy, magnitude, n, width, sign, counts, sums):
+    """Add one vote per voter at its affected pixel ``p +- round(g(p)/||g(p)|| * n)``.
 
-    ``sign=+1`` gives the positively-affected pixels p+ve, ``-1`` the negatively-affected p-ve.
-    ``round`` is to the nearest integer with ties to even (``np.rint``).
+    ``sign=+1`` votes at the positively-affected pixels p+ve, ``-1`` at the negatively-affected
+    p-ve; ``round`` is to the nearest integer with ties to even (``np.rint``). ``counts[q]``
+    gains 1 and ``sums[q]`` gains ``||g(p)||`` for every voter whose affected pixel is the flat
+    grid index ``q`` (several voters hitting one pixel all count), in voter order, so the sums
+    are those ``np.bincount`` would give. O_n and M_n are ``sign`` times these.
     """
-    step = np.rint(voters.uy * n)
-    step *= voters.grid[1]
-    step += np.rint(voters.ux * n)
-    offset = step.astype(np.intp)
-    return voters.index + offset if sign > 0 else voters.index - offset
-
-
-def orientation_projection(index: np.ndarray, sign: int, size: int) -> np.ndarray:
-    """O_n: +1 at each positively- (``sign=+1``) or -1 at each negatively-affected pixel.
-
-    Votes are accumulated with ``np.bincount`` so that several voters hitting the same pixel all
-    count (``O[index] += 1`` would keep only one of them).
-    """
-    counts = np.bincount(index, minlength=size)
-    return counts if sign > 0 else np.negative(counts, out=counts)
-
-
-def magnitude_projection(
-    index: np.ndarray, weights: np.ndarray, sign: int, size: int
-) -> np.ndarray:
-    """M_n: ``+||g(p)||`` at each positively- or ``-||g(p)||`` at each negatively-affected pixel."""
-    sums = np.bincount(index, weights=weights, minlength=size)
-    return sums if sign > 0 else np.negative(sums, out=sums)
+    for i in range(index.shape[0]):
+        step = np.rint(uy[i] * n) * width + np.rint(ux[i] * n)
+        target = index[i] + sign * np.intp(step)
+        counts[target] += 1
+        sums[target] += magnitude[i]
 
 
 def kappa(n: int) -> float:
@@ -241,11 +231,19 @@ def frst(
 def projections(voters: Voters, n: int, signs: Sequence[int]) -> tuple[np.ndarray, np.ndarray]:
     """O_n and M_n (flat, working grid) for radius ``n``, voting at the pixels of ``signs``."""
     size = voters.grid[0] * voters.grid[1]
-    votes = [(affected_pixels(voters, n, sign), sign) for sign in signs]
-    orientation = reduce(
-        np.add, (orientation_projection(index, sign, size) for index, sign in votes)
-    )
-    magnitude = reduce(
-        np.add, (magnitude_projection(index, voters.magnitude, sign, size) for index, sign in votes)
-    )
-    return orientation, magnitude
+    parts = []
+    for sign in signs:
+        counts, sums = np.zeros(size, np.int64), np.zeros(size)
+        cast_votes(
+            voters.index,
+            voters.ux,
+            voters.uy,
+            voters.magnitude,
+            n,
+            voters.grid[1],
+            sign,
+            counts,
+            sums,
+        )
+        parts.append((counts, sums) if sign > 0 else (np.negative(counts), np.negative(sums)))
+    return reduce(np.add, (o for o, _ in parts)), reduce(np.add, (m for _, m in parts))

@@ -108,6 +108,35 @@ def extract_contours(mask: np.ndarray) -> list[np.ndarray]:
     return list(contours)
 
 
+def levelled_boxes(
+    contours: list[np.ndarray], scale: tuple[float, float], roll: float, centre: tuple[float, float]
+) -> np.ndarray:
+    """Pixel-edge extents ``(u0, v0, u1, v1)`` of reduced-frame contours, levelled (line 8).
+
+    All contours' points are scaled to the full frame and levelled in one array operation and
+    reduced per contour, so a cluttered frame's thousands of contours cost no Python loop.
+    """
+    if not contours:
+        return np.zeros((0, 4))
+    pts = np.concatenate([c.reshape(-1, 2) for c in contours]).astype(np.float64)
+    pts = (pts + 0.5) * scale - 0.5
+    uv = geo.level_coordinates(pts, roll, centre)
+    starts = np.cumsum([0] + [len(c) for c in contours[:-1]])
+    low, high = np.minimum.reduceat(uv, starts), np.maximum.reduceat(uv, starts)
+    pad_u, pad_v = scale[0] / 2, scale[1] / 2
+    return np.column_stack(
+        [low[:, 0] - pad_u, low[:, 1] - pad_v, high[:, 0] + pad_u, high[:, 1] + pad_v]
+    )
+
+
+def image_boxes(boxes_uv: np.ndarray, roll: float, centre: tuple[float, float]) -> np.ndarray:
+    """Axis-aligned frame boxes ``(x0, y0, x1, y1)`` around levelled boxes (N, 4)."""
+    u0, v0, u1, v1 = boxes_uv.T
+    corners = np.stack([u0, v0, u1, v0, u1, v1, u0, v1], axis=1).reshape(-1, 2)
+    xy = geo.image_coordinates(corners, roll, centre).reshape(-1, 4, 2)
+    return np.concatenate([xy.min(axis=1), xy.max(axis=1)], axis=1)
+
+
 def red_or_yellow(
     patch_bgr: np.ndarray,
     s_min: float,
@@ -463,25 +492,14 @@ class TlRecognizer(Detector):
             mask = enclosed_cores(hsv, mask, self.params["core_v"], self.params["ring_share"])
         scale = (image.shape[1] / hsv.shape[1], image.shape[0] / hsv.shape[0])
         centre = ((image.shape[1] - 1) / 2, (image.shape[0] - 1) / 2)
-        out = []
-        for contour in extract_contours(mask):
-            box_uv = self._levelled_box(contour, scale, camera.roll, centre)
-            if not self._passes_pruning(box_uv, camera):
-                continue
-            out.append(self._validate(image, box_uv, colour, camera.roll, centre))
-        return out
-
-    @staticmethod
-    def _levelled_box(
-        contour: np.ndarray, scale: tuple[float, float], roll: float, centre: tuple[float, float]
-    ) -> tuple[float, float, float, float]:
-        """Pixel-edge extents ``(u0, v0, u1, v1)`` of a reduced-frame contour, levelled (line 8)."""
-        pts = contour.reshape(-1, 2).astype(np.float64)
-        pts = (pts + 0.5) * scale - 0.5
-        uv = geo.level_coordinates(pts, roll, centre)
-        (u0, v0), (u1, v1) = uv.min(axis=0), uv.max(axis=0)
-        pad_u, pad_v = scale[0] / 2, scale[1] / 2
-        return u0 - pad_u, v0 - pad_v, u1 + pad_u, v1 + pad_v
+        boxes = levelled_boxes(extract_contours(mask), scale, camera.roll, centre)
+        kept = [box for box in map(tuple, boxes) if self._passes_pruning(box, camera)]
+        validated = [self._validate(image, box, colour, camera.roll, centre) for box in kept]
+        frame_boxes = image_boxes(np.array(kept).reshape(-1, 4), camera.roll, centre)
+        return [
+            Candidate.from_box(tuple(box), score, state)
+            for box, (score, state) in zip(frame_boxes, validated)
+        ]
 
     def _passes_pruning(self, box_uv, camera: Camera) -> bool:
         """Property 2 and 3 with a known focal length, else pixel size and aspect bounds (3.4)."""
@@ -509,13 +527,14 @@ class TlRecognizer(Detector):
 
     def _validate(
         self, image: np.ndarray, box_uv, colour: str, roll: float, centre: tuple[float, float]
-    ) -> Candidate:
+    ) -> tuple[float, str]:
         """Red/yellow split on the lens patch, then NCC with the state's template (3.5, 4.1).
 
-        The candidate's box is the lens; its score the best over the allowed orientations.
+        Returns the score, the best over the allowed orientations, and the state.
         """
         size = self.params["template_size"]
         state = colour
+        lens = None
         if colour == "yellowred":
             lens = extract_patch(image, box_uv, roll, centre, size)
             state = red_or_yellow(
@@ -526,15 +545,10 @@ class TlRecognizer(Detector):
                 self.params["yellow_h"],
             )
         score = max(
-            self._orientation_score(image, box_uv, state, orientation, roll, centre)
+            self._orientation_score(image, box_uv, state, orientation, roll, centre, lens)
             for orientation in self.orientations
         )
-        u0, v0, u1, v1 = box_uv
-        corners = geo.image_coordinates(
-            np.array([[u0, v0], [u1, v0], [u1, v1], [u0, v1]]), roll, centre
-        )
-        (x0, y0), (x1, y1) = corners.min(axis=0), corners.max(axis=0)
-        return Candidate.from_box((x0, y0, x1, y1), score, state)
+        return score, state
 
     def _orientation_score(
         self,
@@ -544,10 +558,19 @@ class TlRecognizer(Detector):
         orientation: str,
         roll: float,
         centre: tuple[float, float],
+        lens: np.ndarray | None = None,
     ) -> float:
-        """NCC of the patch a lens of ``state`` implies in a head of ``orientation``."""
+        """NCC of the patch a lens of ``state`` implies in a head of ``orientation``.
+
+        ``lens`` is the lens MBR already sampled at template size, if any; when the patch is
+        that very rectangle at that size (the bare-lens layout), it is reused, not sampled again.
+        """
         box = patch_box(box_uv, state, orientation, self.layout)
-        patch = extract_patch(image, box, roll, centre, patch_size(orientation, self.layout))
+        size = patch_size(orientation, self.layout)
+        if lens is not None and box == tuple(box_uv) and size == lens.shape[1::-1]:
+            patch = lens
+        else:
+            patch = extract_patch(image, box, roll, centre, size)
         return ncc(patch, self.templates[state, orientation])
 
     def fit(self, samples: Iterable[Sample], *, detector: Detector | None = None) -> Model:
