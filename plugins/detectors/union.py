@@ -1,0 +1,133 @@
+"""``union``: the candidates of several detectors, merged, for recall (issue 11, item 2).
+
+Beyond the documents: the learned verifier can only keep what some detector proposed, and each
+paper detector misses lights the others find (lab-frst the small ones, conspicuity the
+over-exposed ones, ...). ``union`` runs several registered detectors, each with its own
+parameters, and merges their candidates:
+
+1. **Comparable scores.** Each detector's scores are on its own scale (saliency, symmetry,
+   boosting votes), so each member's candidates are rank-normalised: the member's k-th best of
+   n scores ``1 - k / n`` (its best 1, the rest evenly below).
+2. **Duplicate suppression.** Candidates are taken best-first; one whose centre lies within
+   ``merge`` x the larger of the two lens radii (at least ``min_distance`` px) of a kept
+   candidate is the same light. The kept candidate keeps its own lens and gains the duplicate's
+   rank score (once per member): a light several detectors agree on ranks above one found by a
+   single detector. Scores are therefore in ``[0, number of members]``.
+
+Members are written ``NAME [KEY=VALUE ...]; NAME ...``, e.g.
+``lab-frst top=15; conspicuity n_top=15``; values are checked by each member's own schema.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from tsrkit.hookspecs import hookimpl
+from tsrkit.params import Param, ParamError, parse_assignments
+from tsrkit.plugin import Detector
+from tsrkit.registry import get_registry
+from tsrkit.types import Candidate, Frame
+
+DEFAULT_MEMBERS = "lab-frst top=15; conspicuity n_top=15; adaboost-hsv max_boxes=10; tl-recognizer"
+
+
+def parse_members(text: str) -> list[tuple[str, dict[str, str]]]:
+    """``"a k=v; b"`` -> ``[("a", {"k": "v"}), ("b", {})]``.
+
+    Raises
+    ------
+    ParamError
+        No member, a member given twice, ``union`` itself, or a ``KEY=VALUE`` without ``=``.
+    """
+    members = []
+    for part in text.split(";"):
+        words = part.split()
+        if not words:
+            continue
+        name, assignments = words[0], words[1:]
+        if name == Union.name:
+            raise ParamError("union: a member cannot be 'union' itself")
+        if any(name == seen for seen, _ in members):
+            raise ParamError(f"union: member {name!r} given twice")
+        members.append((name, parse_assignments(assignments)))
+    if not members:
+        raise ParamError(f"union: no member detector in {text!r}")
+    return members
+
+
+def rank_scores(count: int) -> np.ndarray:
+    """Rank-normalised scores of ``count`` best-first candidates: ``1 - k / count``."""
+    return 1.0 - np.arange(count) / max(count, 1)
+
+
+def merge(lists: list[list[Candidate]], factor: float, min_distance: float) -> list[Candidate]:
+    """Merge best-first candidate lists (one per member) by the module's rules, best first."""
+    pool = []  # (rank score, member, candidate)
+    for member, candidates in enumerate(lists):
+        ordered = sorted(candidates, key=lambda c: -c.score)
+        pool += [(s, member, c) for s, c in zip(rank_scores(len(ordered)), ordered)]
+    pool.sort(key=lambda item: (-item[0], item[1]))
+    kept: list[tuple[Candidate, dict[int, float]]] = []
+    for score, member, c in pool:
+        for other, votes in kept:
+            reach = max(factor * max(c.radius, other.radius), min_distance)
+            if np.hypot(c.x - other.x, c.y - other.y) <= reach:
+                votes.setdefault(member, score)
+                break
+        else:
+            kept.append((c, {member: score}))
+    merged = [replace(c, score=float(sum(votes.values()))) for c, votes in kept]
+    return sorted(merged, key=lambda c: -c.score)
+
+
+class Union(Detector):
+    """Several detectors' candidates, rank-normalised and merged with duplicate suppression."""
+
+    name = "union"
+    summary = "union of several detectors' candidates: rank-normalised scores, duplicates merged"
+    section = "issue 11 (beyond the documents)"
+    params = (
+        Param(
+            "members",
+            "str",
+            DEFAULT_MEMBERS,
+            help="member detectors with their parameters: 'NAME KEY=VALUE ...; NAME ...'",
+        ),
+        Param(
+            "merge",
+            "float",
+            1.0,
+            min=0.0,
+            max=10.0,
+            help="two candidates whose centres are within this many lens radii (the larger "
+            "radius) are the same light",
+        ),
+        Param(
+            "min_distance",
+            "float",
+            3.0,
+            min=0.0,
+            max=100.0,
+            help="... or within this many pixels, whatever their radii",
+        ),
+    )
+
+    def __init__(self, **params):
+        super().__init__(**params)
+        registry = get_registry()
+        self.members = [
+            registry.create("detector", name, values)
+            for name, values in parse_members(self.params["members"])
+        ]
+
+    def detect(self, frame: Frame) -> list[Candidate]:
+        """Every member's candidates, merged; scores in ``[0, number of members]``."""
+        lists = [member.detect(frame) for member in self.members]
+        return merge(lists, self.params["merge"], self.params["min_distance"])
+
+
+@hookimpl
+def register_detectors(register):
+    register(Union)

@@ -1,0 +1,72 @@
+"""The ``union`` detector: member parsing, rank-normalised scores, duplicate suppression."""
+
+import numpy as np
+import pytest
+
+from tsrkit.params import ParamError
+from tsrkit.registry import get_registry
+from tsrkit.synth.heads import background, render_head
+from tsrkit.types import Candidate, Frame
+from tsrkit_plugins.detectors.union import merge, parse_members, rank_scores
+
+
+def test_members_parse_with_their_own_parameters():
+    assert parse_members("lab-frst top=15; conspicuity n_top=15 ;tl-recognizer") == [
+        ("lab-frst", {"top": "15"}),
+        ("conspicuity", {"n_top": "15"}),
+        ("tl-recognizer", {}),
+    ]
+
+
+@pytest.mark.parametrize("text", ["", " ; ", "union", "lab-frst; lab-frst top=3", "a top"])
+def test_bad_members_are_one_clear_error(text):
+    with pytest.raises(ParamError):
+        parse_members(text)
+
+
+def test_a_member_parameter_outside_its_schema_is_refused():
+    with pytest.raises(ParamError, match="top"):
+        get_registry().create("detector", "union", {"members": "lab-frst top=-4"})
+
+
+def test_rank_scores_put_each_members_best_at_one():
+    assert rank_scores(4).tolist() == [1.0, 0.75, 0.5, 0.25]
+
+
+def test_merge_suppresses_duplicates_and_sums_the_agreeing_members_rank_scores():
+    # member A: raw scores in the thousands; member B: in [0, 1]; ranks make them comparable
+    a = [Candidate.from_circle(100, 100, 4, 5000.0), Candidate.from_circle(300, 50, 4, 10.0)]
+    b = [Candidate.from_circle(102, 101, 5, 0.2), Candidate.from_circle(200, 200, 3, 0.9)]
+    merged = merge([a, b], factor=1.0, min_distance=3.0)
+    # (100, 100): A's best (1.0) + B's second (0.5), B's duplicate at 2.2 px < 5 px dropped
+    assert [(c.x, c.y, c.score) for c in merged] == [
+        (100, 100, 1.5),
+        (200, 200, 1.0),
+        (300, 50, 0.5),
+    ]
+    assert merged[0].radius == 4  # the kept candidate keeps its own lens
+
+
+def test_min_distance_merges_radius_less_centres():
+    a = [Candidate.from_circle(10, 10, 0.5, 1.0)]
+    b = [Candidate.from_circle(12, 12, 0.5, 1.0)]
+    assert len(merge([a, b], factor=1.0, min_distance=3.0)) == 1
+    assert len(merge([a, b], factor=1.0, min_distance=2.0)) == 2
+
+
+def test_union_finds_what_each_member_finds_on_a_rendered_head():
+    image = background(240, 320, seed=3)
+    head = render_head(image, (160.0, 120.0), 6, 3, 0)
+    frame = Frame(image, "head")
+    registry = get_registry()
+    union = registry.create(
+        "detector", "union", {"members": "lab-frst top=15; conspicuity n_top=15"}
+    )
+    found = union.detect(frame)
+    members = [d.detect(frame) for d in union.members]
+    assert len(found) <= sum(len(m) for m in members)
+    assert max(c.score for c in found) <= 2.0
+    x, y = head.lens[:2]
+    for member in members:  # what a member finds near the lit lens, the union finds too
+        if any(np.hypot(c.x - x, c.y - y) < 6 for c in member):
+            assert any(np.hypot(c.x - x, c.y - y) < 12 for c in found)
