@@ -63,7 +63,9 @@ VERBS = {
     "track": Verb(
         "tsrkit.cli.track",
         "track_command",
-        "List the traversals of the GPS track through the map's signalised intersections.",
+        "List the traversals of the GPS track through the map's signalised intersections; "
+        "with VIDEO, recognise the signal states of each traversal on its clip "
+        "(Zheng 2016, 3.4).",
     ),
     "train": Verb(
         "tsrkit.cli.train",
