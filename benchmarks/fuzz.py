@@ -14,7 +14,7 @@ Surfaces:
   ``ModelError``);
 - ``params``: random strings and numbers for every parameter type (allowed: ``ParamError``).
 
-    python benchmarks/fuzz.py [--cases 10000] [--seed 0]
+    python benchmarks/fuzz.py [--cases 10000] [--seed 0] [--only model,config]
 """
 
 from __future__ import annotations
@@ -250,6 +250,9 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cases", type=int, default=10000)
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument(
+        "--only", default=None, help="Comma-separated surfaces to run (default all)."
+    )
     args = parser.parse_args()
     rng = np.random.default_rng(args.seed)
     folder = Path(tempfile.mkdtemp(prefix="tsrkit-fuzz-"))
@@ -264,7 +267,10 @@ def main() -> None:
         surfaces["model"] = model_surface(folder)
         surfaces["params"] = params_surface()
         total_uncaught = 0
+        chosen = args.only.split(",") if args.only else list(surfaces)
         for name, (seeds, target, allowed) in surfaces.items():
+            if name not in chosen:
+                continue
             start = time.perf_counter()
             counts = fuzz(name, seeds, target, args.cases, rng, allowed)
             uncaught = sum(n for k, n in counts.items() if k.startswith("UNCAUGHT"))

@@ -294,6 +294,26 @@ def good_npz() -> bytes:
     return buffer.getvalue()
 
 
+def damaged_npz(part: str) -> bytes:
+    """:func:`good_npz` with its deflate stream overwritten (``"deflate"``) or its central
+    directory naming an unknown compression method (``"method"``): cases fuzz.py found."""
+    import io
+    import zipfile
+
+    data = bytearray(good_npz())
+    with zipfile.ZipFile(io.BytesIO(bytes(data))) as archive:
+        info = archive.infolist()[0]
+    if part == "deflate":
+        at = info.header_offset  # the local header's own name and extra lengths
+        start = at + 30 + int.from_bytes(data[at + 26 : at + 28], "little")
+        start += int.from_bytes(data[at + 28 : at + 30], "little")
+        data[start : start + 8] = b"\xff" * 8  # BTYPE 11: an invalid deflate block
+    else:
+        central = data.rfind(b"PK\x01\x02")
+        data[central + 10 : central + 12] = (99).to_bytes(2, "little")
+    return bytes(data)
+
+
 def model_meta(**overrides) -> str:
     meta = {"format_version": 1, "plugin": "ab-hist", "arrays": {"histograms": {"sha256": "x"}}}
     meta.update(overrides)
@@ -1017,6 +1037,15 @@ RUNS: list[Row] = [
         2,
         "no format recognises",
     ),
+    *(
+        (
+            f"sniff-utf8-{name}",
+            lambda tmp, name=name: ["datasets", "info", str(write(tmp / name, BAD_UTF8))],
+            2,
+            "no format recognises it",
+        )
+        for name in ("a.json", "labels.csv", "GT-1.csv", "a.xml", "data.yaml", "gt.txt")
+    ),
     (
         "info-unknown",
         lambda tmp: ["datasets", "info", "no-such-set"],
@@ -1045,6 +1074,18 @@ RUNS: list[Row] = [
     ("train-missing-split", train("--split", "nope"), 2, "nope"),
     ("model-missing", model_files(None, None), 2, "no such file"),
     ("model-npz-garbage", model_files(b"garbage", model_meta()), 2, "corrupt archive"),
+    (
+        "model-npz-bad-deflate",
+        model_files(damaged_npz("deflate"), model_meta()),
+        2,
+        "corrupt archive \\(error",
+    ),
+    (
+        "model-npz-unknown-method",
+        model_files(damaged_npz("method"), model_meta()),
+        2,
+        "corrupt archive \\(NotImplementedError",
+    ),
     ("model-json-garbage", model_files(good_npz(), "{"), 2, "unreadable metadata"),
     ("model-json-utf8", model_files(good_npz(), b'{"plugin": "\xff"}'), 2, "unreadable metadata"),
     ("model-json-list", model_files(good_npz(), "[1]"), 2, "not tsrkit model metadata"),

@@ -280,6 +280,29 @@ def test_model_loading_is_total(work, meta, archive, keep_archive):
     assert set(model.arrays) == {"w"}
 
 
+@BOUNDED
+@given(
+    edits=st.lists(
+        st.tuples(st.floats(0, 1, exclude_max=True), st.integers(0, 255)), min_size=1, max_size=4
+    )
+)
+def test_a_damaged_model_archive_is_a_model_error(work, edits):
+    base = work / "zipped"
+    save_model(
+        base, Model({"w": np.arange(64.0)}), plugin="p", plugin_version="1", params={}, training={}
+    )
+    data = bytearray((work / "zipped.npz").read_bytes())
+    for where, value in edits:  # a relative position: uniform over the whole file
+        data[int(where * len(data))] = value
+    (work / "zipped.npz").write_bytes(bytes(data))
+    try:
+        model = load_model(base, plugin="p")
+    except ModelError as exc:
+        assert "\n" not in str(exc)
+        return
+    assert np.array_equal(model.arrays["w"], np.arange(64.0))  # the checksum guards the values
+
+
 # --- configs and parameters ---
 
 

@@ -12,6 +12,7 @@ import io
 import json
 import os
 import zipfile
+import zlib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -134,8 +135,19 @@ def load_model(path: str | os.PathLike, plugin: str) -> Model:
     try:
         with np.load(npz_path, allow_pickle=False) as archive:
             arrays = {name: archive[name] for name in archive.files}
-    except (OSError, ValueError, zipfile.BadZipFile, EOFError) as exc:
-        raise ModelError(f"model {npz_path}: corrupt archive ({exc})") from None
+    except (
+        OSError,
+        ValueError,
+        zipfile.BadZipFile,
+        EOFError,
+        zlib.error,
+        NotImplementedError,
+    ) as exc:
+        # a damaged deflate stream (zlib.error) or zip header (NotImplementedError: "zip file
+        # version 21.7", "compression method is not supported") found by benchmarks/fuzz.py
+        raise ModelError(
+            f"model {npz_path}: corrupt archive ({type(exc).__name__}: {exc})"
+        ) from None
     expected = meta["arrays"]
     if set(arrays) != set(expected):
         raise ModelError(
