@@ -106,3 +106,24 @@ def test_setup_error_from_a_plugin_stops_the_run(fakes, tmp_path, workers):
     assert result.exit_code == 2
     assert result.stderr.strip() == "Error: untrained needs a model: pass --param model=M"
     assert not (tmp_path / "report.json").exists()
+
+
+def test_a_rerun_with_fewer_files_leaves_none_of_the_old_report(fakes, tmp_path):
+    args = ["benchmark", "--dataset", "hand", "--detector", "oracle", "--classifier", "always-red",
+            "--out", str(tmp_path), "--workers", "1", "--quiet"]  # fmt: skip
+    assert CliRunner().invoke(cli, args).exit_code == 0
+    first = json.loads((tmp_path / "report.json").read_text())
+    assert first["plots"] and all((tmp_path / name).is_file() for name in first["plots"])
+    (tmp_path / "notes.txt").write_text("the user's own file")
+    (tmp_path / "report.json").write_text(
+        json.dumps({**first, "files": [*first["files"], "../outside.txt", "notes.txt"]})
+    )
+    (tmp_path.parent / "outside.txt").write_text("not the run's")
+    result = CliRunner().invoke(cli, [*args, "--writer", "json", "--writer", "csv"])
+    assert result.exit_code == 0, result.output
+    second = json.loads((tmp_path / "report.json").read_text())
+    left = {p.relative_to(tmp_path).as_posix() for p in tmp_path.rglob("*") if p.is_file()}
+    assert not second["plots"] and not any(name in left for name in first["plots"])
+    assert set(second["files"]) <= left and "summary.md" not in left
+    assert (tmp_path.parent / "outside.txt").exists()  # never outside the run's folder
+    assert "notes.txt" not in left  # listed by the old report, so it was the run's

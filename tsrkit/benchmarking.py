@@ -134,9 +134,34 @@ def evaluate(
     run = replace(run, report=report([f for w in chosen for f in w.files(run)]))
     folder = Path(out)
     folder.mkdir(parents=True, exist_ok=True)
+    remove_stale_files(folder, {*run.report["files"], *run.report["plots"]})
     for writer in chosen:
         writer.write(run, folder)
     return run
+
+
+def remove_stale_files(folder: Path, keep: set[str]) -> list[str]:
+    """Delete the files an earlier run's ``report.json`` in ``folder`` lists and this run will
+    not write (a rerun with fewer writers or plots replaces the old report completely).
+
+    Only names the old report lists, inside ``folder``, are touched; an unreadable old report
+    removes nothing. Returns the names removed.
+    """
+    try:
+        old = json.loads((folder / "report.json").read_text(encoding="utf-8"))
+        listed = [*old.get("files", []), *old.get("plots", [])]
+    except (OSError, ValueError, AttributeError, TypeError):
+        return []
+    root = folder.resolve()
+    removed = []
+    for name in listed:
+        if not isinstance(name, str) or name in keep:
+            continue
+        path = (folder / name).resolve()
+        if path.is_relative_to(root) and path != root and path.is_file():
+            path.unlink()
+            removed.append(name)
+    return removed
 
 
 def run_benchmark(
