@@ -80,7 +80,10 @@ def report_command(run_dir) -> None:
     """Write RUN_DIR/report.html (a benchmark folder) or RUN_DIR/compare.html (a compare folder)
     from the files the run left, without recomputing.
 
-    Example: tsrkit report tsrkit-out
+    \b
+    Examples:
+      tsrkit report tsrkit-out/conspicuity     # one benchmark run: report.html
+      tsrkit report tsrkit-out                 # a compare folder: compare.html
     """
     from tsrkit_plugins.writers.html import page
 
