@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tsrkit.geo.errors import GeoError
+from tsrkit.geo.errors import GeoError, read_text
 from tsrkit.geo.gpx import gpx_rows
 from tsrkit.geo.nmea import nmea_rows
 
@@ -70,15 +70,6 @@ Rows = list[tuple[int | str, float, float, float]]
 
 #: Log formats by file extension; other extensions are told apart by their first character.
 _BY_SUFFIX = {".csv": "csv", ".gpx": "gpx", ".nmea": "nmea", ".nma": "nmea", ".nme": "nmea"}
-
-
-def _read_text(path: Path) -> str:
-    try:
-        return path.read_text(encoding="utf-8-sig")
-    except FileNotFoundError:
-        raise GeoError(path, "no such file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise GeoError(path, f"cannot read as UTF-8 text ({exc})") from None
 
 
 def _csv_rows(path: Path, lines: list[str]) -> Rows:
@@ -147,7 +138,7 @@ def log_format(path: Path, text: str) -> str:
 
 
 def _rows(path: Path) -> tuple[Rows, str]:
-    text = _read_text(path)
+    text = read_text(path)
     kind = log_format(path, text)
     if kind == "gpx":
         return gpx_rows(path, text), kind
