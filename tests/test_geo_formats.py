@@ -234,3 +234,10 @@ def test_malformed_osm_nodes_and_entities_are_clear_errors(tmp_path):
     gz.write_bytes(MAP.read_bytes()[:20] + b"\x00" * 200)
     with pytest.raises(GeoError, match=r"bad\.osm\.gz: cannot read"):
         read_signals(gz)
+
+
+def test_a_csv_log_without_the_csv_extension_is_told_by_its_header(tmp_path):
+    path = tmp_path / "drive.txt"
+    path.write_text("time,lat,lon\n2009-01-17T20:27:37Z,47.6,-122.1\n")
+    track = read_track(path)
+    assert list(track.time) == [datetime(2009, 1, 17, 20, 27, 37, tzinfo=UTC).timestamp()]

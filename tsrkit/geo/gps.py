@@ -125,16 +125,21 @@ def _whitespace_rows(path: Path, lines: list[str]) -> Rows:
 
 
 def log_format(path: Path, text: str) -> str:
-    """``csv``, ``gpx``, ``nmea`` or ``whitespace``: by extension, else by the first character
-    (``<`` GPX, ``$`` or ``!`` NMEA, anything else the whitespace lines).
+    """``csv``, ``gpx``, ``nmea`` or ``whitespace``: by extension, else by the content (``<``
+    first: GPX; ``$`` or ``!``: NMEA; a first line with a comma and ``lat``: CSV; anything else
+    the whitespace lines).
 
     >>> log_format(Path("drive.log"), "$GPRMC,...")
     'nmea'
+    >>> log_format(Path("drive.txt"), "time,lat,lon\\n0,47.6,-122.1")
+    'csv'
     """
     if path.suffix.lower() in _BY_SUFFIX:
         return _BY_SUFFIX[path.suffix.lower()]
-    head = text.lstrip()[:1]
-    return "gpx" if head == "<" else "nmea" if head in ("$", "!") else "whitespace"
+    first = text.lstrip().split("\n", 1)[0].lower()
+    if first[:1] in ("<", "$", "!"):
+        return "gpx" if first[0] == "<" else "nmea"
+    return "csv" if "," in first and "lat" in first else "whitespace"
 
 
 def _rows(path: Path) -> tuple[Rows, str]:
