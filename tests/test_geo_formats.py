@@ -5,19 +5,19 @@ naming the file and the line, track point or feature."""
 import json
 import sys
 from datetime import UTC, datetime
-from pathlib import Path
 
 import numpy as np
 import pynmea2
 import pytest
 from click.testing import CliRunner
+from conftest import shared_datasets_dir
 
 from tsrkit.cli.main import cli
 from tsrkit.geo import GeoError, read_signals, read_track
 from tsrkit.geo.export import to_gpx, to_nmea
 from tsrkit.geo.osm import _nodes
 
-SET = Path(__file__).resolve().parents[1].parent / "shared/datasets/nk_seattle_gps_bellevue_osm"
+SET = shared_datasets_dir() / "nk_seattle_gps_bellevue_osm"
 DRIVE, MAP = SET / "gps_data.txt", SET / "map-issue147.osm.gz"
 
 
