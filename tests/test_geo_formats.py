@@ -5,19 +5,19 @@ naming the file and the line, track point or feature."""
 import json
 import sys
 from datetime import UTC, datetime
-from pathlib import Path
 
 import numpy as np
 import pynmea2
 import pytest
 from click.testing import CliRunner
+from conftest import shared_datasets_dir
 
 from tsrkit.cli.main import cli
 from tsrkit.geo import GeoError, read_signals, read_track
 from tsrkit.geo.export import to_gpx, to_nmea
 from tsrkit.geo.osm import _nodes
 
-SET = Path(__file__).resolve().parents[1].parent / "shared/datasets/nk_seattle_gps_bellevue_osm"
+SET = shared_datasets_dir() / "nk_seattle_gps_bellevue_osm"
 DRIVE, MAP = SET / "gps_data.txt", SET / "map-issue147.osm.gz"
 
 
@@ -234,3 +234,10 @@ def test_malformed_osm_nodes_and_entities_are_clear_errors(tmp_path):
     gz.write_bytes(MAP.read_bytes()[:20] + b"\x00" * 200)
     with pytest.raises(GeoError, match=r"bad\.osm\.gz: cannot read"):
         read_signals(gz)
+
+
+def test_a_csv_log_without_the_csv_extension_is_told_by_its_header(tmp_path):
+    path = tmp_path / "drive.txt"
+    path.write_text("time,lat,lon\n2009-01-17T20:27:37Z,47.6,-122.1\n")
+    track = read_track(path)
+    assert list(track.time) == [datetime(2009, 1, 17, 20, 27, 37, tzinfo=UTC).timestamp()]

@@ -2,9 +2,8 @@
 intersection on a long synthetic drive and on the real Seattle drive at video frame times, with
 far fewer searches; and the one case Condition 3-1 does not cover."""
 
-from pathlib import Path
-
 import numpy as np
+from conftest import shared_datasets_dir
 from scipy.spatial import cKDTree
 
 from tsrkit.geo import Track, read_signals, read_track, traversals
@@ -12,7 +11,7 @@ from tsrkit.geo.nearest import TAU_MIN, nearest_extended, nearest_kdtree
 from tsrkit.geo.simulate import grid_city, grid_drive
 from tsrkit.geo.vicinity import vicinity_profile
 
-SET = Path(__file__).resolve().parents[1].parent / "shared/datasets/nk_seattle_gps_bellevue_osm"
+SET = shared_datasets_dir() / "nk_seattle_gps_bellevue_osm"
 
 
 class CountingTree(cKDTree):

@@ -1,8 +1,10 @@
-"""The one error of GPS logs and maps: file, place in the file and problem."""
+"""The one error of GPS logs and maps (file, place in the file, problem), and reading them as
+text."""
 
 from __future__ import annotations
 
 import os
+from pathlib import Path
 
 from tsrkit.errors import TsrkitError
 
@@ -26,3 +28,13 @@ class GeoError(TsrkitError):
     ) -> None:
         where = f"line {line}: " if isinstance(line, int) else f"{line}: " if line else ""
         super().__init__(f"{path}: {where}{problem}")
+
+
+def read_text(path: Path) -> str:
+    """The UTF-8 text of ``path`` (a byte order mark dropped), or a :class:`GeoError`."""
+    try:
+        return path.read_text(encoding="utf-8-sig")
+    except FileNotFoundError:
+        raise GeoError(path, "no such file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise GeoError(path, f"cannot read as UTF-8 text ({exc})") from None

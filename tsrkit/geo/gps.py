@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tsrkit.geo.errors import GeoError
+from tsrkit.geo.errors import GeoError, read_text
 from tsrkit.geo.gpx import gpx_rows
 from tsrkit.geo.nmea import nmea_rows
 
@@ -72,15 +72,6 @@ Rows = list[tuple[int | str, float, float, float]]
 _BY_SUFFIX = {".csv": "csv", ".gpx": "gpx", ".nmea": "nmea", ".nma": "nmea", ".nme": "nmea"}
 
 
-def _read_text(path: Path) -> str:
-    try:
-        return path.read_text(encoding="utf-8-sig")
-    except FileNotFoundError:
-        raise GeoError(path, "no such file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise GeoError(path, f"cannot read as UTF-8 text ({exc})") from None
-
-
 def _csv_rows(path: Path, lines: list[str]) -> Rows:
     reader = csv.reader(lines)
     try:
@@ -134,20 +125,25 @@ def _whitespace_rows(path: Path, lines: list[str]) -> Rows:
 
 
 def log_format(path: Path, text: str) -> str:
-    """``csv``, ``gpx``, ``nmea`` or ``whitespace``: by extension, else by the first character
-    (``<`` GPX, ``$`` or ``!`` NMEA, anything else the whitespace lines).
+    """``csv``, ``gpx``, ``nmea`` or ``whitespace``: by extension, else by the content (``<``
+    first: GPX; ``$`` or ``!``: NMEA; a first line with a comma and ``lat``: CSV; anything else
+    the whitespace lines).
 
     >>> log_format(Path("drive.log"), "$GPRMC,...")
     'nmea'
+    >>> log_format(Path("drive.txt"), "time,lat,lon\\n0,47.6,-122.1")
+    'csv'
     """
     if path.suffix.lower() in _BY_SUFFIX:
         return _BY_SUFFIX[path.suffix.lower()]
-    head = text.lstrip()[:1]
-    return "gpx" if head == "<" else "nmea" if head in ("$", "!") else "whitespace"
+    first = text.lstrip().split("\n", 1)[0].lower()
+    if first[:1] in ("<", "$", "!"):
+        return "gpx" if first[0] == "<" else "nmea"
+    return "csv" if "," in first and "lat" in first else "whitespace"
 
 
 def _rows(path: Path) -> tuple[Rows, str]:
-    text = _read_text(path)
+    text = read_text(path)
     kind = log_format(path, text)
     if kind == "gpx":
         return gpx_rows(path, text), kind

@@ -21,7 +21,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
-from tsrkit.geo.errors import GeoError
+from tsrkit.geo.errors import GeoError, read_text
 from tsrkit.geo.geojson import geojson_nodes
 from tsrkit.geo.osm_pbf import SIGNAL_TAGS, pbf_nodes
 from tsrkit.geo.projection import LocalProjection
@@ -99,13 +99,7 @@ def _nodes(path: Path) -> list[tuple[int, float, float, dict[str, str]]]:
     if kind == "pbf":
         found = pbf_nodes(path)
     elif kind == "geojson":
-        try:
-            text = path.read_text(encoding="utf-8-sig")
-        except FileNotFoundError:
-            raise GeoError(path, "no such file") from None
-        except (OSError, UnicodeDecodeError) as exc:
-            raise GeoError(path, f"cannot read as UTF-8 text ({exc})") from None
-        found = geojson_nodes(path, text)
+        found = geojson_nodes(path, read_text(path))
     else:
         found = _xml_nodes(path)
     for _, lat, lon, _, label in found:
