@@ -11,8 +11,10 @@ parameters, and merges their candidates:
 2. **Duplicate suppression.** Candidates are taken best-first; one whose centre lies within
    ``merge`` x the larger of the two lens radii (at least ``min_distance`` px) of a kept
    candidate is the same light. The kept candidate keeps its own lens and gains the duplicate's
-   rank score (once per member): a light several detectors agree on ranks above one found by a
-   single detector. Scores are therefore in ``[0, number of members]``.
+   rank score (once per member); its score is the mean over all members of these rank scores
+   (0 for a member that did not find it): a light several detectors agree on ranks above one
+   found by a single detector, and scores lie in [0, 1] (the ``verifier``'s ``prior`` can
+   blend them with its probability).
 
 Members are written ``NAME [KEY=VALUE ...]; NAME ...``, e.g.
 ``lab-frst top=15; conspicuity n_top=15``; values are checked by each member's own schema.
@@ -78,7 +80,8 @@ def merge(lists: list[list[Candidate]], factor: float, min_distance: float) -> l
                 break
         else:
             kept.append((c, {member: score}))
-    merged = [replace(c, score=float(sum(votes.values()))) for c, votes in kept]
+    share = 1.0 / max(len(lists), 1)
+    merged = [replace(c, score=float(sum(votes.values())) * share) for c, votes in kept]
     return sorted(merged, key=lambda c: -c.score)
 
 
@@ -123,7 +126,7 @@ class Union(Detector):
         ]
 
     def detect(self, frame: Frame) -> list[Candidate]:
-        """Every member's candidates, merged; scores in ``[0, number of members]``."""
+        """Every member's candidates, merged; scores in [0, 1]."""
         lists = [member.detect(frame) for member in self.members]
         return merge(lists, self.params["merge"], self.params["min_distance"])
 
