@@ -45,7 +45,8 @@ def test_merge_suppresses_duplicates_and_sums_the_agreeing_members_rank_scores()
         (200, 200, 0.5),
         (300, 50, 0.25),
     ]
-    assert merged[0].radius == 4  # the kept candidate keeps its own lens
+    # the kept candidate keeps its centre and takes the duplicates' largest lens radius
+    assert merged[0].radius == 5 and merged[0].bbox == (95.0, 95.0, 105.0, 105.0)
 
 
 def test_min_distance_merges_radius_less_centres():
