@@ -13,10 +13,10 @@ parameters, and merges their candidates:
    candidate is the same light. The kept candidate keeps its own centre, takes the largest lens
    radius of its duplicates (a detector without a radius estimate, such as lab-frst, gives a
    far too small one: on the KR test lenses this raises the share of lens boxes at IoU >= 0.5
-   from 0.09 to 0.39) and gains the duplicate's rank score (once per member); its score is the mean over all members of these rank scores
-   (0 for a member that did not find it): a light several detectors agree on ranks above one
-   found by a single detector, and scores lie in [0, 1] (the ``verifier``'s ``prior`` can
-   blend them with its probability).
+   from 0.09 to 0.39) and gains the duplicate's rank score (once per member). Its score is the
+   mean over all members of these rank scores (0 for a member that did not find it): a light
+   several detectors agree on ranks above one found by a single detector, and scores lie in
+   [0, 1] (the ``verifier``'s ``prior`` can blend them with its probability).
 
 Members are written ``NAME [KEY=VALUE ...]; NAME ...``, e.g.
 ``lab-frst top=15; conspicuity n_top=15``; values are checked by each member's own schema.
