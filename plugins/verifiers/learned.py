@@ -104,6 +104,15 @@ class LearnedVerifier(Verifier):
             max=10000,
             help="training: synthetic 1280x720 scenes without a lit light, mined for negatives",
         ),
+        Param(
+            "head_frames",
+            "int",
+            40,
+            min=0,
+            max=10000,
+            help="training: synthetic 1280x720 scenes with 5 rendered lit heads each (jittered "
+            "scale, colour, blur and exposure), whose candidates on a head are positives",
+        ),
         Param("seed", "int", 0, min=0, help="training: seed of the negative draw and the trees"),
     )
 
@@ -170,7 +179,8 @@ class LearnedVerifier(Verifier):
         """Learn to verify ``detector``'s candidates on ``samples`` (deterministic).
 
         Every candidate is labelled by Zheng's centre rule; candidates of
-        ``synthetic_frames`` no-light scenes are negatives. The first round draws
+        ``synthetic_frames`` no-light scenes are negatives, and those of ``head_frames`` scenes
+        with rendered lit heads are labelled by the heads' housings. The first round draws
         ``negative_ratio`` negatives per positive (seeded); each mining round adds as many of
         the remaining negatives the current model scores highest, and refits.
 
@@ -188,6 +198,7 @@ class LearnedVerifier(Verifier):
             candidate_features,
             len(feature_names()),
             self.params["synthetic_frames"],
+            self.params["head_frames"],
         )
         positives = np.flatnonzero(data.labels == 1)
         negatives = np.flatnonzero(data.labels == 0)
