@@ -2,6 +2,12 @@
 the real housing boxes given their lit lens, and housing AP50 / recall after the paper detectors.
 
     python benchmarks/bench_housing.py
+    python benchmarks/bench_housing.py --stages    # only: where the fit is lost, stage by stage
+
+``--stages`` fits each test housing from four starts and gives the share at IoU >= 0.5: the
+true lit lens (centre and radius from the box, :func:`find_lens`), the ``union`` detector's
+best-scored candidate whose centre lies in the box's circle (Zheng's rule), and the two mixed
+(true centre with the candidate's radius, the candidate's centre with the true radius).
 """
 
 from __future__ import annotations
@@ -11,6 +17,7 @@ import os
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ[_var] = "1"
 
+import argparse  # noqa: E402
 import json  # noqa: E402
 import subprocess  # noqa: E402
 import sys  # noqa: E402
@@ -22,6 +29,7 @@ import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
 from tsrkit.datasets import open_dataset  # noqa: E402
+from tsrkit.eval.matching import centre_hits  # noqa: E402
 from tsrkit.geometry import iou_matrix  # noqa: E402
 from tsrkit.registry import get_registry  # noqa: E402
 from tsrkit.synth.heads import background, render_head  # noqa: E402
@@ -68,6 +76,38 @@ def fit_quality(name: str) -> str:
     )
 
 
+def stage_starts(name: str) -> str:
+    """Share of ``name`` test housings fitted at IoU >= 0.5 from each start (module docstring)."""
+    union = get_registry().create("detector", "union")
+    starts = ("true lens", "true centre, cand. radius", "cand. centre, true radius", "candidate")
+    fitted: dict[str, list[float]] = {k: [] for k in starts}
+    offsets, total = [], 0
+    for sample in open_dataset(name).split("test"):
+        boxes = [a.bbox for a in sample.annotations]
+        if not boxes:
+            continue
+        total += len(boxes)
+        frame = sample.load()
+        gray = cv2.cvtColor(frame.image, cv2.COLOR_BGR2GRAY)
+        found = union.detect(frame)
+        hits = centre_hits([(c.x, c.y) for c in found], boxes) if found else None
+        for j, box in enumerate(boxes):
+            lens = find_lens(frame.image, box)
+            idx = np.flatnonzero(hits[:, j]) if hits is not None else []
+            lenses = {"true lens": (lens.x, lens.y, lens.radius)}
+            if len(idx):
+                c = max((found[i] for i in idx), key=lambda c: c.score)
+                lenses["true centre, cand. radius"] = (lens.x, lens.y, c.radius)
+                lenses["cand. centre, true radius"] = (c.x, c.y, lens.radius)
+                lenses["candidate"] = (c.x, c.y, c.radius)
+                offsets.append(np.hypot(c.x - lens.x, c.y - lens.y) / lens.radius)
+            for key, start in lenses.items():
+                fit, _, _ = fit_housings(gray, [start])
+                fitted[key].append(iou_matrix([box], fit)[0, 0])
+    cells = " | ".join(f"{np.sum(np.array(fitted[k]) >= 0.5) / total:.2f}" for k in starts)
+    return f"| {name} | {total} | {len(offsets) / total:.2f} | {cells} | {np.median(offsets):.2f} |"
+
+
 def detector_runs(name: str, detector: str, stage: list[str]) -> str:
     """Housing AP50 and recall at IoU 0.5 of ``detector`` with ``stage`` on ``name`` test."""
     with tempfile.TemporaryDirectory() as out:
@@ -85,6 +125,17 @@ def detector_runs(name: str, detector: str, stage: list[str]) -> str:
 
 
 def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--stages", action="store_true", help="only the stage-by-stage table")
+    if parser.parse_args().stages:
+        print(
+            "| set (test) | housings | union hit | true lens | true centre, cand. radius "
+            "| cand. centre, true radius | candidate | cand. offset (true radii, median) |"
+        )
+        print("|---|---:|---:|---:|---:|---:|---:|---:|")
+        for name in ("roboflow_cinta_v2_id", "dtld_fridtjofs"):
+            print(stage_starts(name), flush=True)
+        return
     print(f"housing stage, 1280x720, 50 candidates, one thread: {speed():.2f} ms (median of 30)")
     for name in ("roboflow_cinta_v2_id", "dtld_fridtjofs"):
         print(fit_quality(name))

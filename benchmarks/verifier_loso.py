@@ -11,8 +11,8 @@ candidate recall per light size.
 Run: python benchmarks/verifier_loso.py [--detector lab-frst]... [-p lab-frst.KEY=V]
          [-p verifier.KEY=V] [--housing housing] [--no-light 30] [--skip-paper]
          [--out benchmarks/out/verifier_loso]
-Several --detector options form a union of their candidates (a later candidate whose centre
-lies within the larger radius of a kept one is dropped), a stand-in until a union plugin exists.
+Several detectors: ``--detector union -p "union.members=lab-frst top=15; conspicuity n_top=15"``
+(the ``union`` plugin; its default members are the loosened four of RESULTS.verifier.md).
 """
 
 from __future__ import annotations
@@ -30,10 +30,12 @@ from pathlib import Path  # noqa: E402
 
 import cv2  # noqa: E402
 import numpy as np  # noqa: E402
+from candidate_recall import SIZE_BINS, bin_label, recall_by_size  # noqa: E402
 
 from tsrkit.benchmarking import run_benchmark  # noqa: E402
 from tsrkit.datasets import open_datasets  # noqa: E402
 from tsrkit.eval.perframe import score_frame  # noqa: E402
+from tsrkit.geometry import iou_matrix  # noqa: E402
 from tsrkit.params import parse_assignments  # noqa: E402
 from tsrkit.plugin import Detector, Verifier  # noqa: E402
 from tsrkit.registry import get_registry  # noqa: E402
@@ -65,7 +67,7 @@ SETS = (
     RealSet("cinTA", "roboflow_cinta_v2_id", "valid", "test", "housing", True),
     RealSet("DTLD", "dtld_fridtjofs", "train", "test", "housing", False),
 )
-SIZE_BINS = ((0, 3), (3, 6), (6, 12), (12, 1e9))
+LABELS = [bin_label(lo, hi) for lo, hi in SIZE_BINS]
 THRESHOLDS = (0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9)
 
 
@@ -83,25 +85,6 @@ class Memo(Detector):
         if key not in self._seen:
             self._seen[key] = self.inner.detect(frame)
         return self._seen[key]
-
-
-class Union(Detector):
-    """Every detector's candidates, in the order given; a candidate whose centre lies within
-    the larger radius of an already kept one is a duplicate and dropped."""
-
-    name = "union"
-
-    def __init__(self, members):
-        super().__init__(members=[(m.name, m.params) for m in members])
-        self.members = members
-
-    def detect(self, frame):
-        kept = []
-        for member in self.members:
-            for c in member.detect(frame):
-                if all(np.hypot(c.x - k.x, c.y - k.y) > max(c.radius, k.radius) for k in kept):
-                    kept.append(c)
-        return kept
 
 
 class Chain(Verifier):
@@ -129,16 +112,22 @@ def no_light_dataset(count: int) -> Dataset:
 
 
 def evaluate(dataset, detector, verifier, box, thresholds=(0.0,)):
-    """One run (verifier threshold 0); Zheng figures recomputed at every score threshold."""
+    """One run (verifier threshold 0); Zheng figures and the share of lights some kept box
+    overlaps at IoU >= 0.5 (``iou50_recall``, the set's ``box``) recomputed at every threshold."""
     run = run_benchmark(dataset, detector, verifier=verifier, cache=False, box=box)
     ap = run.report["iou50"]["ap"]
     pairs = list(run.pairs())
     rows = {}
     for t in thresholds:
-        scores = []
+        scores, box_hits = [], []
         for sample, record in pairs:
-            points = [(d.x, d.y) for d in record.detections if d.score >= t]
-            scores.append(score_frame(points, [a.bbox for a in sample.annotations]))
+            kept = [d for d in record.detections if d.score >= t]
+            truth = [a.bbox for a in sample.annotations]
+            scores.append(score_frame([(d.x, d.y) for d in kept], truth))
+            if truth:
+                boxes = [d.bbox if box == "housing" else d.lens_bbox for d in kept]
+                overlap = iou_matrix(truth, boxes) if boxes else np.zeros((len(truth), 1))
+                box_hits += list(overlap.max(axis=1) >= 0.5)
         gt = [s for s in scores if s.n_gt]
         with_det = [s for s in gt if s.n_det]
         fps = [s.n_det - s.det_tp for s in scores]
@@ -148,37 +137,15 @@ def evaluate(dataset, detector, verifier, box, thresholds=(0.0,)):
             "hit": float(np.mean([s.gt_hit > 0 for s in gt])) if gt else None,
             "fp_per_frame": float(np.mean(fps)) if fps else None,
             "det_per_frame": float(np.mean([s.n_det for s in scores])) if scores else None,
+            "iou50_recall": float(np.mean(box_hits)) if box_hits else None,
         }
     return ap, rows, pairs
 
 
-def candidate_recall(pairs) -> dict[str, float | None]:
+def candidate_recall(pairs) -> dict:
     """Share of annotated lights with a candidate centre in their circle, per lens radius."""
-    hit = {b: [0, 0] for b in SIZE_BINS}
-    total = [0, 0]
-    for sample, record in pairs:
-        boxes = [a.bbox for a in sample.annotations]
-        if not boxes:
-            continue
-        from tsrkit.eval.matching import centre_hits
-
-        points = [(d.x, d.y) for d in record.detections]
-        found = centre_hits(points, boxes).any(axis=0) if points else np.zeros(len(boxes), bool)
-        for box, ok in zip(boxes, found):
-            r = min(box[2] - box[0], box[3] - box[1]) / 2
-            for b in SIZE_BINS:
-                if b[0] <= r < b[1]:
-                    hit[b][0] += int(ok)
-                    hit[b][1] += 1
-            total[0] += int(ok)
-            total[1] += 1
-    out = {"all": total[0] / total[1] if total[1] else None, "n": total[1]}
-    for b, (k, n) in hit.items():
-        label = (
-            f"r<{b[1]:g}" if b[0] == 0 else (f"r>={b[0]:g}" if b[1] > 1e8 else f"{b[0]:g}-{b[1]:g}")
-        )
-        out[label] = (k / n if n else None, n)
-    return out
+    pairs = list(pairs)
+    return recall_by_size([p[0] for p in pairs], [p[1].detections for p in pairs])
 
 
 def _f(value, spec=".2f") -> str:
@@ -196,9 +163,9 @@ def markdown(results: dict, threshold: str = "0.5") -> str:
         f"{threshold}. FP/frame: detections outside every ground-truth circle (exhaustive sets "
         "only); no-light: synthetic 1280x720 scenes without a lit light.",
         "",
-        "| test set | pipeline | AP50 (box) | recall | hit | precision | FP/frame "
+        "| test set | pipeline | AP50 (box) | recall IoU.5 | recall | hit | precision | FP/frame "
         "| no-light FP/frame |",
-        "|---|---|---|---|---|---|---|---|",
+        "|---|---|---|---|---|---|---|---|---|",
     ]
     for key, fold in results["folds"].items():
         c = fold["candidates"]
@@ -213,7 +180,8 @@ def markdown(results: dict, threshold: str = "0.5") -> str:
             rows.append((f"best paper detector: {best}", paper[best], paper[best]["ap50"]))
         for label, r, ap in rows:
             lines.append(
-                f"| {key} | {label} | {_f(ap)} ({boxes[key]}) | {_f(r['recall'])} | {_f(r['hit'])}"
+                f"| {key} | {label} | {_f(ap)} ({boxes[key]}) | {_f(r.get('iou50_recall'))}"
+                f" | {_f(r['recall'])} | {_f(r['hit'])}"
                 f" | {_f(r['precision'] if exhaustive[key] else None)}"
                 f" | {_f(r['fp_per_frame'] if exhaustive[key] else None)} | {_f(r['nolight_fp'])} |"
             )
@@ -222,19 +190,19 @@ def markdown(results: dict, threshold: str = "0.5") -> str:
         "Candidate recall (share of annotated lights with a candidate centre in their circle) "
         "by lens radius r = half the box's shorter side, px (count):",
         "",
-        "| test set | all | r<3 | 3-6 | 6-12 | r>=12 |",
-        "|---|---|---|---|---|---|",
+        "| test set | all | " + " | ".join(LABELS) + " |",
+        "|---|---|" + "---|" * len(LABELS),
     ]
     for key, fold in results["folds"].items():
         cr = fold["candidates"]["candidate_recall"]
-        cells = [f"{_f(cr[b][0])} ({cr[b][1]})" for b in ("r<3", "3-6", "6-12", "r>=12")]
-        lines.append(f"| {key} | {_f(cr['all'])} ({cr['n']}) | " + " | ".join(cells) + " |")
+        cells = [f"{_f(cr[b][0])} ({cr[b][1]})" for b in LABELS]
+        lines.append(f"| {key} | {_f(cr['all'][0])} ({cr['all'][1]}) | " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--detector", action="append", default=[], help="repeatable: a union")
+    parser.add_argument("--detector", action="append", default=[], help="candidate detector")
     parser.add_argument(
         "-p", "--param", action="append", default=[], help="DETECTOR.KEY=V / verifier.KEY=V"
     )
@@ -242,6 +210,12 @@ def main() -> None:
     parser.add_argument("--no-light", type=int, default=30, help="synthetic no-light test frames")
     parser.add_argument("--out", default="benchmarks/out/verifier_loso")
     parser.add_argument("--skip-paper", action="store_true", help="no paper-detector baselines")
+    parser.add_argument(
+        "--paper-from",
+        metavar="RESULTS_JSON",
+        help="take the paper-detector baselines from an earlier run's results.json (they do "
+        "not depend on the candidates or the verifier)",
+    )
     parser.add_argument(
         "--tables", metavar="RESULTS_JSON", help="only print the Markdown tables of a results.json"
     )
@@ -265,14 +239,18 @@ def main() -> None:
         )
         for name in names
     ]
-    detector = Memo(members[0] if len(members) == 1 else Union(members))
+    if len(members) != 1:
+        parser.error("one --detector (several: the union detector)")
+    detector = Memo(members[0])
     housing = [reg.create("verifier", args.housing)] if args.housing else []
     tests = {s.key: open_datasets([f"{s.name}:{s.test}"]) for s in SETS}
     nolight = no_light_dataset(args.no_light)
     started = time.perf_counter()
     results: dict = {"detector": names, "params": args.param, "housing": args.housing}
 
-    if not args.skip_paper:
+    if args.paper_from:
+        results["paper"] = json.loads(Path(args.paper_from).read_text())["paper"]
+    elif not args.skip_paper:
         paper: dict = {}
         for s in SETS:
             for name in PAPER:
@@ -298,7 +276,12 @@ def main() -> None:
             verifier = reg.create(
                 "verifier",
                 "verifier",
-                {"model": str(model), "threshold": 0.0, "after": ver_params["after"]},
+                {
+                    "model": str(model),
+                    "threshold": 0.0,
+                    "after": ver_params["after"],
+                    "prior": ver_params.get("prior", 0.0),
+                },
             )
             chain = Chain([verifier])  # the verifier runs its `after` stage (housing) itself
             ap, rows, pairs = evaluate(tests[s.key], detector, chain, s.box, THRESHOLDS)

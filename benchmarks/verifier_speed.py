@@ -2,8 +2,9 @@
 
 Candidates are 50 circles of radius 2-20 px at random places of synthetic 1280x720 road scenes
 (half of them given a 1:3 housing box, as a housing stage would); the verifier (features +
-shipped model) runs on each frame, and the median over frames and repeats is reported, with the
-features alone beside it.
+shipped model, after its housing stage) runs on each frame, then the recommended preset's state
+classifier (``--classifier``, ab-hist) on all 50 candidates (the worst case: none rejected);
+medians over frames and repeats are reported, with the features alone beside them.
 
 Run: python benchmarks/verifier_speed.py [--frames 20] [--repeats 5] [--candidates 50]
 """
@@ -49,6 +50,7 @@ def main() -> None:
     parser.add_argument("--frames", type=int, default=20)
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--candidates", type=int, default=50)
+    parser.add_argument("--classifier", default="ab-hist", help="state classifier timed after")
     args = parser.parse_args()
     verifier = get_registry().create("verifier", "verifier", {"threshold": 0.5})
     rng = np.random.default_rng(0)
@@ -57,8 +59,10 @@ def main() -> None:
         for i in range(args.frames)
     ]
     sets = [candidates(rng, args.candidates) for _ in frames]
-    verifier.verify(frames[0], sets[0])  # load the model once
-    whole, feats = [], []
+    classifier = get_registry().create("classifier", args.classifier)
+    verifier.verify(frames[0], sets[0])  # load the models once
+    classifier.classify(frames[0], sets[0])
+    whole, feats, states = [], [], []
     for _ in range(args.repeats):
         for frame, cands in zip(frames, sets):
             t0 = time.perf_counter()
@@ -66,12 +70,21 @@ def main() -> None:
             t1 = time.perf_counter()
             candidate_features(frame.image, cands)
             t2 = time.perf_counter()
+            classifier.classify(frame, cands)
+            t3 = time.perf_counter()
             whole.append((t1 - t0) * 1000)
             feats.append((t2 - t1) * 1000)
+            states.append((t3 - t2) * 1000)
     print(
         f"verifier on 1280x720, {args.candidates} candidates, one thread: "
         f"median {statistics.median(whole):.2f} ms/frame (features alone "
         f"{statistics.median(feats):.2f} ms); {len(whole)} timings"
+    )
+    total = [w + s for w, s in zip(whole, states)]
+    print(
+        f"+ {args.classifier} on all {args.candidates} candidates: median "
+        f"{statistics.median(states):.2f} ms; housing + verifier + state: median "
+        f"{statistics.median(total):.2f} ms/frame"
     )
 
 

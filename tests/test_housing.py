@@ -67,3 +67,16 @@ def test_records_report_the_housing_as_bbox(tmp_path):
     assert found, "the housing stage set no housing"
     x0, y0, x1, y1 = found[0]["bbox"]
     assert (x1 - x0) < (y1 - y0)  # a vertical head
+
+
+def test_scattered_heads_are_deterministic_and_boxed_in_the_frame():
+    from tsrkit.synth.heads import scatter_heads
+
+    images = [background(360, 640, seed=1) for _ in range(2)]
+    boxes = [scatter_heads(im, np.random.default_rng(9)) for im in images]
+    assert boxes[0] == boxes[1] and np.array_equal(images[0], images[1])
+    assert len(boxes[0]) == 5
+    for x0, y0, x1, y1 in boxes[0]:
+        # 3-4 lenses of radius 2-12 px, 2.8 radii per cell, centred in the upper 55 %
+        assert 5.6 <= min(x1 - x0, y1 - y0) <= 33.6 + 1e-9
+        assert 0 <= (y0 + y1) / 2 <= 360 and 0 <= (x0 + x1) / 2 <= 640

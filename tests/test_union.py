@@ -38,13 +38,15 @@ def test_merge_suppresses_duplicates_and_sums_the_agreeing_members_rank_scores()
     a = [Candidate.from_circle(100, 100, 4, 5000.0), Candidate.from_circle(300, 50, 4, 10.0)]
     b = [Candidate.from_circle(102, 101, 5, 0.2), Candidate.from_circle(200, 200, 3, 0.9)]
     merged = merge([a, b], factor=1.0, min_distance=3.0)
-    # (100, 100): A's best (1.0) + B's second (0.5), B's duplicate at 2.2 px < 5 px dropped
+    # (100, 100): A's best (1.0) + B's second (0.5), B's duplicate at 2.2 px < 5 px dropped;
+    # scores are the mean over the two members
     assert [(c.x, c.y, c.score) for c in merged] == [
-        (100, 100, 1.5),
-        (200, 200, 1.0),
-        (300, 50, 0.5),
+        (100, 100, 0.75),
+        (200, 200, 0.5),
+        (300, 50, 0.25),
     ]
-    assert merged[0].radius == 4  # the kept candidate keeps its own lens
+    # the kept candidate keeps its centre and takes the duplicates' largest lens radius
+    assert merged[0].radius == 5 and merged[0].bbox == (95.0, 95.0, 105.0, 105.0)
 
 
 def test_min_distance_merges_radius_less_centres():
@@ -65,7 +67,7 @@ def test_union_finds_what_each_member_finds_on_a_rendered_head():
     found = union.detect(frame)
     members = [d.detect(frame) for d in union.members]
     assert len(found) <= sum(len(m) for m in members)
-    assert max(c.score for c in found) <= 2.0
+    assert max(c.score for c in found) <= 1.0
     x, y = head.lens[:2]
     for member in members:  # what a member finds near the lit lens, the union finds too
         if any(np.hypot(c.x - x, c.y - y) < 6 for c in member):

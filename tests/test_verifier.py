@@ -107,7 +107,7 @@ def make(**params):
     return get_registry().create("verifier", "verifier", params)
 
 
-FAST = dict(iterations=20, synthetic_frames=1, negative_ratio=2.0)
+FAST = dict(iterations=20, synthetic_frames=1, head_frames=1, negative_ratio=2.0)
 
 
 @pytest.fixture(scope="module")
@@ -148,6 +148,25 @@ def test_model_round_trip_scores_like_the_fitted_estimator(trained):
     assert make(model=str(trained[0]), threshold=1.0).verify(frame, candidates) == [
         c for c in kept if c.score >= 1.0
     ]
+
+
+def test_prior_blends_the_detectors_score_with_the_probability(trained):
+    frame = tiny_dataset(1).samples[0].load()
+    candidates = get_registry().create("detector", "gray-tophat").detect(frame)[:4]
+    own = [0.0, 0.5, 1.0, 7.0][: len(candidates)]  # detector scores, clipped to [0, 1]
+    candidates = [dataclasses.replace(c, score=s) for c, s in zip(candidates, own)]
+    # the verifier fits housings first (after=housing): read the probability after that stage
+    candidates = get_registry().create("verifier", "housing").verify(frame, candidates)
+    plain = make(model=str(trained[0]), threshold=0.0)
+    probability = plain.probabilities(frame, candidates)
+    blended = make(model=str(trained[0]), threshold=0.0, prior=0.7).verify(frame, candidates)
+    expected = {
+        (c.x, c.y): 0.3 * p + 0.7 * min(c.score, 1.0) for c, p in zip(candidates, probability)
+    }
+    assert blended  # the housing stage may merge duplicates; the survivors are blended
+    assert [c.score for c in blended] == pytest.approx([expected[c.x, c.y] for c in blended])
+    alone = make(model=str(trained[0]), prior=1.0).verify(frame, candidates)  # threshold 0.5
+    assert alone and {c.score for c in alone} <= {0.5, 1.0}
 
 
 def test_corrupt_foreign_or_mismatched_models_are_one_clear_error(trained, tmp_path):
@@ -228,7 +247,7 @@ def test_fit_needs_a_detector_and_both_classes():
     )
     detector = get_registry().create("detector", "gray-tophat")
     with pytest.raises(TsrkitError, match="positive"):
-        make(synthetic_frames=0).fit(empty, detector=detector)
+        make(synthetic_frames=0, head_frames=0).fit(empty, detector=detector)
 
 
 def test_a_annotation_is_used_by_its_box():

@@ -4,8 +4,10 @@ Beyond the three documents (issue 11): a gradient-boosted classifier (scikit-lea
 ``HistGradientBoostingClassifier``) reads features of each candidate and its housing
 (:mod:`features`: HOG, Lab/HSV statistics of lens, annulus, surround and housing, surround
 darkness, geometry, frame position, the detector's score) and gives the probability that the
-candidate is a lit traffic light. Candidates below ``threshold`` are dropped; the rest take the
-probability as their score. Trained by ``tsrkit train verifier --detector X`` on that detector's
+candidate is a lit traffic light. The candidate's score is that probability, blended with the
+detector's own score by ``prior`` (issue 11: the ``union`` detector's agreement score holds on
+cameras the model never saw, where the probability drops); candidates scoring below
+``threshold`` are dropped. Trained by ``tsrkit train verifier --detector X`` on that detector's
 candidates labelled by Zheng's centre rule (5.2.1), with hard-negative mining (:mod:`mining`).
 """
 
@@ -55,6 +57,17 @@ class LearnedVerifier(Verifier):
             help="candidates whose probability is below this are rejected",
         ),
         Param(
+            "prior",
+            "float",
+            0.0,
+            min=0.0,
+            max=1.0,
+            help="weight of the detector's own score in the candidate's score: "
+            "(1 - prior) x probability + prior x detector score clipped to [0, 1]; for "
+            "detectors scoring in [0, 1] such as union (its members' agreement), which holds "
+            "across cameras where the learned probability may not; 0: the probability alone",
+        ),
+        Param(
             "after",
             "str",
             "housing",
@@ -90,6 +103,15 @@ class LearnedVerifier(Verifier):
             min=0,
             max=10000,
             help="training: synthetic 1280x720 scenes without a lit light, mined for negatives",
+        ),
+        Param(
+            "head_frames",
+            "int",
+            40,
+            min=0,
+            max=10000,
+            help="training: synthetic 1280x720 scenes with 5 rendered lit heads each (jittered "
+            "scale, colour, blur and exposure), whose candidates on a head are positives",
         ),
         Param("seed", "int", 0, min=0, help="training: seed of the negative draw and the trees"),
     )
@@ -136,10 +158,12 @@ class LearnedVerifier(Verifier):
 
     def verify(self, frame: Frame, candidates: Sequence[Candidate]) -> list[Candidate]:
         candidates = self._stage()(frame, list(candidates))
-        probability = self.probabilities(frame, candidates)
+        prior = self.params["prior"]
+        own = np.clip([c.score for c in candidates], 0.0, 1.0)
+        score = (1.0 - prior) * self.probabilities(frame, candidates) + prior * own
         kept = [
             replace(c, score=float(p))
-            for c, p in zip(candidates, probability)
+            for c, p in zip(candidates, score)
             if p >= self.params["threshold"]
         ]
         return sorted(kept, key=lambda c: -c.score)
@@ -155,7 +179,8 @@ class LearnedVerifier(Verifier):
         """Learn to verify ``detector``'s candidates on ``samples`` (deterministic).
 
         Every candidate is labelled by Zheng's centre rule; candidates of
-        ``synthetic_frames`` no-light scenes are negatives. The first round draws
+        ``synthetic_frames`` no-light scenes are negatives, and those of ``head_frames`` scenes
+        with rendered lit heads are labelled by the heads' housings. The first round draws
         ``negative_ratio`` negatives per positive (seeded); each mining round adds as many of
         the remaining negatives the current model scores highest, and refits.
 
@@ -173,6 +198,7 @@ class LearnedVerifier(Verifier):
             candidate_features,
             len(feature_names()),
             self.params["synthetic_frames"],
+            self.params["head_frames"],
         )
         positives = np.flatnonzero(data.labels == 1)
         negatives = np.flatnonzero(data.labels == 0)

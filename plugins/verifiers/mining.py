@@ -18,6 +18,7 @@ import numpy as np
 from tsrkit.eval.matching import centre_hits
 from tsrkit.plugin import Detector
 from tsrkit.synth import SynthOptions, render_frame
+from tsrkit.synth.heads import scatter_heads
 from tsrkit.types import Candidate, Frame, Sample
 
 #: Candidates of one frame -> the candidates the verifier will see (e.g. after a housing stage).
@@ -25,6 +26,8 @@ Stage = Callable[[Frame, list[Candidate]], list[Candidate]]
 #: Frame size of the synthetic no-light frames (a dash-cam's).
 SYNTH_SIZE = (1280, 720)
 SYNTH_SEED = 1011
+#: Seed of the synthetic scenes with rendered lit heads (positives).
+HEADS_SEED = 77
 
 
 @dataclass
@@ -83,6 +86,17 @@ def no_light_frames(count: int, seed: int = SYNTH_SEED) -> Iterator[Frame]:
         yield Frame(image, f"synth-no-light:{seed}:{index - 1}", metadata={"lighting": condition})
 
 
+def head_frames(count: int, seed: int = HEADS_SEED) -> Iterator[tuple[Frame, list]]:
+    """``count`` synthetic 1280x720 no-light scenes, each with 5 rendered lit heads of jittered
+    scale, colour, blur and exposure (:func:`tsrkit.synth.heads.scatter_heads`), and their
+    housing boxes: positives of cameras no real training set shows."""
+    rng = np.random.default_rng(seed)
+    for frame in no_light_frames(count, seed):
+        image = frame.image.copy()
+        boxes = scatter_heads(image, rng)
+        yield Frame(image, f"synth-heads:{seed}:{frame.source}"), boxes
+
+
 def labelled_candidates(
     samples: Iterable[Sample],
     detector: Detector,
@@ -90,15 +104,17 @@ def labelled_candidates(
     features: Callable[[np.ndarray, Sequence[Candidate]], np.ndarray],
     width: int,
     no_light: int,
+    heads: int = 0,
 ) -> Labelled:
-    """Run ``detector`` (then ``stage``) on every sample and on ``no_light`` synthetic frames;
-    return every candidate's features, its Zheng label and its frame index."""
+    """Run ``detector`` (then ``stage``) on every sample, on ``no_light`` synthetic frames and on
+    ``heads`` synthetic frames with rendered lit heads (:func:`head_frames`); return every
+    candidate's features, its Zheng label and its frame index."""
     parts = []
     frames: Iterator[tuple[Frame, list[tuple[float, ...]]]] = (
         (s.load(), [a.bbox for a in s.annotations]) for s in samples
     )
     synthetic = ((f, []) for f in no_light_frames(no_light))
-    for index, (frame, boxes) in enumerate(chain(frames, synthetic)):
+    for index, (frame, boxes) in enumerate(chain(frames, synthetic, head_frames(heads))):
         candidates = stage(frame, detector.detect(frame))
         if not candidates:
             continue

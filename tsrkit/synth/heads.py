@@ -88,3 +88,33 @@ def background(height: int, width: int, seed: int = 0) -> np.ndarray:
     image = (sky * (1 - rows) + road * rows) * np.ones((1, width, 1))
     image += rng.normal(0, 6, image.shape)
     return np.clip(image, 0, 255).astype(np.uint8)
+
+
+def scatter_heads(
+    image: np.ndarray, rng: np.random.Generator, count: int = 5
+) -> list[tuple[float, float, float, float]]:
+    """Draw ``count`` jittered heads on ``image`` (in place, then blurred and gamma-jittered as a
+    whole) and return their housing boxes: the verifier's rendered positives (issue 11).
+
+    Each head: lens radius 2-12 px, 3 or 4 lenses, vertical 4 times in 5, any lamp lit, its
+    colour a :data:`LAMP_COLOURS` entry scaled 0.7-1.2 per channel, a white over-exposed core
+    2 times in 5, anywhere in the upper 55 % of the frame; then a Gaussian blur of sigma 0.7
+    (optics) and a gamma of 0.7-1.4 (exposure).
+    """
+    height, width = image.shape[:2]
+    boxes = []
+    for _ in range(count):
+        radius = float(rng.uniform(2, 12))
+        lenses = int(rng.integers(3, 5))
+        lit = int(rng.integers(0, lenses))
+        vertical = bool(rng.random() < 0.8)
+        base = np.array(list(LAMP_COLOURS.values())[int(rng.integers(0, 3))])
+        blue, green, red = (int(c) for c in np.clip(base * rng.uniform(0.7, 1.2, 3), 0, 255))
+        colour = (blue, green, red)
+        centre = (float(rng.uniform(0.05, 0.95) * width), float(rng.uniform(0.05, 0.55) * height))
+        head = render_head(image, centre, radius, lenses, lit, vertical, colour, rng.random() < 0.4)
+        boxes.append(head.housing)
+    blurred = cv2.GaussianBlur(image, (0, 0), 0.7)
+    gamma = rng.uniform(0.7, 1.4)
+    image[:] = np.clip(255 * (blurred / 255.0) ** gamma, 0, 255).astype(np.uint8)
+    return boxes
