@@ -139,6 +139,8 @@ def flow_stage() -> None:
             now = {x["id"]: x for x in truth[k]["lights"] if usable(x)}
             nxt = {x["id"]: x for x in truth[k + 1]["lights"] if usable(x)}
             for light in now.keys() & nxt.keys():
+                if not same_lens(now[light], nxt[light]):
+                    continue
                 for label, (a, b, fa, fb) in {
                     "forward": (now[light], nxt[light], k, k + 1),
                     "backward": (nxt[light], now[light], k + 1, k),
@@ -166,6 +168,11 @@ def flow_stage() -> None:
 def usable(light: dict) -> bool:
     """A lens fully in the image and unoccluded."""
     return light["status"] == "in" and light["visible"] >= 1.0
+
+
+def same_lens(a: dict, b: dict) -> bool:
+    """The same lamp lit in both frames (a state change moves the lit lens in its head)."""
+    return a["state"] == b["state"]
 
 
 def long_stage() -> None:
