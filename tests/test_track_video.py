@@ -67,6 +67,8 @@ def test_no_video_still_lists_traversals(drive, tmp_path):
     result = CliRunner().invoke(cli, [*args, "--out", str(tmp_path)])
     assert result.exit_code == 0, result.output
     assert "through" in result.output and (tmp_path / "traversals.jsonl").is_file()
+    refused = CliRunner().invoke(cli, [*args, "-c", "ab-hist"])
+    assert refused.exit_code == 2 and "need a VIDEO" in refused.output
 
 
 @pytest.mark.parametrize(

@@ -162,6 +162,8 @@ def track_command(
     """
     from tsrkit.geo import read_signals, read_track, traversals
 
+    if video is None and (truth or detector or verifier or classifier or tracker or params):
+        raise click.UsageError("--truth and plugin options need a VIDEO")
     track = read_track(gps)
     signals = read_signals(osm)
     console = Console()
