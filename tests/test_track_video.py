@@ -55,6 +55,7 @@ def test_a_rendered_drive_is_recovered_and_resumes(drive, tmp_path):
     assert temporal["detected_accuracy"] >= 0.95 and temporal["temporal_accuracy"] >= 0.9
     assert report["clip_frames"] < report["frames"]  # only the clip was decoded
     assert (out / "vicinity.png").is_file() and (out / "plots" / "traversal_000.png").is_file()
+    assert "| 0 | 0 | through |" in (out / "report.md").read_text()
     again = CliRunner().invoke(cli, args)
     assert again.exit_code == 0, again.output
     resumed = json.loads((out / "report.json").read_text())
