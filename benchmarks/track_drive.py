@@ -2,6 +2,7 @@
 
     python benchmarks/track_drive.py                 # all stages
     python benchmarks/track_drive.py --stage short   # one of: short, flow, long
+    python benchmarks/track_drive.py --stage long --flow-margin 48   # windowed flow instead
 
 short  three single-intersection drives (through, left, right) at Zheng's 480x356 and 14 fps:
        traversal and movement recovered, temporal accuracy of the true tracks (5.4).
@@ -61,7 +62,7 @@ def rendered(name: str, options: DriveOptions, seed: int = 0) -> tuple[Path, flo
     return folder, time.perf_counter() - start
 
 
-def run_track(folder: Path, out: Path, extra: list[str] = ()) -> tuple[dict, float]:
+def run_track(folder: Path, out: Path, extra: list[str]) -> tuple[dict, float]:
     """``tsrkit track`` on a rendered drive (a fresh run: no cache); its report, wall time."""
     command = [
         sys.executable, "-m", "tsrkit", "track", str(folder / "drive.mp4"),
@@ -95,7 +96,7 @@ def recovered(folder: Path, out: Path) -> list[tuple[dict, dict | None]]:
     return pairs
 
 
-def short_stage() -> None:
+def short_stage(extra: list[str]) -> None:
     print("## short drives (480x356, 14 fps, one intersection each)\n")
     print("| drive | frames | movement (true / found) | clip | short range | true tracks "
           "| false tracks | temporal acc. (all / detected) | candidates | track s |")  # fmt: skip
@@ -103,7 +104,7 @@ def short_stage() -> None:
     for name, options in SHORT.items():
         folder, _ = rendered(name, options)
         out = WORK / f"run_{name}"
-        report, seconds = run_track(folder, out)
+        report, seconds = run_track(folder, out, extra)
         frames = report["frames"]
         for truth, found in recovered(folder, out):
             temporal = next(
@@ -139,6 +140,8 @@ def flow_stage() -> None:
             now = {x["id"]: x for x in truth[k]["lights"] if usable(x)}
             nxt = {x["id"]: x for x in truth[k + 1]["lights"] if usable(x)}
             for light in now.keys() & nxt.keys():
+                if not same_lens(now[light], nxt[light]):
+                    continue
                 for label, (a, b, fa, fb) in {
                     "forward": (now[light], nxt[light], k, k + 1),
                     "backward": (nxt[light], now[light], k + 1, k),
@@ -168,8 +171,13 @@ def usable(light: dict) -> bool:
     return light["status"] == "in" and light["visible"] >= 1.0
 
 
-def long_stage() -> None:
-    print("\n## 10-minute drive (random route, 480x356, 14 fps)\n")
+def same_lens(a: dict, b: dict) -> bool:
+    """The same lamp lit in both frames (a state change moves the lit lens in its head)."""
+    return a["state"] == b["state"]
+
+
+def long_stage(extra: list[str]) -> None:
+    print(f"\n## 10-minute drive (random route, 480x356, 14 fps) {' '.join(extra)}\n")
     folder, render_s = rendered("long", LONG)
     meta = json.loads((folder / "drive.json").read_text())
     minutes = meta["frames"] / meta["fps"] / 60
@@ -177,8 +185,8 @@ def long_stage() -> None:
           f"{len(meta['traversals'])} signalised traversals; rendering "
           f"{'reused' if render_s is None else f'{render_s:.0f} s'}; load before track: "
           f"{os.getloadavg()[0]:.1f}")  # fmt: skip
-    out = WORK / "run_long"
-    report, seconds = run_track(folder, out)
+    out = WORK / ("run_long" + "".join(extra).replace("-", "_"))
+    report, seconds = run_track(folder, out, extra)
     pairs = recovered(folder, out)
     found = sum(f is not None for _, f in pairs)
     moves = sum(f is not None and f["movement"] == t["movement"] for t, f in pairs)
@@ -209,10 +217,18 @@ def fmt(value: float | None) -> str:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--stage", choices=("short", "flow", "long", "all"), default="all")
-    stage = parser.parse_args().stage
+    parser.add_argument("--flow-margin", type=int, default=None, help="passed to track")
+    args = parser.parse_args()
+    stage = args.stage
+    extra = [] if args.flow_margin is None else ["--flow-margin", str(args.flow_margin)]
     WORK.mkdir(parents=True, exist_ok=True)
     print(f"load average at start: {os.getloadavg()[0]:.1f}\n")
-    for name, run in (("short", short_stage), ("flow", flow_stage), ("long", long_stage)):
+    stages = {
+        "short": lambda: short_stage(extra),
+        "flow": flow_stage,
+        "long": lambda: long_stage(extra),
+    }
+    for name, run in stages.items():
         if stage in (name, "all"):
             run()
 

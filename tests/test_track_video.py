@@ -55,6 +55,7 @@ def test_a_rendered_drive_is_recovered_and_resumes(drive, tmp_path):
     assert temporal["detected_accuracy"] >= 0.95 and temporal["temporal_accuracy"] >= 0.9
     assert report["clip_frames"] < report["frames"]  # only the clip was decoded
     assert (out / "vicinity.png").is_file() and (out / "plots" / "traversal_000.png").is_file()
+    assert "| 0 | 0 | through |" in (out / "report.md").read_text()
     again = CliRunner().invoke(cli, args)
     assert again.exit_code == 0, again.output
     resumed = json.loads((out / "report.json").read_text())
@@ -67,6 +68,8 @@ def test_no_video_still_lists_traversals(drive, tmp_path):
     result = CliRunner().invoke(cli, [*args, "--out", str(tmp_path)])
     assert result.exit_code == 0, result.output
     assert "through" in result.output and (tmp_path / "traversals.jsonl").is_file()
+    refused = CliRunner().invoke(cli, [*args, "-c", "ab-hist"])
+    assert refused.exit_code == 2 and "need a VIDEO" in refused.output
 
 
 @pytest.mark.parametrize(

@@ -109,9 +109,10 @@ def _write_jsonl(path: Path, records) -> None:
 @click.option(
     "--flow-margin",
     type=click.IntRange(min=0),
-    default=48,
+    default=0,
     show_default=True,
-    help="Pixels of Farneback flow around a candidate (0: whole frames).",
+    help="Farneback flow in a window this many pixels around a candidate; 0: whole frames "
+    "(accurate under fast motion, slower).",
 )
 @click.option(
     "--truth",
@@ -125,7 +126,7 @@ def _write_jsonl(path: Path, records) -> None:
     "-o",
     type=click.Path(file_okay=False),
     default=None,
-    help="Folder for traversals.jsonl (and, with VIDEO, plots/, cache/ and report.json).",
+    help="Folder for traversals.jsonl (and, with VIDEO, report.json / .md, plots/, cache/).",
 )
 def track_command(
     video,
@@ -161,6 +162,8 @@ def track_command(
     """
     from tsrkit.geo import read_signals, read_track, traversals
 
+    if video is None and (truth or detector or verifier or classifier or tracker or params):
+        raise click.UsageError("--truth and plugin options need a VIDEO")
     track = read_track(gps)
     signals = read_signals(osm)
     console = Console()
@@ -280,25 +283,19 @@ def _track_video(
                 report["temporal"] = temporal_section(evaluations)
             with atomic_open(out / "report.json") as fh:
                 json.dump(report, fh, indent=1)
+            with atomic_open(out / "report.md") as fh:
+                fh.write(_markdown(report, records, evaluations))
     _print_traversals(console, records, evaluations, count, total, elapsed)
     if out is not None:
-        console.print(f"-> {out}/traversals.jsonl, report.json, vicinity.png, plots/")
+        console.print(f"-> {out}/traversals.jsonl, report.json, report.md, vicinity.png, plots/")
 
 
-def _print_traversals(console, records, evaluations, frames, clip_frames, elapsed) -> None:
-    table = Table(
-        title=f"{len(records)} traversals; {clip_frames} of {frames} frames decoded "
-        f"({elapsed:.1f} s)",
-        caption="acc.: temporal accuracy of the true tracks (Zheng 5.4), all candidates / "
-        "detected ones"
-        if evaluations is not None
-        else None,
-    )
+def _summary_rows(records, evaluations) -> tuple[list[str], list[list[str]]]:
+    """The per-traversal summary: columns and rows (terminal table and report.md)."""
     columns = ["#", "node", "movement", "anchor", "short range", "tracks"]
     if evaluations is not None:
         columns += ["true", "acc."]
-    for column in columns:
-        table.add_column(column, no_wrap=True)
+    rows = []
     for k, record in enumerate(records):
         row = [
             str(record["traversal"]),
@@ -314,8 +311,53 @@ def _print_traversals(console, records, evaluations, frames, clip_frames, elapse
                 str(e["true_tracks"]),
                 f"{_ratio(e['temporal_accuracy'])} / {_ratio(e['detected_accuracy'])}",
             ]
+        rows.append(row)
+    return columns, rows
+
+
+ACCURACY_NOTE = (
+    "acc.: temporal accuracy of the true tracks (Zheng 5.4), all candidates / detected ones"
+)
+
+
+def _print_traversals(console, records, evaluations, frames, clip_frames, elapsed) -> None:
+    table = Table(
+        title=f"{len(records)} traversals; {clip_frames} of {frames} frames decoded "
+        f"({elapsed:.1f} s)",
+        caption=ACCURACY_NOTE if evaluations is not None else None,
+    )
+    columns, rows = _summary_rows(records, evaluations)
+    for column in columns:
+        table.add_column(column, no_wrap=True)
+    for row in rows:
         table.add_row(*row)
     console.print(table)
+
+
+def _markdown(report: dict, records, evaluations) -> str:
+    """``report.md``: the run in a few lines and the per-traversal table."""
+    from tsrkit.report import markdown_table
+
+    timing = report["timing"]
+    lines = [
+        f"# tsrkit track: {report['video']}",
+        "",
+        f"{len(records)} traversals; {report['clip_frames']} of {report['frames']} frames "
+        f"decoded; {timing['seconds']} s ({timing['video_frames_per_second']} video frames/s).",
+        "",
+        markdown_table(*_summary_rows(records, evaluations)),
+    ]
+    if evaluations is not None:
+        temporal = report["temporal"]
+        lines += [
+            "",
+            ACCURACY_NOTE + ".",
+            f"Pooled: {_ratio(temporal['temporal_accuracy'])} over {temporal['candidates']} "
+            f"candidates, {_ratio(temporal['detected_accuracy'])} over {temporal['detected']} "
+            f"detected; {temporal['true_tracks']} true and {temporal['false_tracks']} false "
+            "tracks.",
+        ]
+    return "\n".join(lines) + "\n"
 
 
 def _ratio(value: float | None) -> str:

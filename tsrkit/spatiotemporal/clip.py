@@ -21,6 +21,8 @@ CONTEXT_PX = 12
 MIN_REGION_PX = 3.0
 #: Above this many candidates, one whole-frame flow is cheaper than a window each.
 WHOLE_FLOW_POINTS = 8
+#: Whole-frame flows kept for reuse.
+KEPT_FLOWS = 4
 
 
 @dataclass
@@ -30,19 +32,24 @@ class Clip:
     ``pipeline`` runs on whole frames (detector, verifier, tracker, classifier) cut to their
     upper ``roi_top`` share, Zheng's "general region of interests" (5.4: the upper 60 %);
     ``regional`` (the same plugins without the tracker) on restricted regions. ``margin`` is
-    the flow window of :func:`tsrkit.spatiotemporal.flow.project`; projecting more than
-    :data:`WHOLE_FLOW_POINTS` candidates at once uses one whole-frame flow instead.
+    the flow window of :func:`tsrkit.spatiotemporal.flow.project`, 0 for whole-frame flows
+    (the default: windows lose the lens under fast image motion, see RESULTS.track.md);
+    projecting more than :data:`WHOLE_FLOW_POINTS` candidates at once always uses one
+    whole-frame flow.
     """
 
     source: str
     images: dict[int, np.ndarray]
     pipeline: Pipeline
     regional: Pipeline
-    margin: int = 48
+    margin: int = 0
     roi_top: float = 1.0
-    calls: dict[str, int] = field(default_factory=lambda: {"whole": 0, "region": 0, "flow": 0})
+    calls: dict[str, int] = field(
+        default_factory=lambda: {"whole": 0, "region": 0, "flow": 0, "projections": 0}
+    )
     _gray: dict[int, np.ndarray] = field(default_factory=dict, repr=False)
     _whole: dict[int, list[Point]] = field(default_factory=dict, repr=False)
+    _flows: dict[tuple[int, int], np.ndarray] = field(default_factory=dict, repr=False)
 
     @property
     def first(self) -> int:
@@ -100,8 +107,22 @@ class Clip:
                 found.append(point)
         return found
 
+    def flow(self, source: int, target: int) -> np.ndarray:
+        """The whole-frame Farneback flow from ``source`` to ``target`` (the last few kept:
+        every track projected between the same two frames shares it)."""
+        key = (source, target)
+        if key not in self._flows:
+            self.calls["flow"] += 1
+            self._flows[key] = farneback(self.gray(source), self.gray(target))
+            while len(self._flows) > KEPT_FLOWS:
+                self._flows.pop(next(iter(self._flows)))
+        return self._flows[key]
+
     def project(self, point: Point, source: int, target: int) -> Point:
         """``point`` of frame ``source`` projected onto frame ``target`` by Farneback flow."""
+        self.calls["projections"] += 1
+        if self.margin <= 0:
+            return project_with(point, self.flow(source, target), self.images[target].shape)
         self.calls["flow"] += 1
         return project(point, self.gray(source), self.gray(target), self.margin)
 
@@ -110,7 +131,6 @@ class Clip:
         few, one whole-frame flow for many (the same Farneback flow, computed once)."""
         if len(points) <= WHOLE_FLOW_POINTS:
             return [self.project(p, source, target) for p in points]
-        self.calls["flow"] += 1
-        gray_j, gray_i = self.gray(source), self.gray(target)
-        flow = farneback(gray_j, gray_i)
-        return [project_with(p, flow, gray_i.shape) for p in points]
+        self.calls["projections"] += len(points)
+        flow = self.flow(source, target)
+        return [project_with(p, flow, self.images[target].shape) for p in points]

@@ -74,7 +74,7 @@ def window(point: Point, shape: tuple[int, ...], margin: int) -> tuple[int, int,
     return x0, y0, max(x1, x0 + 1), max(y1, y0 + 1)
 
 
-def project(point: Point, gray_j: np.ndarray, gray_i: np.ndarray, margin: int = 48) -> Point:
+def project(point: Point, gray_j: np.ndarray, gray_i: np.ndarray, margin: int = 0) -> Point:
     """The candidate ``point`` of frame j projected onto frame i (Eq. 3.30-3.34), flagged
     ``dof`` with its in-frame status; it keeps its state and scores (the state of the frame
     it came from, 3.4.4)."""

@@ -34,7 +34,7 @@ from tsrkit.spatiotemporal.ranges import DOWNSTREAM_M, UPSTREAM_M, FrameTraversa
 from tsrkit.types import Skipped
 
 #: Bumped when a traversal's record changes meaning; part of the cache key.
-RECORD_VERSION = 1
+RECORD_VERSION = 2
 
 
 class VideoError(TsrkitError):
@@ -53,7 +53,7 @@ class TrackSettings:
     downstream: float = DOWNSTREAM_M
     top: int = TOP_N
     slack: float = 0.0
-    margin: int = 48
+    margin: int = 0
     roi_top: float = 0.6
 
 

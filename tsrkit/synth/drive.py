@@ -145,7 +145,8 @@ def _turn(direction: str, movement: str) -> str:
 
 
 def plan_nodes(options: DriveOptions, rng: np.random.Generator) -> list[Node]:
-    """The intersections of the route, driven north from the first one at (0, 0)."""
+    """The intersections of the route, driven north from the first one at (0, 0); a junction
+    the route meets again keeps its signals and their offset."""
     if options.random_nodes:
         moves = rng.choice(MOVEMENTS, options.random_nodes, p=(0.6, 0.2, 0.2)).tolist()
         signals = (rng.random(len(moves)) < options.signal_fraction).tolist()
@@ -153,10 +154,16 @@ def plan_nodes(options: DriveOptions, rng: np.random.Generator) -> list[Node]:
         moves, signals = list(options.route), [True] * len(options.route)
     cycle = 2 * (options.green_s + options.yellow_s)
     nodes, i, j, heading = [], 0, 0, "N"
+    seen: dict[tuple[int, int], tuple[bool, float]] = {}  # a revisit meets the same junction
     for move, signalised in zip(moves, signals):
         out = _turn(heading, move)
-        offset = options.light_offset if options.light_offset is not None else rng.uniform(0, cycle)
-        nodes.append(Node(i, j, heading, out, str(move), bool(signalised), float(offset)))
+        if (i, j) not in seen:
+            offset = (
+                options.light_offset if options.light_offset is not None else rng.uniform(0, cycle)
+            )
+            seen[i, j] = (bool(signalised), float(offset))
+        signalised, offset = seen[i, j]
+        nodes.append(Node(i, j, heading, out, str(move), signalised, offset))
         di, dj = DIRECTIONS[out]
         i, j, heading = i + di, j + dj, out
     return nodes
@@ -616,6 +623,15 @@ class Drive:
         return np.arange(self.frames) / self.options.fps
 
 
+def junctions(nodes: list[Node]) -> dict[Node, int]:
+    """Each signalised junction once (its first visit) with that visit's route index."""
+    first: dict[tuple[int, int], tuple[Node, int]] = {}
+    for index, node in enumerate(nodes):
+        if node.signalised:
+            first.setdefault((node.i, node.j), (node, index))
+    return dict(first.values())
+
+
 def plan_drive(options: DriveOptions, seed: int = 0) -> Drive:
     """The route, the car's pose at every frame and the trucks (no rendering)."""
     rng = np.random.default_rng(seed)
@@ -634,7 +650,7 @@ def render_frames(drive: Drive) -> Iterator[tuple[np.ndarray, list[Light]]]:
     """Each frame's image (BGR uint8) and its lit lenses."""
     options = drive.options
     block = options.block
-    signalised = [(k, n) for k, n in enumerate(drive.route.nodes) if n.signalised]
+    signalised = list(junctions(drive.route.nodes).items())
     jitter = 0.0
     for k in range(drive.frames):
         rng = np.random.default_rng((drive.seed, k))
@@ -659,7 +675,7 @@ def render_frames(drive: Drive) -> Iterator[tuple[np.ndarray, list[Light]]]:
         image = (np.clip(scene, 0, 1) * 255).astype(np.uint8)
         near = [
             (index, node)
-            for index, node in signalised
+            for node, index in signalised
             if math.hypot(node.i * block - camera.x, node.j * block - camera.y) < 160
         ]
         lights = draw_signals(image, depth, camera, options, near, t)
@@ -723,9 +739,10 @@ def osm_extract(drive: Drive) -> str:
     nodes = drive.route.nodes
     first = nodes[0]
     ux, uy = DIRECTIONS[first.into]
+    grid = {(n.i, n.j): n.signalised for n in nodes}
     points = [
-        (n.i * options.block, n.j * options.block, "highway" if n.signalised else None)
-        for n in nodes
+        (i * options.block, j * options.block, "highway" if signalised else None)
+        for (i, j), signalised in grid.items()
     ]
     points.append((-ux * options.block / 2, -uy * options.block / 2, "crossing"))
     lat, lon = to_latlon(options, [p[0] for p in points], [p[1] for p in points])
@@ -745,20 +762,26 @@ def summary(drive: Drive) -> dict:
     intersections in route order, movement, approach and the frame closest to each)."""
     options = drive.options
     traversals = []
+    after = 0  # route order: each visit's closest frame comes after the previous one's
     for index, node in enumerate(drive.route.nodes):
+        cx, cy = node.i * options.block, node.j * options.block
+        distance = np.hypot(drive.x[after:] - cx, drive.y[after:] - cy)
+        near = np.flatnonzero(distance < options.block / 2)
+        run = near[: int(np.argmax(np.diff(near) > 1)) + 1] if np.any(np.diff(near) > 1) else near
+        closest = after + int(run[np.argmin(distance[run])]) if len(run) else after
+        after = closest + 1
         if not node.signalised:
             continue
-        cx, cy = node.i * options.block, node.j * options.block
-        anchor = int(np.argmin(np.hypot(drive.x - cx, drive.y - cy)))
         lat, lon = to_latlon(options, [cx], [cy])
         traversals.append(
             {
                 "node": index,
+                "grid": [node.i, node.j],
                 "lat": float(lat[0]),
                 "lon": float(lon[0]),
                 "movement": node.movement,
                 "approach": node.into,
-                "closest_frame": anchor,
+                "closest_frame": closest,
             }
         )
     return {
