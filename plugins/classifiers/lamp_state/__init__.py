@@ -6,6 +6,8 @@ unchanged, beside it. Features: :mod:`.features`; model: scikit-learn's
 ``HistGradientBoostingClassifier`` stored with skops (explicit trusted types, no pickle; see
 ``tsrkit_plugins.verifiers.persistence``). ``red_yellow`` is a state of its own where the
 training data labels it (DTLD); other labels (arrows, off) are passed over in training.
+``ab_hist_weight`` mixes ab-hist's normalised scores into the learned probabilities (a late
+fusion, :func:`blend`; measured in ``benchmarks/RESULTS.state.md``).
 """
 
 from __future__ import annotations
