@@ -7,7 +7,7 @@ import pytest
 import tsrkit
 from tsrkit.models import ModelError, load_model, save_model
 from tsrkit.types import Annotation, Candidate, Frame, Sample
-from tsrkit_plugins.classifiers.lamp_state import STATES
+from tsrkit_plugins.classifiers.lamp_state import STATES, colour_jitter
 from tsrkit_plugins.classifiers.lamp_state.features import N_FEATURES, lamp_features
 
 #: BGR of lit lamps as cameras record them (saturated, slightly orange red; amber; blue-green).
@@ -103,3 +103,27 @@ def test_one_state_is_not_enough(tmp_path):
     only_red = [s for s in samples(tmp_path) if s.annotations[0].state == "red"]
     with pytest.raises(tsrkit.TsrkitError, match="need at least two"):
         tsrkit.classifier("lamp-state").fit(only_red)
+
+
+def test_colour_jitter_spans_other_cameras_exposure():
+    grey = np.full((4, 4, 3), 100, np.uint8)
+    rng = np.random.default_rng(0)
+    views = np.stack([colour_jitter(grey, rng) for _ in range(200)])
+    # gains 0.85-1.15 x exposure 0.8-3, gamma 0.8-1.25: 100 stays within these bounds
+    low = 255 * (100 * 0.85 * 0.8 / 255) ** 1.25
+    high = 255 * min(1.0, 100 * 1.15 * 3.0 / 255) ** 0.8
+    assert low - 1 <= views.min() and views.max() <= high
+    assert views.max() == 255  # some views clip, as an over-exposed lamp core does
+    again = np.random.default_rng(0)
+    assert np.array_equal(colour_jitter(grey, again), views[0])
+
+
+@pytest.mark.parametrize("state", ["red", "yellow", "green"])
+def test_fusion_with_ab_hist_reads_rendered_heads(state):
+    image, box = head(state, white_core=True)
+    found = tsrkit.classifier("lamp-state", ab_hist_weight=0.5).classify(
+        Frame(image, "head"), [Candidate.from_box(box, 1.0)]
+    )
+    assert found[0].state == state
+    assert set(found[0].state_scores) >= {"red", "yellow", "green"}
+    assert abs(sum(found[0].state_scores.values()) - 1.0) < 1e-6

@@ -6,6 +6,8 @@ unchanged, beside it. Features: :mod:`.features`; model: scikit-learn's
 ``HistGradientBoostingClassifier`` stored with skops (explicit trusted types, no pickle; see
 ``tsrkit_plugins.verifiers.persistence``). ``red_yellow`` is a state of its own where the
 training data labels it (DTLD); other labels (arrows, off) are passed over in training.
+``ab_hist_weight`` mixes ab-hist's normalised scores into the learned probabilities (a late
+fusion, :func:`blend`; measured in ``benchmarks/RESULTS.state.md``).
 """
 
 from __future__ import annotations
@@ -21,7 +23,9 @@ from tsrkit.hookspecs import hookimpl
 from tsrkit.models import Model, ModelError, load_model
 from tsrkit.params import Param
 from tsrkit.plugin import Classifier, Detector
+from tsrkit.registry import get_registry
 from tsrkit.types import Candidate, Detection, Frame, Sample
+from tsrkit_plugins.classifiers.ab_hist import AbHist
 from tsrkit_plugins.classifiers.lamp_state.features import N_FEATURES, VERSION, lamp_features
 from tsrkit_plugins.verifiers.persistence import estimator_arrays, load_estimator
 
@@ -30,11 +34,18 @@ STATES = ("red", "yellow", "green", "red_yellow")
 DEFAULT_MODEL = Path(__file__).parent / "models" / "lamp_state_default"
 
 
+#: Exposure range of the jittered views (a gain, drawn log-uniform): other cameras' exposure,
+#: up to the over-exposed white cores with a coloured rim of dash-cams.
+EXPOSURE = (0.8, 3.0)
+
+
 def colour_jitter(image: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     """``image`` as another camera might see it: channel gains in [0.85, 1.15] (white balance)
-    and a gamma in [0.8, 1.25] (response curve), drawn from ``rng``."""
+    times one exposure gain in :data:`EXPOSURE` (bright lamps clip to white), and a gamma in
+    [0.8, 1.25] (response curve), drawn from ``rng``."""
     gains = rng.uniform(0.85, 1.15, 3)
     gamma = rng.uniform(0.8, 1.25)
+    gains = gains * np.exp(rng.uniform(np.log(EXPOSURE[0]), np.log(EXPOSURE[1])))
     scaled = np.clip(image.astype(np.float32) * (gains / 255.0), 0.0, 1.0)
     return (255.0 * scaled**gamma).astype(np.uint8)
 
@@ -58,6 +69,24 @@ def labelled_features(
     if not rows:
         return np.zeros((0, N_FEATURES), np.float32), np.zeros(0, np.int64)
     return np.concatenate(rows), np.array(labels, np.int64)
+
+
+def blend(
+    probability: np.ndarray, states: Sequence[str], other: np.ndarray, weight: float
+) -> np.ndarray:
+    """``(1 - weight)`` x lamp-state's ``probability`` (columns: ``states``) plus ``weight`` x
+    another classifier's scores ``other`` (columns: :data:`STATES`, each row normalised to sum
+    1), as an (N, len(STATES)) table.
+
+    Examples
+    --------
+    >>> blend(np.array([[0.8, 0.2]]), ["red", "green"], np.array([[0.0, 3.0, 1.0, 0.0]]), 0.5)
+    array([[0.4  , 0.375, 0.225, 0.   ]])
+    """
+    table = np.zeros((len(probability), len(STATES)))
+    table[:, [STATES.index(s) for s in states]] = probability
+    other = other / np.maximum(other.sum(axis=1, keepdims=True), 1e-9)
+    return (1 - weight) * table + weight * other
 
 
 def fit_estimator(
@@ -103,12 +132,22 @@ class LampState(Classifier):
             "response), for states that carry over to unseen cameras",
         ),
         Param("seed", "int", 0, min=0, help="training: seed of the jitter and the trees"),
+        Param(
+            "ab_hist_weight",
+            "float",
+            0.0,
+            min=0.0,
+            max=1.0,
+            help="weight of ab-hist's scores (shipped model, normalised) mixed with the learned "
+            "probabilities; 0.5 is the late fusion of benchmarks/RESULTS.state.md",
+        ),
     )
 
     def __init__(self, **params):
         super().__init__(**params)
         self._estimator: HistGradientBoostingClassifier | None = None
         self._states: tuple[str, ...] = ()
+        self._ab_hist: Classifier | None = None
 
     @property
     def estimator(self) -> HistGradientBoostingClassifier:
@@ -139,10 +178,21 @@ class LampState(Classifier):
             return []
         estimator = self.estimator
         probability = estimator.predict_proba(lamp_features(frame.image, candidates))
+        weight = self.params["ab_hist_weight"]
+        known = set(self._states)
+        if weight > 0:
+            if self._ab_hist is None:
+                self._ab_hist = get_registry().create("classifier", AbHist.name)
+            found = self._ab_hist.classify(frame, candidates)
+            known |= {s for d in found for s in d.state_scores}
+            other = np.array([[d.state_scores.get(s, 0.0) for s in STATES] for d in found])
+        else:
+            other = np.zeros((len(candidates), len(STATES)))
+        table = blend(probability, self._states, other, weight)
         out = []
-        for candidate, p in zip(candidates, probability):
-            scores = {state: float(v) for state, v in zip(self._states, p)}
-            out.append(Detection(candidate, self._states[int(np.argmax(p))], scores))
+        for candidate, row in zip(candidates, table):
+            scores = {s: float(v) for s, v in zip(STATES, row) if s in known}
+            out.append(Detection(candidate, STATES[int(np.argmax(row))], scores))
         return out
 
     def fit(self, samples: Iterable[Sample], *, detector: Detector | None = None) -> Model:

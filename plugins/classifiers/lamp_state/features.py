@@ -8,14 +8,16 @@ robust across cameras:
 
 * **lamp colour**: hue histograms (weighted by saturation x value) of the lens disk and of its
   rim ``0.6 r .. 1.3 r`` (a white core is read by the rim), CIELab a/b of the brightest disk
-  pixels and of the most chromatic rim pixels, the over-exposed share of the disk, mean value,
-  saturation and normalised red/green chromaticity;
-* **housing colour**: the hue histogram of the bright pixels of the whole housing box;
+  pixels and of the most chromatic rim pixels and the over-exposed share of the disk;
 * **position**: the housing resampled upright (vertical or horizontal head) to
   :data:`HOUSING_SIZE`, the brightness and colourfulness of its top, middle and bottom thirds
   and the lit centroid along its axis (red on top, amber in the middle, green at the bottom in
   most countries; red+amber lights two thirds at once). Without a housing (a lens box) these are
   zero and ``has_housing`` is 0.
+
+Layout 2 left out what differs by camera rather than by state (mean value and saturation of the
+disk, its red/green chromaticity, the hue histogram of the whole housing): across cameras they
+cost accuracy (leave-one-dataset-out, ``benchmarks/RESULTS.state.md``).
 """
 
 from __future__ import annotations
@@ -37,7 +39,7 @@ HOUSING_SIZE = (12, 36)
 #: Long / short side ratio from which a box without a fitted housing is read as a housing.
 ELONGATION = 1.5
 #: Feature layout version: a model trained on another layout is refused.
-VERSION = 1
+VERSION = 2
 
 
 def _lens_masks() -> tuple[np.ndarray, np.ndarray]:
@@ -49,8 +51,10 @@ def _lens_masks() -> tuple[np.ndarray, np.ndarray]:
 
 DISK, RIM = _lens_masks()
 N_HUE = len(HUE_EDGES) - 1
-#: Number of features: 2 x lens hue, 4 Lab, 5 lens statistics, housing hue, 9 position.
-N_FEATURES = 2 * N_HUE + 4 + 5 + N_HUE + 9
+#: Number of features: 2 x lens hue, 4 Lab, the over-exposed share, 9 position.
+N_FEATURES = 2 * N_HUE + 4 + 1 + 9
+#: Number of lens (colour) features, the first columns.
+N_LENS = 2 * N_HUE + 5
 
 
 def housing_of(candidate: Candidate) -> tuple[float, float, float, float] | None:
@@ -98,7 +102,7 @@ def convert(stack: np.ndarray, code: int) -> np.ndarray:
 
 
 def lens_features(image: np.ndarray, lenses: Sequence[Candidate]) -> np.ndarray:
-    """Lens and rim colour of each lens (see the module notes), (N, 2 x hue bins + 9)."""
+    """Lens and rim colour of each lens (see the module notes), (N, :data:`N_LENS`)."""
     r = np.array([max(c.radius, 0.5) * 1.3 for c in lenses])
     x, y = np.array([c.x for c in lenses]), np.array([c.y for c in lenses])
     stack = patches(image, np.stack([x - r, y - r, x + r, y + r], axis=1), (LENS_PATCH,) * 2)
@@ -113,11 +117,7 @@ def lens_features(image: np.ndarray, lenses: Sequence[Candidate]) -> np.ndarray:
     def masked_mean(values: np.ndarray, mask: np.ndarray) -> np.ndarray:
         return (values * mask[..., None]).sum(axis=1) / np.maximum(mask.sum(axis=1), 1)[:, None]
 
-    bgr = stack[:, DISK].astype(np.float32)
-    chromaticity = bgr / (bgr.sum(axis=2, keepdims=True) + 1e-3)
-    weight = value / np.maximum(value.sum(axis=1, keepdims=True), 1e-3)
-    saturation = hsv[..., 1][:, DISK]
-    over = (value > 230) & (saturation < 80)
+    over = (value > 230) & (hsv[..., 1][:, DISK] < 80)
     return np.concatenate(
         [
             hue_histograms(hsv, DISK),
@@ -125,10 +125,6 @@ def lens_features(image: np.ndarray, lenses: Sequence[Candidate]) -> np.ndarray:
             masked_mean(lab[:, DISK, 1:], bright) / 128,
             masked_mean(lab[:, RIM, 1:], vivid) / 128,
             over.mean(axis=1, keepdims=True),
-            value.mean(axis=1, keepdims=True) / 255,
-            saturation.mean(axis=1, keepdims=True) / 255,
-            (chromaticity[..., 2] * weight).sum(axis=1, keepdims=True),
-            (chromaticity[..., 1] * weight).sum(axis=1, keepdims=True),
         ],
         axis=1,
     ).reshape(n, -1)
@@ -166,17 +162,15 @@ def lit_lenses(
 
 
 def housing_features(hsv: np.ndarray, vertical: np.ndarray) -> np.ndarray:
-    """Housing hue and lit-position features of upright housing patches in HSV."""
+    """Lit-position features of upright housing patches in HSV."""
     n = hsv.shape[0]
     value = hsv[..., 2].astype(np.float32) / 255
-    lit = value >= np.maximum(0.5 * value.max(axis=(1, 2)), 1e-3)[:, None, None]
     colourful = hsv[..., 1].astype(np.float32) / 255 * value
     thirds = np.array_split(np.arange(value.shape[1]), 3)
     weight = value.max(axis=2) ** 4
     position = weight @ np.linspace(0, 1, weight.shape[1]) / np.maximum(weight.sum(axis=1), 1e-6)
     return np.concatenate(
         [
-            hue_histograms(hsv, lit),
             np.stack([quantiles(value[:, rows].reshape(n, -1), 0.9) for rows in thirds], 1),
             np.stack([quantiles(colourful[:, rows].reshape(n, -1), 0.9) for rows in thirds], 1),
             position[:, None],
@@ -197,11 +191,11 @@ def lamp_features(image: np.ndarray, candidates: Sequence[Candidate]) -> np.ndar
         boxes = np.array([housings[i] for i in boxed], np.float64)
         upright, vertical = upright_housings(image, boxes)
         hsv = convert(upright, cv2.COLOR_BGR2HSV)
-        rows[boxed, 2 * N_HUE + 9 :] = housing_features(hsv, vertical)
+        rows[boxed, N_LENS:] = housing_features(hsv, vertical)
         found = lit_lenses(boxes, vertical, hsv)
         for k, i in enumerate(boxed):
             if candidates[i].housing is None:
                 lenses[i] = found[k]
     if lenses:
-        rows[:, : 2 * N_HUE + 9] = lens_features(image, lenses)
+        rows[:, :N_LENS] = lens_features(image, lenses)
     return np.nan_to_num(rows)
