@@ -219,3 +219,9 @@ def test_cli_writes_the_dataset_and_reports_mistakes_in_one_line(tmp_path):
         cli, ["datasets", "synth", "--out", str(tmp_path / "t"), "--lighting", "noon"]
     )
     assert bad.exit_code == 2 and "lighting" in bad.output and "Traceback" not in bad.output
+
+
+def test_generate_reports_each_rendered_frame(tmp_path):
+    calls = []
+    synth.generate(tmp_path / "s", frames=3, seed=2, on_frame=lambda: calls.append(len(calls)))
+    assert calls == [0, 1, 2]

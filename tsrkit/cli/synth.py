@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 from collections import Counter
-from contextlib import nullcontext
 from pathlib import Path
 
 import click
@@ -63,12 +62,14 @@ def synth_command(
       tsrkit datasets synth --out clip/ --frames 60 --video clip.mp4
     """
     conditions = tuple(c.strip() for c in lighting.split(",") if c.strip())
-    status = Console(stderr=True).status(f"rendering {frames} frames into {out}...")
+    from tsrkit.report import ProgressBar
+
     try:
-        with status if not quiet else nullcontext():
+        with ProgressBar(frames, not quiet and Console(stderr=True).is_terminal, "synth") as bar:
             dataset = generate(
-                out, frames, seed, width, height, overwrite=overwrite, lighting=conditions
-            )
+                out, frames, seed, width, height, overwrite=overwrite, lighting=conditions,
+                on_frame=bar.advance,
+            )  # fmt: skip
     except ValueError as exc:  # bad option values: one line, like every TsrkitError
         raise TsrkitError(str(exc)) from None
     states = Counter(a.state for s in dataset for a in s.annotations)
