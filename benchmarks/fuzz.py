@@ -246,6 +246,20 @@ def params_surface():
     return seeds, target, ParamError
 
 
+def run_surface(name, seeds, target, cases: int, rng, allowed) -> int:
+    """Fuzz one surface, print its line of counts and return how many cases went uncaught."""
+    start = time.perf_counter()
+    counts = fuzz(name, seeds, target, cases, rng, allowed)
+    uncaught = sum(n for k, n in counts.items() if k.startswith("UNCAUGHT"))
+    print(
+        f"{name:10s} {cases} cases in {time.perf_counter() - start:5.1f} s: "
+        f"accepted {counts['accepted']}, clear error {counts['clear error']} "
+        f"(of which by the readers' safety net {counts['net']}), uncaught {uncaught}",
+        flush=True,
+    )
+    return uncaught
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cases", type=int, default=10000)
@@ -271,16 +285,7 @@ def main() -> None:
         for name, (seeds, target, allowed) in surfaces.items():
             if name not in chosen:
                 continue
-            start = time.perf_counter()
-            counts = fuzz(name, seeds, target, args.cases, rng, allowed)
-            uncaught = sum(n for k, n in counts.items() if k.startswith("UNCAUGHT"))
-            total_uncaught += uncaught
-            print(
-                f"{name:10s} {args.cases} cases in {time.perf_counter() - start:5.1f} s: "
-                f"accepted {counts['accepted']}, clear error {counts['clear error']} "
-                f"(of which by the readers' safety net {counts['net']}), uncaught {uncaught}",
-                flush=True,
-            )
+            total_uncaught += run_surface(name, seeds, target, args.cases, rng, allowed)
         print(f"total uncaught: {total_uncaught}")
     finally:
         shutil.rmtree(folder, ignore_errors=True)

@@ -19,12 +19,11 @@ import json
 import os
 import shutil
 import tempfile
-import time
 from datetime import UTC, datetime
 from pathlib import Path
 
 import numpy as np
-from fuzz import fuzz  # benchmarks/fuzz.py: the mutations and the outcome counts
+from fuzz import run_surface  # benchmarks/fuzz.py: the mutations and the outcome counts
 
 from tsrkit.geo import GeoError, Track, read_signals, read_track
 from tsrkit.geo.export import to_gpx, to_nmea
@@ -95,16 +94,7 @@ def main() -> None:
 
             for data in files:  # every seed is read cleanly before it is mutated
                 target(data)
-            start = time.perf_counter()
-            counts = fuzz(name, files, target, args.cases, rng, GeoError)
-            uncaught = sum(n for k, n in counts.items() if k.startswith("UNCAUGHT"))
-            total += uncaught
-            print(
-                f"{name:10s} {args.cases} cases in {time.perf_counter() - start:5.1f} s: "
-                f"accepted {counts['accepted']}, clear error {counts['clear error']}, "
-                f"uncaught {uncaught}",
-                flush=True,
-            )
+            total += run_surface(name, files, target, args.cases, rng, GeoError)
         print(f"total uncaught: {total}")
     finally:
         shutil.rmtree(folder, ignore_errors=True)
