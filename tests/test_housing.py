@@ -80,3 +80,15 @@ def test_scattered_heads_are_deterministic_and_boxed_in_the_frame():
         # 3-4 lenses of radius 2-12 px, 2.8 radii per cell, centred in the upper 55 %
         assert 5.6 <= min(x1 - x0, y1 - y0) <= 33.6 + 1e-9
         assert 0 <= (y0 + y1) / 2 <= 360 and 0 <= (x0 + x1) / 2 <= 640
+
+
+def test_every_fitted_housing_holds_its_lens():
+    rng = np.random.default_rng(5)
+    gray = cv2.GaussianBlur(rng.integers(0, 256, (240, 320), dtype=np.uint8), (0, 0), 3)
+    lenses = [(float(x), float(y), float(r)) for x, y, r in zip(
+        rng.uniform(20, 300, 200), rng.uniform(20, 220, 200), rng.uniform(1, 12, 200)
+    )]  # fmt: skip
+    boxes, _, radii = fit_housings(gray, lenses)
+    x, y, _ = np.array(lenses).T
+    assert np.all(boxes[:, 0] <= x - radii) and np.all(boxes[:, 2] >= x + radii)
+    assert np.all(boxes[:, 1] <= y - radii) and np.all(boxes[:, 3] >= y + radii)

@@ -207,7 +207,10 @@ def fit_housings(
     x, y, r = (np.asarray(v, np.float64) for v in zip(*lenses))
     _, coarse = best_layouts(table, x, y, radius_options(r), COARSE)
     best, chosen = best_layouts(table, x, y, coarse[:, None] * FINE)
-    refined = refine(table, best, chosen)
     lens = np.stack([x - chosen, y - chosen, x + chosen, y + chosen], axis=1)
+    # A housing holds its lens: refinement may not move an edge past the lens disc.
+    refined = refine(table, best, chosen)
+    refined[:, :2] = np.minimum(refined[:, :2], lens[:, :2])
+    refined[:, 2:] = np.maximum(refined[:, 2:], lens[:, 2:])
     final = contrast(table, refined, lens, np.maximum(BAND * chosen, 1.0))
     return refined, np.clip(final, 0.0, 1.0), chosen
