@@ -75,7 +75,8 @@ def _check_dataset(dataset) -> None:
             assert isinstance(ann.attributes, dict)
 
 
-def _read(path: Path, fmt: str) -> None:
+def check_reader_total(path: Path, fmt: str) -> None:
+    """Reading ``path`` gives a valid dataset or one reader-specific line, never a traceback."""
     try:
         dataset = open_dataset(path, format=fmt)
     except TsrkitError as exc:
@@ -107,7 +108,7 @@ def test_normalized_reader_is_total(work, data):
     record = _mutated(record, data) if data.draw(st.booleans()) else record
     path = work / "annotations.json"
     path.write_text(json.dumps([record], allow_nan=True))
-    _read(path, "normalized")
+    check_reader_total(path, "normalized")
 
 
 @BOUNDED
@@ -124,7 +125,7 @@ def test_coco_reader_is_total(work, data):
         top[part] = [_mutated(top[part][0], data)]
     path = work / "coco.json"
     path.write_text(json.dumps(top, allow_nan=True))
-    _read(path, "coco")
+    check_reader_total(path, "coco")
 
 
 @BOUNDED
@@ -138,7 +139,7 @@ def test_dtld_reader_is_total(work, data):
         entry = _mutated(entry, data) | {"image_path": entry["image_path"]}
     path = work / "dtld.json"
     path.write_text(json.dumps({"images": [entry]}, allow_nan=True))
-    _read(path, "dtld")
+    check_reader_total(path, "dtld")
 
 
 @BOUNDED
@@ -150,7 +151,7 @@ def test_bosch_reader_is_total(work, data):
         entry = _mutated(entry, data)
     path = work / "bosch.yaml"
     path.write_text(yaml.safe_dump([entry]))
-    _read(path, "bosch")
+    check_reader_total(path, "bosch")
 
 
 # --- line formats: rows of tokens drawn from a tricky alphabet ---
@@ -171,7 +172,7 @@ def test_yolo_reader_is_total(work, data):
     names = data.draw(st.one_of(st.just(["red"]), JSON))
     (root / "data.yaml").write_text(yaml.safe_dump({"names": names, "train": "images"}))
     (root / "labels" / "a.txt").write_text(_line(data, 5, " ") + "\n" + _line(data, 5, " "))
-    _read(root / "data.yaml", "yolo")
+    check_reader_total(root / "data.yaml", "yolo")
 
 
 HEADERS = {
@@ -202,7 +203,7 @@ def test_line_readers_are_total(work, fmt, data):
     path.write_text("\n".join(lines) + "\n")
     if fmt != "lara":
         cv2.imwrite(str(path.parent / "a.png"), np.zeros((24, 24, 3), np.uint8))
-    _read(path, fmt)
+    check_reader_total(path, fmt)
 
 
 @BOUNDED
@@ -225,7 +226,7 @@ def test_readers_are_total_on_arbitrary_bytes(work, fmt, name, content):
     path = work / f"bytes-{fmt}" / name
     path.parent.mkdir(exist_ok=True)
     path.write_bytes(content)
-    _read(path, fmt)
+    check_reader_total(path, fmt)
 
 
 # --- images ---
