@@ -5,6 +5,8 @@ from __future__ import annotations
 import cv2
 import numpy as np
 import pytest
+from sklearn.ensemble import AdaBoostClassifier
+from sklearn.tree import DecisionTreeClassifier
 
 from tsrkit.errors import TsrkitError
 from tsrkit.models import load_model, save_model
@@ -75,8 +77,8 @@ def test_margin_matches_scikit_learn_decision():
     rng = np.random.default_rng(0)
     pos = rng.integers(0, 50, ab.LEVELS**2) * (rng.random(ab.LEVELS**2) < 0.01)
     neg = rng.integers(0, 50, ab.LEVELS**2) * (rng.random(ab.LEVELS**2) < 0.05)
-    booster = ab.AdaBoostClassifier(
-        ab.DecisionTreeClassifier(max_depth=1), n_estimators=7, random_state=0
+    booster = AdaBoostClassifier(
+        DecisionTreeClassifier(max_depth=1), n_estimators=7, random_state=0
     )
     x = ab.plane_features()
     cells = np.flatnonzero(pos + neg)

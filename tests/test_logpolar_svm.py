@@ -5,6 +5,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 import pytest
+from sklearn.svm import SVC
 
 from tsrkit.errors import TsrkitError
 from tsrkit.models import save_model
@@ -109,7 +110,7 @@ def test_votes_match_scikit_learn(shapes, kernel):
     x = clf._vectors(((s.image, s.annotations[0].bbox) for s in samples), info)
     test_x = clf._vectors(((s.image, s.annotations[0].bbox) for s in crops(4, shapes=shapes)), info)
     projected = clf.project(x)
-    svm = lp.SVC(kernel=kernel, C=1.0, gamma=info["gamma"], degree=3, coef0=0.0)
+    svm = SVC(kernel=kernel, C=1.0, gamma=info["gamma"], degree=3, coef0=0.0)
     svm.fit(projected, np.searchsorted(info["classes"], [s.annotations[0].state for s in samples]))
     ours = np.argmax(clf.votes(np.vstack([x, test_x])), axis=1)
     np.testing.assert_array_equal(ours, svm.predict(clf.project(np.vstack([x, test_x]))))

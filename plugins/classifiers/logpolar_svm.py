@@ -16,9 +16,6 @@ from typing import Any
 
 import cv2
 import numpy as np
-from sklearn.decomposition import PCA
-from sklearn.metrics.pairwise import linear_kernel, polynomial_kernel, rbf_kernel, sigmoid_kernel
-from sklearn.svm import SVC
 
 from tsrkit.errors import TsrkitError
 from tsrkit.hookspecs import hookimpl
@@ -78,6 +75,13 @@ def sign_vector(
 
 def kernel_matrix(x: np.ndarray, vectors: np.ndarray, info: Mapping[str, Any]) -> np.ndarray:
     """The SVM kernel between rows of ``x`` and the support vectors, as scikit-learn's SVC."""
+    from sklearn.metrics.pairwise import (
+        linear_kernel,
+        polynomial_kernel,
+        rbf_kernel,
+        sigmoid_kernel,
+    )
+
     kind = info["kernel"]
     if kind == "linear":
         return linear_kernel(x, vectors)
@@ -188,6 +192,9 @@ class LogPolarSVM(Classifier):
                 f"{len(labels)} boxes"
             )
         x = self._vectors(pairs, p)
+        from sklearn.decomposition import PCA
+        from sklearn.svm import SVC
+
         pca = PCA(n_components=p["n_components"], svd_solver="full").fit(x)
         projected = pca.transform(x)
         gamma = (

@@ -15,12 +15,11 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import cv2
 import numpy as np
 from scipy.special import expit
-from sklearn.ensemble import AdaBoostClassifier
-from sklearn.tree import DecisionTreeClassifier
 
 from tsrkit.errors import TsrkitError
 from tsrkit.geometry import clip_box, iou_matrix
@@ -29,6 +28,10 @@ from tsrkit.models import Model, load_model
 from tsrkit.params import Param
 from tsrkit.plugin import Detector
 from tsrkit.types import STATES, Candidate, Frame, Sample
+
+if TYPE_CHECKING:  # scikit-learn loads when a model is fitted or read, not on import
+    from sklearn.ensemble import AdaBoostClassifier
+    from sklearn.tree import DecisionTreeClassifier
 
 #: OpenCV's full-range 8-bit hue and saturation both take 256 values.
 LEVELS = 256
@@ -232,6 +235,9 @@ def fit_stumps(
     weight = np.r_[
         positive[pos_cells] / (2 * positive.sum()), negative[neg_cells] / (2 * negative.sum())
     ]
+    from sklearn.ensemble import AdaBoostClassifier
+    from sklearn.tree import DecisionTreeClassifier
+
     booster = AdaBoostClassifier(
         DecisionTreeClassifier(max_depth=1), n_estimators=n_estimators, random_state=seed
     )

@@ -26,7 +26,6 @@ every angle (``v_a0``, ``v_d0``).
 from __future__ import annotations
 
 import numpy as np
-from sklearn.decomposition import PCA
 
 #: Bin edges of the relative azimuth, degrees (Lee's 30-degree steps of 4.2).
 BIN_EDGES = np.arange(0.0, 181.0, 30.0)
@@ -62,6 +61,8 @@ def fit_line(pixels: np.ndarray, alpha: np.ndarray) -> dict[str, np.ndarray]:
     needs known angles in at least two bins, else ``b = 0`` (the uncompensated form).
     """
     mean = pixels.mean(axis=0)
+    from sklearn.decomposition import PCA
+
     axis = PCA(n_components=1, svd_solver="full").fit(pixels).components_[0]
     axis = axis if axis.sum() >= 0 else -axis  # positive: towards brighter
     s = (pixels - mean) @ axis

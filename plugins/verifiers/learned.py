@@ -16,9 +16,9 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 from dataclasses import replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-from sklearn.ensemble import HistGradientBoostingClassifier
 
 from tsrkit.errors import TsrkitError
 from tsrkit.hookspecs import hookimpl
@@ -30,6 +30,9 @@ from tsrkit.types import Candidate, Frame, Sample
 from tsrkit_plugins.verifiers.features import candidate_features, feature_names, layout
 from tsrkit_plugins.verifiers.mining import Labelled, Stage, hard_negatives, labelled_candidates
 from tsrkit_plugins.verifiers.persistence import estimator_arrays, load_estimator
+
+if TYPE_CHECKING:  # scikit-learn loads when a model is fitted or read, not on import
+    from sklearn.ensemble import HistGradientBoostingClassifier
 
 DEFAULT_MODEL = Path(__file__).parent / "models" / "verifier_default"
 
@@ -232,6 +235,8 @@ class LearnedVerifier(Verifier):
         )
 
     def _fit_once(self, data: Labelled, rows: np.ndarray) -> HistGradientBoostingClassifier:
+        from sklearn.ensemble import HistGradientBoostingClassifier
+
         rows = np.sort(rows)
         estimator = HistGradientBoostingClassifier(
             max_iter=self.params["iterations"],

@@ -13,12 +13,14 @@ import io
 import re
 import zipfile
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
-import skops.io as sio
-from sklearn.ensemble import HistGradientBoostingClassifier
 
 from tsrkit.models import Model, ModelError
+
+if TYPE_CHECKING:  # skops and scikit-learn load when a model is saved or read, not on import
+    from sklearn.ensemble import HistGradientBoostingClassifier
 
 #: The only non-builtin types a verifier model may contain (skops refuses every other one).
 TRUSTED_TYPES = ["sklearn.ensemble._hist_gradient_boosting.predictor.TreePredictor"]
@@ -56,6 +58,8 @@ def canonical_skops(data: bytes) -> bytes:
 
 def estimator_arrays(estimator: HistGradientBoostingClassifier) -> dict[str, np.ndarray]:
     """The model arrays holding ``estimator`` (canonical skops bytes as uint8)."""
+    import skops.io as sio
+
     return {ARRAY: np.frombuffer(canonical_skops(sio.dumps(estimator)), dtype=np.uint8)}
 
 
@@ -73,6 +77,9 @@ def load_estimator(
         No estimator array, bytes skops cannot read, a type outside :data:`TRUSTED_TYPES`, or
         an object that is not a fitted classifier of ``classes``.
     """
+    import skops.io as sio
+    from sklearn.ensemble import HistGradientBoostingClassifier
+
     data = model.arrays.get(ARRAY)
     if data is None or data.dtype != np.uint8 or data.ndim != 1:
         raise ModelError(f"model {where}: no '{ARRAY}' byte array (not a verifier model)")

@@ -7,19 +7,28 @@ max-radius category, circle area proportional to the share of the category's fra
 
 from __future__ import annotations
 
+import functools
 from pathlib import Path
-
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
 
 from tsrkit import ReportWriter, RunResult, hookimpl
 from tsrkit.atomic import atomic_open
 from tsrkit.eval.categories import radius_label
 
 
+@functools.cache
+def pyplot():
+    """matplotlib's pyplot on the Agg backend, imported on first use (it costs a quarter second,
+    which every verb that loads the plugins would otherwise pay)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot
+
+    return matplotlib.pyplot
+
+
 def _save(fig, path: Path) -> str:
+    plt = pyplot()
     with atomic_open(path, "wb") as fh:
         fig.savefig(fh, format="png", dpi=110)
     plt.close(fig)
@@ -35,6 +44,7 @@ def bubble_plot(rows: list[dict], path: Path) -> str:
     (:data:`tsrkit.eval.categories.RADIUS_BIN_STARTS`) and lighting conditions, whatever the
     dataset size.
     """
+    plt = pyplot()
     cells = [r for r in rows if r["max_radius"] is not None] or rows
     lightings = sorted({r["lighting"] for r in cells})
     starts = sorted({r["max_radius"] for r in cells if r["max_radius"] is not None})
@@ -78,6 +88,7 @@ def _radius_name(start: int | None) -> str:
 
 def category_bars(rows: list[dict], path: Path) -> str:
     """Per-category bars of mean recall, mean precision and hit-frame fraction."""
+    plt = pyplot()
     labels = [
         r["lighting"]
         if r["max_radius"] is None
@@ -102,6 +113,7 @@ def category_bars(rows: list[dict], path: Path) -> str:
 
 def pr_curve(curve: dict | None, ap: float | None, path: Path) -> str:
     """COCOeval's interpolated precision-recall curve at IoU 0.5."""
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(4, 4))
     if curve:
         precision = [max(p, 0.0) for p in curve["precision"]]
@@ -117,6 +129,7 @@ def pr_curve(curve: dict | None, ap: float | None, path: Path) -> str:
 
 def confusion_plot(state: dict, path: Path) -> str:
     """The state confusion matrix (rows: ground truth, columns: predicted), counts annotated."""
+    plt = pyplot()
     labels, matrix = state["confusion"]["labels"], state["confusion"]["matrix"]
     fig, ax = plt.subplots(figsize=(4.5, 4))
     ax.imshow(matrix, cmap="Blues")

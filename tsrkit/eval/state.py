@@ -11,7 +11,6 @@ from collections import Counter
 from collections.abc import Mapping, Sequence
 
 import numpy as np
-from sklearn.metrics import confusion_matrix, precision_recall_fscore_support
 
 from tsrkit.eval.matching import centre_hits, greedy_match
 from tsrkit.eval.settings import EvalSettings
@@ -54,6 +53,8 @@ def state_metrics(
     """
     if len(truth) != len(predicted):
         raise ValueError(f"{len(truth)} true states but {len(predicted)} predictions")
+    from sklearn.metrics import confusion_matrix  # on first use: sklearn is slow to import
+
     labels = label_order(set(truth) | set(predicted))
     matrix = (
         confusion_matrix(truth, predicted, labels=labels)
@@ -96,6 +97,8 @@ def per_class(
     """
     if not len(truth):
         return {}
+    from sklearn.metrics import precision_recall_fscore_support
+
     precision, recall, _, support = precision_recall_fscore_support(
         truth, predicted, labels=list(labels), zero_division=np.nan
     )

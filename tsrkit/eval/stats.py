@@ -10,7 +10,6 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
-from scipy import stats
 
 ALPHA = 0.05
 
@@ -30,6 +29,8 @@ def bootstrap_interval(
         return None
     if np.all(data == data[0]):
         return [float(data[0])] * 2
+    from scipy import stats  # on first use: scipy.stats costs half a second to import
+
     result = stats.bootstrap(
         (data,),
         np.mean,
@@ -53,7 +54,9 @@ def paired_test(
     if x.shape != y.shape:
         raise ValueError(f"paired values differ in length: {x.size} and {y.size}")
     diff = x - y
-    p_value = 1.0 if not np.any(diff) else float(stats.wilcoxon(x, y, zero_method="wilcox").pvalue)
+    from scipy.stats import wilcoxon
+
+    p_value = 1.0 if not np.any(diff) else float(wilcoxon(x, y, zero_method="wilcox").pvalue)
     mean = float(diff.mean()) if diff.size else 0.0
     if p_value < ALPHA:
         verdict = f"{name_a} better" if mean > 0 else f"{name_b} better"

@@ -14,9 +14,9 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-from sklearn.ensemble import HistGradientBoostingClassifier
 
 from tsrkit.errors import TsrkitError
 from tsrkit.hookspecs import hookimpl
@@ -28,6 +28,9 @@ from tsrkit.types import Candidate, Detection, Frame, Sample
 from tsrkit_plugins.classifiers.ab_hist import AbHist
 from tsrkit_plugins.classifiers.lamp_state.features import N_FEATURES, VERSION, lamp_features
 from tsrkit_plugins.verifiers.persistence import estimator_arrays, load_estimator
+
+if TYPE_CHECKING:  # scikit-learn loads when a model is fitted or read, not on import
+    from sklearn.ensemble import HistGradientBoostingClassifier
 
 #: The states lamp-state can learn (those present in the training data are learned).
 STATES = ("red", "yellow", "green", "red_yellow")
@@ -93,6 +96,8 @@ def fit_estimator(
     features: np.ndarray, labels: np.ndarray, params
 ) -> tuple[HistGradientBoostingClassifier, list[str]]:
     """The classifier of ``labels`` (indices into :data:`STATES`) and the states it knows."""
+    from sklearn.ensemble import HistGradientBoostingClassifier
+
     present = sorted(set(labels.tolist()))
     estimator = HistGradientBoostingClassifier(
         max_iter=params["iterations"],
