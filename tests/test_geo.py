@@ -127,3 +127,17 @@ def test_track_verb_writes_the_traversals(tmp_path):
     assert result.exit_code == 0, result.output
     lines = (out / "traversals.jsonl").read_text().splitlines()
     assert len(lines) == 1 and '"movement": "left"' in lines[0]
+
+
+def test_a_car_waiting_at_the_light_anchors_on_its_last_stopped_fix(tmp_path):
+    """Zheng 3.4.2: on a flat valley bottom the latest bottom frame is the anchor."""
+    gps, osm = drive(tmp_path)
+    rows = gps.read_text().splitlines()
+    header, fixes = rows[0], rows[1:]
+    stop = fixes[31]  # (300, 10), 5 m from the merged junction: the car waits there 5 s
+    t0 = int(stop.split(",")[0])
+    waiting = [f"{t0 + k}," + stop.split(",", 1)[1] for k in range(6)]
+    later = [f"{int(f.split(',')[0]) + 5}," + f.split(",", 1)[1] for f in fixes[32:]]
+    gps.write_text("\n".join([header, *fixes[:31], *waiting, *later]) + "\n")
+    (found,) = traversals(read_track(gps), read_signals(osm), 30.0)
+    assert found.anchor == t0 + 5 and found.movement == "left"

@@ -2,7 +2,8 @@
 
 Every fix gets its nearest intersection and distance (scipy's cKDTree on locally projected
 metres); a traversal is a maximal run of fixes within ``vicinity`` metres of the same
-intersection. Its anchor is the closest fix; its movement compares the heading before entering
+intersection. Its anchor is the closest fix (the latest of equally close ones: a car waiting at
+the light); its movement compares the heading before entering
 with the heading after leaving (Eq. 3.29): a turn of more than ``theta_min`` degrees to the left
 or right, else through.
 """
@@ -91,6 +92,16 @@ def _heading(x: np.ndarray, y: np.ndarray, a: int, b: int) -> float:
     return float(np.degrees(np.arctan2(y[b] - y[a], x[b] - x[a])))
 
 
+def latest_minimum(values: np.ndarray) -> int:
+    """Index of the valley bottom of a vicinity profile: "when the valley bottom is flat, the
+    latest bottom frame is chosen as the anchor frame" (Zheng 2016, 3.4.2).
+
+    >>> latest_minimum(np.array([9.0, 4.0, 4.0, 7.0]))
+    2
+    """
+    return len(values) - 1 - int(np.argmin(values[::-1]))
+
+
 def traversals(
     track: Track, signals: Signals, vicinity: float = 30.0, lead: int = 3
 ) -> list[Traversal]:
@@ -113,7 +124,7 @@ def traversals(
         j = i
         while j + 1 < n and inside[j + 1] and nearest[j + 1] == nearest[i]:
             j += 1
-        anchor = i + int(np.argmin(distance[i : j + 1]))
+        anchor = latest_minimum(distance[i : j + 1]) + i
         before, after = max(i - lead, 0), min(j + lead, n - 1)
         heading_in = (
             _heading(x, y, before, anchor) if anchor > before else _heading(x, y, anchor, after)
