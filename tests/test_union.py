@@ -56,6 +56,13 @@ def test_min_distance_merges_radius_less_centres():
     assert len(merge([a, b], factor=1.0, min_distance=2.0)) == 2
 
 
+def test_a_large_blob_swallows_a_nearby_lens_only_when_the_larger_radius_sets_the_reach():
+    blob = [Candidate.from_circle(100, 100, 40, 1.0)]  # a bright region, 40 px "radius"
+    lens = [Candidate.from_circle(125, 100, 3, 1.0)]  # a lamp 25 px from its centre
+    assert len(merge([blob, lens], factor=1.0, min_distance=3.0)) == 1
+    assert len(merge([blob, lens], factor=1.0, min_distance=3.0, reach_by="smaller")) == 2
+
+
 def test_union_finds_what_each_member_finds_on_a_rendered_head():
     image = background(240, 320, seed=3)
     head = render_head(image, (160.0, 120.0), 6, 3, 0)
