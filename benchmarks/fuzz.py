@@ -20,11 +20,13 @@ Surfaces:
 from __future__ import annotations
 
 import argparse
+import itertools
 import shutil
 import tempfile
 import time
 import traceback
 from collections import Counter
+from collections.abc import Callable
 from pathlib import Path
 
 import cv2
@@ -89,6 +91,23 @@ def fuzz(name: str, seeds: list[bytes], target, cases: int, rng, allowed) -> Cou
     return counts
 
 
+def rotating_target(files: list[Path], read) -> Callable[[bytes], None]:
+    """A fuzz target that writes each case over the next of ``files`` in turn, calls ``read()``
+    and puts the file's original bytes back."""
+    turn = itertools.count()
+
+    def target(data: bytes) -> None:
+        victim = files[next(turn) % len(files)]
+        original = victim.read_bytes()
+        victim.write_bytes(data)
+        try:
+            read()
+        finally:
+            victim.write_bytes(original)
+
+    return target
+
+
 def image_surface(folder: Path):
     seeds = []
     image = np.random.default_rng(1).integers(0, 255, (24, 32, 3), dtype=np.uint8)
@@ -116,18 +135,7 @@ def format_surface(folder: Path, fmt: str, dataset: Dataset):
     seeds = [p.read_bytes() for p in files]
     ref = out / ("annotations.json" if fmt in ("coco", "normalized") else "data")
 
-    def target(data: bytes) -> None:
-        victim = files[target.k % len(files)]  # type: ignore[attr-defined]
-        target.k += 1  # type: ignore[attr-defined]
-        original = victim.read_bytes()
-        victim.write_bytes(data)
-        try:
-            open_dataset(ref, format=fmt)
-        finally:
-            victim.write_bytes(original)
-
-    target.k = 0  # type: ignore[attr-defined]
-    return seeds, target, TsrkitError
+    return seeds, rotating_target(files, lambda: open_dataset(ref, format=fmt)), TsrkitError
 
 
 #: A small valid annotation file of each read-only format (one 24x24 image ``a.png``).
@@ -209,18 +217,7 @@ def model_surface(folder: Path):
     files = [folder / "model.json", folder / "model.npz"]
     seeds = [f.read_bytes() for f in files]
 
-    def target(data: bytes) -> None:
-        victim = files[target.k % len(files)]  # type: ignore[attr-defined]
-        target.k += 1  # type: ignore[attr-defined]
-        original = victim.read_bytes()
-        victim.write_bytes(data)
-        try:
-            load_model(base, plugin="p")
-        finally:
-            victim.write_bytes(original)
-
-    target.k = 0  # type: ignore[attr-defined]
-    return seeds, target, ModelError
+    return seeds, rotating_target(files, lambda: load_model(base, plugin="p")), ModelError
 
 
 def params_surface():
