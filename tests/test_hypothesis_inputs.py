@@ -175,6 +175,19 @@ def test_yolo_reader_is_total(work, data):
     check_reader_total(root / "data.yaml", "yolo")
 
 
+@pytest.mark.parametrize("names", [{"\u00b2": "red"}, ["red"]])
+def test_yolo_superscript_digits_are_not_class_ids(work, names):
+    """Found by the test above: ``'\u00b2'.isdigit()`` is true but ``int('\u00b2')`` raises."""
+    root = work / "yolo_sup"
+    (root / "images").mkdir(parents=True, exist_ok=True)
+    (root / "labels").mkdir(exist_ok=True)
+    cv2.imwrite(str(root / "images" / "a.png"), np.zeros((24, 24, 3), np.uint8))
+    (root / "data.yaml").write_text(yaml.safe_dump({"names": names, "train": "images"}))
+    (root / "labels" / "a.txt").write_text("\u00b2 0.5 0.5 0.1 0.1\n")
+    with pytest.raises(TsrkitError, match="not an"):
+        open_dataset(root / "data.yaml", format="yolo")
+
+
 HEADERS = {
     "gtsrb": ("GT-00000.csv", "Filename;Width;Height;Roi.X1;Roi.Y1;Roi.X2;Roi.Y2;ClassId", ";", 8),
     "lisa": (

@@ -63,7 +63,7 @@ def class_names(folder: Path) -> dict[int, str]:
     names = {}
     for number, line in enumerate(read_text(file).splitlines(), 1):
         first, sep, name = line.strip().partition(";")
-        if sep and first.strip().isdigit():
+        if sep and first.strip().isdecimal():
             names[int(first)] = name.strip()
         elif sep and number > 2:
             raise DatasetError(
@@ -120,7 +120,7 @@ def _rows(file: Path, delimiter: str, columns: tuple[str, ...]):
 
 
 def _class_id(file: Path, value: str, where: str) -> int:
-    if not value.strip().isdigit():
+    if not value.strip().isdecimal():
         raise DatasetError(file, f"class id must be a non-negative integer, got {value!r}", where)
     return int(value)
 

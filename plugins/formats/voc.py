@@ -156,7 +156,7 @@ def _sample(file: Path, images: Path | None, split: str | None) -> Sample:
         if box is None:
             raise DatasetError(file, "missing <bndbox>", where)
         bbox = checked_box([_text(box, k, file, where) for k in COORDS], file, where)
-        flags = {k: int(obj.findtext(k)) for k in FLAGS if (obj.findtext(k) or "").isdigit()}
+        flags = {k: int(obj.findtext(k)) for k in FLAGS if (obj.findtext(k) or "").isdecimal()}
         state = explicit_state(
             {"state": obj.findtext("state")} if obj.find("state") is not None else {}, file, where
         )
@@ -164,7 +164,7 @@ def _sample(file: Path, images: Path | None, split: str | None) -> Sample:
     size = {
         k: int(root.findtext(f"size/{k}"))
         for k in ("width", "height")
-        if (root.findtext(f"size/{k}") or "").strip().isdigit()
+        if (root.findtext(f"size/{k}") or "").strip().isdecimal()
     }
     return Sample(_image(file, root, images), tuple(annotations), split=split, **size)
 

@@ -56,7 +56,7 @@ def class_table(data: dict, file: Path) -> dict[int, str]:
     pairs = names.items() if isinstance(names, dict) else enumerate(names)
     table = {}
     for key, name in pairs:
-        if isinstance(key, str) and key.strip().isdigit():
+        if isinstance(key, str) and key.strip().isdecimal():
             key = int(key)
         if isinstance(key, bool) or not isinstance(key, int):
             raise DatasetError(file, f"class id {key!r} is not an integer", "names")
@@ -184,7 +184,7 @@ def _sample(image: Path, split: str, classes: dict[int, str], data_file: Path) -
     annotations = []
     for number, tokens in rows:
         where = f"line {number}"
-        if not tokens[0].isdigit() or int(tokens[0]) not in classes:
+        if not tokens[0].isdecimal() or int(tokens[0]) not in classes:
             raise DatasetError(
                 label_file, f"class {tokens[0]!r} is not an id of {data_file.name} names", where
             )
