@@ -8,7 +8,7 @@ disk that is not sky or a blue housing: the lit lens.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 
 import cv2
@@ -90,16 +90,63 @@ def rings(image: np.ndarray, x: float, y: float, radius: float) -> Rings:
     >>> int(r.disk.sum()), int(r.annulus.sum())
     (13, 36)
     """
-    if radius <= 0:
-        raise ValueError(f"lens radius must be positive; got {radius}")
+    area = ring_pixels(image, [(x, y, radius)])
+    x0, y0, x1, y1 = (int(v) for v in area.boxes[0])
+    shape = (y1 - y0, x1 - x0)
+    return Rings(image[y0:y1, x0:x1], area.disk.reshape(shape), area.annulus.reshape(shape))
+
+
+@dataclass(frozen=True)
+class RingPixels:
+    """The pixels of the :func:`rings` patches of several lenses, flattened and concatenated
+    (each patch row by row, the lenses in order).
+
+    ``boxes`` (N, 4) are the patches ``(x0, y0, x1, y1)``; per pixel, ``owner`` is the index of
+    its lens, ``rows`` and ``cols`` its place in the image, ``disk`` and ``annulus`` whether it
+    lies in that lens's A1 or A3.
+    """
+
+    boxes: np.ndarray
+    owner: np.ndarray
+    rows: np.ndarray
+    cols: np.ndarray
+    disk: np.ndarray
+    annulus: np.ndarray
+
+
+def ring_pixels(image: np.ndarray, lenses: Sequence[tuple[float, float, float]]) -> RingPixels:
+    """The :func:`rings` patches and masks of every lens ``(x, y, radius)`` at once.
+
+    Raises
+    ------
+    ValueError
+        A non-positive radius, or a lens whose patch lies outside the image.
+    """
     h, w = image.shape[:2]
-    outer = 2 * radius
-    x0, y0, x1, y1 = clip_box((x - outer, y - outer, x + outer, y + outer), w, h)
-    yy, xx = np.mgrid[y0:y1, x0:x1]
-    dist2 = (xx + 0.5 - x) ** 2 + (yy + 0.5 - y) ** 2
-    disk = dist2 <= radius**2
-    annulus = ~disk & (dist2 <= outer**2)
-    return Rings(image[y0:y1, x0:x1], disk, annulus)
+    boxes, lens = [], []
+    for x, y, radius in lenses:
+        if radius <= 0:
+            raise ValueError(f"lens radius must be positive; got {radius}")
+        outer = 2 * radius
+        boxes.append(clip_box((x - outer, y - outer, x + outer, y + outer), w, h))
+        lens.append((x, y, radius**2, outer**2))
+    box = np.array(boxes, np.int64).reshape(-1, 4)
+    x, y, radius2, outer2 = np.array(lens, np.float64).reshape(-1, 4).T
+    # one entry per patch row, then each repeated over the row's pixels
+    heights = box[:, 3] - box[:, 1]
+    row_owner = np.repeat(np.arange(len(box)), heights)
+    row_y = np.arange(len(row_owner)) + np.repeat(box[:, 1] - np.cumsum(heights) + heights, heights)
+    width = (box[:, 2] - box[:, 0])[row_owner]
+    start = np.cumsum(width) - width
+    owner = np.repeat(row_owner, width)
+    rows = np.repeat(row_y, width)
+    cols = np.arange(int(width.sum())) + np.repeat(box[row_owner, 0] - start, width)
+    dist2 = (cols + 0.5 - np.repeat(x[row_owner], width)) ** 2 + np.repeat(
+        (row_y + 0.5 - y[row_owner]) ** 2, width
+    )
+    disk = dist2 <= np.repeat(radius2[row_owner], width)
+    annulus = ~disk & (dist2 <= np.repeat(outer2[row_owner], width))
+    return RingPixels(box, owner, rows, cols, disk, annulus)
 
 
 def is_blue(bgr: np.ndarray) -> np.ndarray:
