@@ -134,3 +134,25 @@ def test_find_lens_passes_over_blue_sky():
     image[:20] = (235, 190, 90)  # bright saturated sky blue where the top lens would be
     lens = find_lens(image, (0, 0, 20, 60))
     assert abs(lens.y - 50) <= 2
+
+
+def test_rings_equal_the_per_pixel_distance_test_for_any_lens():
+    """The row runs of ring_pixels give exactly the masks of the per-pixel test they replaced
+    (the squared distance of every patch pixel against radius^2 and (2 radius)^2), for lenses
+    of any size and sub-pixel place, clipped by the border or not."""
+    rng = np.random.default_rng(0)
+    image = np.zeros((60, 90, 3), np.uint8)
+    for _ in range(3000):
+        r = float(rng.choice([rng.uniform(0.01, 1.5), rng.uniform(0.5, 30), rng.integers(1, 12)]))
+        x = float(rng.choice([rng.uniform(-5, 95), rng.integers(0, 90) + 0.5]))
+        y = float(rng.choice([rng.uniform(-5, 65), rng.integers(0, 60) + 0.5]))
+        try:
+            area = rings(image, x, y, r)
+        except ValueError:
+            continue
+        x0, y0 = clip_box((x - 2 * r, y - 2 * r, x + 2 * r, y + 2 * r), 90, 60)[:2]
+        h, w = area.disk.shape
+        yy, xx = np.mgrid[y0 : y0 + h, x0 : x0 + w]
+        dist2 = (xx + 0.5 - x) ** 2 + (yy + 0.5 - y) ** 2
+        assert np.array_equal(area.disk, dist2 <= r**2)
+        assert np.array_equal(area.annulus, (dist2 > r**2) & (dist2 <= (2 * r) ** 2))

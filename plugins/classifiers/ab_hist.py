@@ -44,13 +44,14 @@ def ab_histograms(
     -------
     ndarray of shape (n, bins, bins), float32 (a along rows, b along columns)
     """
+    cells = bins * bins
     index = (np.arange(256) * bins) // 256
-    who = region[mask]
-    key = (who * bins + index[lab[mask, 1]]) * bins + index[lab[mask, 2]]
-    hist = np.bincount(key, minlength=n * bins * bins).astype(np.float32)
-    hist = hist.reshape(n, bins, bins)
-    count = np.bincount(who, minlength=n).astype(np.float32)[:, None, None]
-    return np.divide(hist, count, out=hist, where=count > 0)
+    ab = index[lab[:, 1]] * bins + index[lab[:, 2]]
+    key = region * (cells + 1) + np.where(mask, ab, cells)  # unmasked pixels: a spare bin
+    counts = np.bincount(key, minlength=n * (cells + 1)).reshape(n, cells + 1)[:, :cells]
+    total = counts.sum(axis=1).astype(np.float32)[:, None, None]
+    hist = counts.astype(np.float32).reshape(n, bins, bins)
+    return np.divide(hist, total, out=hist, where=total > 0)
 
 
 def smooth_histograms(h: np.ndarray, sigma: float) -> np.ndarray:
@@ -99,10 +100,11 @@ def similarities(h: np.ndarray, refs: np.ndarray) -> np.ndarray:
 
 
 def mean_saturations(saturation: np.ndarray, region: np.ndarray, n: int) -> np.ndarray:
-    """Mean HSV saturation of the pixels of each of ``n`` regions (0 for an empty one)."""
-    total = np.bincount(region, weights=saturation.astype(np.float64), minlength=n)
-    count = np.bincount(region, minlength=n)
-    return np.divide(total, count, out=np.zeros(n), where=count > 0)
+    """Mean HSV saturation (uint8) of the pixels of each of ``n`` regions (0 for an empty
+    one), from each region's histogram of the 256 levels (integer sums: exact)."""
+    hist = np.bincount(region * 256 + saturation, minlength=n * 256).reshape(n, 256)
+    count = hist.sum(axis=1)
+    return np.divide(hist @ np.arange(256), count, out=np.zeros(n), where=count > 0)
 
 
 def chroma(lab: np.ndarray) -> np.ndarray:
@@ -128,9 +130,8 @@ def lens_histograms(
     """
     n = len(lenses)
     area = ring_pixels(image, [(c.x, c.y, c.radius) for c in lenses])
-    inside = np.flatnonzero(area.disk | area.annulus)
-    region = area.owner[inside] * 2 + area.annulus[inside]  # A1 of lens i: 2i, A3: 2i + 1
-    where = area.rows[inside] * image.shape[1] + area.cols[inside]
+    region = area.owner * 2 + area.annulus  # A1 of lens i: 2i, A3: 2i + 1
+    where = area.rows * image.shape[1] + area.cols
     pixels = np.take(image.reshape(-1, 3), where, axis=0)[None]
     lab = cv2.cvtColor(pixels, cv2.COLOR_BGR2LAB)[0]
     saturation = mean_saturations(cv2.cvtColor(pixels, cv2.COLOR_BGR2HSV)[0][:, 1], region, 2 * n)

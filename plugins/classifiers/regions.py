@@ -92,30 +92,59 @@ def rings(image: np.ndarray, x: float, y: float, radius: float) -> Rings:
     """
     area = ring_pixels(image, [(x, y, radius)])
     x0, y0, x1, y1 = (int(v) for v in area.boxes[0])
-    shape = (y1 - y0, x1 - x0)
-    return Rings(image[y0:y1, x0:x1], area.disk.reshape(shape), area.annulus.reshape(shape))
+    disk = np.zeros((y1 - y0, x1 - x0), bool)
+    annulus = np.zeros_like(disk)
+    disk[area.rows - y0, area.cols - x0] = ~area.annulus
+    annulus[area.rows - y0, area.cols - x0] = area.annulus
+    return Rings(image[y0:y1, x0:x1], disk, annulus)
 
 
 @dataclass(frozen=True)
 class RingPixels:
-    """The pixels of the :func:`rings` patches of several lenses, flattened and concatenated
-    (each patch row by row, the lenses in order).
+    """The A1 and A3 pixels of the :func:`rings` patches of several lenses, flattened and
+    concatenated (each patch row by row, the lenses in order).
 
     ``boxes`` (N, 4) are the patches ``(x0, y0, x1, y1)``; per pixel, ``owner`` is the index of
-    its lens, ``rows`` and ``cols`` its place in the image, ``disk`` and ``annulus`` whether it
-    lies in that lens's A1 or A3.
+    its lens, ``rows`` and ``cols`` its place in the image, and ``annulus`` whether it lies in
+    A3 (else it lies in A1).
     """
 
     boxes: np.ndarray
     owner: np.ndarray
     rows: np.ndarray
     cols: np.ndarray
-    disk: np.ndarray
     annulus: np.ndarray
 
 
+def _run(x: np.ndarray, dy2: np.ndarray, limit: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per row, the columns ``c`` with ``(c + 0.5 - x) ** 2 + dy2 <= limit`` as ``[lo, hi)``
+    (``lo == hi``: none).
+
+    Those columns are one run: along a row the rounded squared distance falls, then rises
+    (every rounding step is monotone). Its ends are estimated with a square root and then
+    settled by the exact test on the two columns either side of each estimate.
+    """
+    half = np.sqrt(np.maximum(limit - dy2, 0.0))
+    window = np.arange(-2, 3)
+    ends = []
+    for estimate in (np.ceil(x - 0.5 - half), np.floor(x - 0.5 + half)):
+        cols = estimate.astype(np.int64)[:, None] + window
+        ends.append((cols, (cols + 0.5 - x[:, None]) ** 2 + dy2[:, None] <= limit[:, None]))
+    (first, first_in), (last, last_in) = ends
+    found = first_in.any(axis=1)
+    rows = np.arange(len(x))
+    lo = first[rows, first_in.argmax(axis=1)]
+    hi = last[rows, len(window) - 1 - last_in[:, ::-1].argmax(axis=1)] + 1
+    return np.where(found, lo, 0), np.where(found, hi, 0)
+
+
 def ring_pixels(image: np.ndarray, lenses: Sequence[tuple[float, float, float]]) -> RingPixels:
-    """The :func:`rings` patches and masks of every lens ``(x, y, radius)`` at once.
+    """The :func:`rings` patches and the A1 and A3 pixels of every lens ``(x, y, radius)``.
+
+    A pixel lies in A1 when its squared distance ``(col + 0.5 - x) ** 2 + (row + 0.5 - y) ** 2``
+    is at most ``radius ** 2``, else in A3 when at most ``(2 radius) ** 2``. Each patch row's
+    A1 and A3 pixels are runs of columns (:func:`_run`), so only the rows are computed, and
+    the pixels are laid out from the runs.
 
     Raises
     ------
@@ -132,21 +161,25 @@ def ring_pixels(image: np.ndarray, lenses: Sequence[tuple[float, float, float]])
         lens.append((x, y, radius**2, outer**2))
     box = np.array(boxes, np.int64).reshape(-1, 4)
     x, y, radius2, outer2 = np.array(lens, np.float64).reshape(-1, 4).T
-    # one entry per patch row, then each repeated over the row's pixels
     heights = box[:, 3] - box[:, 1]
     row_owner = np.repeat(np.arange(len(box)), heights)
     row_y = np.arange(len(row_owner)) + np.repeat(box[:, 1] - np.cumsum(heights) + heights, heights)
-    width = (box[:, 2] - box[:, 0])[row_owner]
+    row_x, dy2 = x[row_owner], (row_y + 0.5 - y[row_owner]) ** 2
+    left, right = box[row_owner, 0], box[row_owner, 2]
+    lo, hi = (np.clip(end, left, right) for end in _run(row_x, dy2, outer2[row_owner]))
+    hi = np.maximum(hi, lo)
+    disk_lo, disk_hi = (np.clip(end, lo, hi) for end in _run(row_x, dy2, radius2[row_owner]))
+    disk_hi = np.maximum(disk_hi, disk_lo)
+    width = hi - lo
     start = np.cumsum(width) - width
-    owner = np.repeat(row_owner, width)
-    rows = np.repeat(row_y, width)
-    cols = np.arange(int(width.sum())) + np.repeat(box[row_owner, 0] - start, width)
-    dist2 = (cols + 0.5 - np.repeat(x[row_owner], width)) ** 2 + np.repeat(
-        (row_y + 0.5 - y[row_owner]) ** 2, width
+    parts = np.column_stack([disk_lo - lo, disk_hi - disk_lo, hi - disk_hi]).ravel()
+    return RingPixels(
+        box,
+        np.repeat(row_owner, width),
+        np.repeat(row_y, width),
+        np.arange(int(width.sum())) + np.repeat(lo - start, width),
+        np.repeat(np.tile([True, False, True], len(width)), parts),
     )
-    disk = dist2 <= np.repeat(radius2[row_owner], width)
-    annulus = ~disk & (dist2 <= np.repeat(outer2[row_owner], width))
-    return RingPixels(box, owner, rows, cols, disk, annulus)
 
 
 def is_blue(bgr: np.ndarray) -> np.ndarray:
