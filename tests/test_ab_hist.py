@@ -9,7 +9,7 @@ from oracles.lamps import COLOURS, lamp, training_set
 from tsrkit.models import ModelError, load_model, save_model
 from tsrkit.registry import get_registry
 from tsrkit.types import Candidate, Frame
-from tsrkit_plugins.classifiers.ab_hist import ab_histograms, similarities
+from tsrkit_plugins.classifiers.ab_hist import ab_cells, ab_histograms, similarities
 from tsrkit_plugins.classifiers.decision import discriminative_ratio
 
 
@@ -37,7 +37,8 @@ def test_histograms_match_numpy_histogram2d_region_by_region():
     lab = rng.integers(0, 256, (180, 3), dtype=np.uint8)
     region = rng.integers(0, 3, 180)
     mask = (rng.random(180) < 0.6) & (region != 2)
-    got = ab_histograms(lab, region, mask, 3, 8)
+    cells = ab_cells(8, 0.0).take(lab[:, 1].astype(int) * 256 + lab[:, 2])
+    got = ab_histograms(np.where(mask, cells, 64), region, 3, 8)
     for i in range(2):
         chosen = mask & (region == i)
         expected, _, _ = np.histogram2d(
@@ -46,6 +47,13 @@ def test_histograms_match_numpy_histogram2d_region_by_region():
         assert np.allclose(got[i], expected / chosen.sum())
         assert got[i].sum() == pytest.approx(1.0)
     assert got.shape == (3, 8, 8) and not got[2].any()
+
+
+def test_cells_leave_out_colours_below_the_chroma_floor():
+    cells = ab_cells(8, 10.0)
+    assert cells[128 * 256 + 128] == 64  # grey (a = b = 128): chroma 0, the spare cell
+    assert cells[200 * 256 + 128] == 6 * 8 + 4  # chroma 72: a in bin 6, b in bin 4
+    assert cells[133 * 256 + 134] == 64 and ab_cells(8, 0.0)[133 * 256 + 134] == 4 * 8 + 4
 
 
 def test_similarity_is_one_for_equal_and_zero_for_disjoint_histograms():

@@ -5,6 +5,7 @@ histogram per colour; the best match wins, and a low discriminative ratio gives 
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 
@@ -23,32 +24,41 @@ from tsrkit_plugins.classifiers.regions import (
     labelled_lenses,
     lens_of,
     region_params,
-    ring_pixels,
+    ring_runs,
 )
 
 DEFAULT_MODEL = Path(__file__).parent / "models" / "ab_hist_default"
 MODES = ("max", "saturation")
 
 
-def ab_histograms(
-    lab: np.ndarray, region: np.ndarray, mask: np.ndarray, n: int, bins: int
-) -> np.ndarray:
+@functools.lru_cache(maxsize=16)
+def ab_cells(bins: int, min_chroma: float) -> np.ndarray:
+    """The histogram cell of every 8-bit CIELab (a, b) pair, indexed ``256 a + b``.
+
+    A pair in a-bin ``i`` and b-bin ``j`` (each axis cut into ``bins`` equal bins, as
+    ``cv2.calcHist`` does: bin ``floor(v * bins / 256)``) has cell ``bins * i + j``; a pair of
+    chroma below ``min_chroma`` has the spare cell ``bins * bins``, counted nowhere.
+    """
+    a, b = np.divmod(np.arange(65536), 256)
+    lab = np.column_stack([np.zeros_like(a), a, b]).astype(np.uint8)
+    index = (np.arange(256) * bins) // 256
+    cell = np.where(chroma(lab) >= min_chroma, index[a] * bins + index[b], bins * bins)
+    cell.flags.writeable = False
+    return cell
+
+
+def ab_histograms(cells: np.ndarray, region: np.ndarray, n: int, bins: int) -> np.ndarray:
     """Eq. 3.16-3.18: the a-b histogram of each of ``n`` regions, divided by its pixel count.
 
-    ``lab`` (P, 3) is OpenCV's 8-bit CIELab of P pixels (a and b offset by 128, range 0-255),
-    ``region`` (P,) the region of each pixel (0 to n - 1) and ``mask`` (P,) the pixels counted;
-    each axis is cut into ``bins`` equal bins, as ``cv2.calcHist`` does (bin
-    ``floor(v * bins / 256)``). An empty region gives an all-zero histogram.
+    ``cells`` (P,) is the :func:`ab_cells` cell of each pixel (``bins * bins``: not counted)
+    and ``region`` (P,) its region (0 to n - 1). An empty region gives an all-zero histogram.
 
     Returns
     -------
     ndarray of shape (n, bins, bins), float32 (a along rows, b along columns)
     """
-    cells = bins * bins
-    index = (np.arange(256) * bins) // 256
-    ab = index[lab[:, 1]] * bins + index[lab[:, 2]]
-    key = region * (cells + 1) + np.where(mask, ab, cells)  # unmasked pixels: a spare bin
-    counts = np.bincount(key, minlength=n * (cells + 1)).reshape(n, cells + 1)[:, :cells]
+    per = bins * bins + 1
+    counts = np.bincount(region * per + cells, minlength=n * per).reshape(n, per)[:, :-1]
     total = counts.sum(axis=1).astype(np.float32)[:, None, None]
     hist = counts.astype(np.float32).reshape(n, bins, bins)
     return np.divide(hist, total, out=hist, where=total > 0)
@@ -129,13 +139,15 @@ def lens_histograms(
         A1 and A3 histograms, each (N, bins, bins), and a boolean (N,).
     """
     n = len(lenses)
-    area = ring_pixels(image, [(c.x, c.y, c.radius) for c in lenses])
-    region = area.owner * 2 + area.annulus  # A1 of lens i: 2i, A3: 2i + 1
-    where = area.rows * image.shape[1] + area.cols
+    area = ring_runs(image, [(c.x, c.y, c.radius) for c in lenses])
+    run, offset = area.pixels()
+    region = (area.owner * 2 + area.annulus).take(run)  # A1 of lens i: 2i, A3: 2i + 1
+    where = (area.row * image.shape[1] + area.col).take(run) + offset
     pixels = np.take(image.reshape(-1, 3), where, axis=0)[None]
     lab = cv2.cvtColor(pixels, cv2.COLOR_BGR2LAB)[0]
     saturation = mean_saturations(cv2.cvtColor(pixels, cv2.COLOR_BGR2HSV)[0][:, 1], region, 2 * n)
-    hist = ab_histograms(lab, region, chroma(lab) >= min_chroma, 2 * n, bins)
+    ab = (lab[:, 1].astype(np.intp) << 8) | lab[:, 2]
+    hist = ab_histograms(ab_cells(bins, min_chroma).take(ab), region, 2 * n, bins)
     return hist[0::2], hist[1::2], saturation[0::2] >= saturation[1::2]
 
 

@@ -90,30 +90,44 @@ def rings(image: np.ndarray, x: float, y: float, radius: float) -> Rings:
     >>> int(r.disk.sum()), int(r.annulus.sum())
     (13, 36)
     """
-    area = ring_pixels(image, [(x, y, radius)])
+    area = ring_runs(image, [(x, y, radius)])
     x0, y0, x1, y1 = (int(v) for v in area.boxes[0])
+    run, offset = area.pixels()
+    rows, cols = area.row.take(run) - y0, area.col.take(run) + offset - x0
     disk = np.zeros((y1 - y0, x1 - x0), bool)
     annulus = np.zeros_like(disk)
-    disk[area.rows - y0, area.cols - x0] = ~area.annulus
-    annulus[area.rows - y0, area.cols - x0] = area.annulus
+    disk[rows, cols] = ~area.annulus.take(run)
+    annulus[rows, cols] = area.annulus.take(run)
     return Rings(image[y0:y1, x0:x1], disk, annulus)
 
 
 @dataclass(frozen=True)
-class RingPixels:
-    """The A1 and A3 pixels of the :func:`rings` patches of several lenses, flattened and
-    concatenated (each patch row by row, the lenses in order).
+class RingRuns:
+    """The A1 and A3 pixels of the :func:`rings` patches of several lenses as runs along the
+    patch rows (lens by lens, row by row, left to right; no run empty).
 
-    ``boxes`` (N, 4) are the patches ``(x0, y0, x1, y1)``; per pixel, ``owner`` is the index of
-    its lens, ``rows`` and ``cols`` its place in the image, and ``annulus`` whether it lies in
-    A3 (else it lies in A1).
+    ``boxes`` (N, 4) are the patches ``(x0, y0, x1, y1)``; per run, ``owner`` is its lens,
+    ``row`` and ``col`` its first pixel, ``length`` its pixel count and ``annulus`` whether it
+    lies in A3 (else in A1).
     """
 
     boxes: np.ndarray
     owner: np.ndarray
-    rows: np.ndarray
-    cols: np.ndarray
+    row: np.ndarray
+    col: np.ndarray
+    length: np.ndarray
     annulus: np.ndarray
+
+    def pixels(self) -> tuple[np.ndarray, np.ndarray]:
+        """The run of every pixel of the runs laid end to end, and the pixel's offset in it.
+
+        Per-run values reach the pixels by ``take`` (faster than ``np.repeat``).
+        """
+        start = np.cumsum(self.length) - self.length
+        run = np.zeros(int(self.length.sum()), np.int64)
+        run[start[1:]] = 1
+        run = np.cumsum(run)
+        return run, np.arange(len(run)) - start.take(run)
 
 
 def _run(x: np.ndarray, dy2: np.ndarray, limit: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -138,13 +152,13 @@ def _run(x: np.ndarray, dy2: np.ndarray, limit: np.ndarray) -> tuple[np.ndarray,
     return np.where(found, lo, 0), np.where(found, hi, 0)
 
 
-def ring_pixels(image: np.ndarray, lenses: Sequence[tuple[float, float, float]]) -> RingPixels:
-    """The :func:`rings` patches and the A1 and A3 pixels of every lens ``(x, y, radius)``.
+def ring_runs(image: np.ndarray, lenses: Sequence[tuple[float, float, float]]) -> RingRuns:
+    """The :func:`rings` patches and the A1 and A3 runs of every lens ``(x, y, radius)``.
 
     A pixel lies in A1 when its squared distance ``(col + 0.5 - x) ** 2 + (row + 0.5 - y) ** 2``
     is at most ``radius ** 2``, else in A3 when at most ``(2 radius) ** 2``. Each patch row's
-    A1 and A3 pixels are runs of columns (:func:`_run`), so only the rows are computed, and
-    the pixels are laid out from the runs.
+    A1 and A3 pixels are runs of columns (:func:`_run`), so only the rows are computed: an
+    A3 run left of the A1 run and one right of it.
 
     Raises
     ------
@@ -152,15 +166,28 @@ def ring_pixels(image: np.ndarray, lenses: Sequence[tuple[float, float, float]])
         A non-positive radius, or a lens whose patch lies outside the image.
     """
     h, w = image.shape[:2]
-    boxes, lens = [], []
-    for x, y, radius in lenses:
-        if radius <= 0:
-            raise ValueError(f"lens radius must be positive; got {radius}")
-        outer = 2 * radius
-        boxes.append(clip_box((x - outer, y - outer, x + outer, y + outer), w, h))
-        lens.append((x, y, radius**2, outer**2))
-    box = np.array(boxes, np.int64).reshape(-1, 4)
-    x, y, radius2, outer2 = np.array(lens, np.float64).reshape(-1, 4).T
+    x, y, radius = np.array(lenses, np.float64).reshape(-1, 3).T
+    for bad in np.flatnonzero(radius <= 0)[:1]:
+        raise ValueError(f"lens radius must be positive; got {lenses[bad][2]}")
+    outer = 2 * radius
+    box = np.column_stack(
+        [
+            np.maximum(0, np.floor(x - outer)),
+            np.maximum(0, np.floor(y - outer)),
+            np.minimum(w, np.ceil(x + outer)),
+            np.minimum(h, np.ceil(y + outer)),
+        ]
+    ).astype(np.int64)
+    for bad in np.flatnonzero((box[:, 2] <= box[:, 0]) | (box[:, 3] <= box[:, 1]))[:1]:
+        clip_box(
+            (x[bad] - outer[bad], y[bad] - outer[bad], x[bad] + outer[bad], y[bad] + outer[bad]),
+            w,
+            h,
+        )
+    # the squares as Python computes them (rings() did), not NumPy's x * x
+    radius2, outer2 = (
+        np.array([(r**2, (2 * r) ** 2) for _, _, r in lenses], np.float64).reshape(-1, 2).T
+    )
     heights = box[:, 3] - box[:, 1]
     row_owner = np.repeat(np.arange(len(box)), heights)
     row_y = np.arange(len(row_owner)) + np.repeat(box[:, 1] - np.cumsum(heights) + heights, heights)
@@ -170,15 +197,16 @@ def ring_pixels(image: np.ndarray, lenses: Sequence[tuple[float, float, float]])
     hi = np.maximum(hi, lo)
     disk_lo, disk_hi = (np.clip(end, lo, hi) for end in _run(row_x, dy2, radius2[row_owner]))
     disk_hi = np.maximum(disk_hi, disk_lo)
-    width = hi - lo
-    start = np.cumsum(width) - width
-    parts = np.column_stack([disk_lo - lo, disk_hi - disk_lo, hi - disk_hi]).ravel()
-    return RingPixels(
+    ends = np.column_stack([lo, disk_lo, disk_hi, hi])
+    length = np.diff(ends, axis=1).ravel()
+    keep = np.flatnonzero(length)
+    return RingRuns(
         box,
-        np.repeat(row_owner, width),
-        np.repeat(row_y, width),
-        np.arange(int(width.sum())) + np.repeat(lo - start, width),
-        np.repeat(np.tile([True, False, True], len(width)), parts),
+        np.repeat(row_owner, 3)[keep],
+        np.repeat(row_y, 3)[keep],
+        ends[:, :3].ravel()[keep],
+        length[keep],
+        np.tile([True, False, True], len(lo))[keep],
     )
 
 
