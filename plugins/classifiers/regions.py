@@ -90,14 +90,15 @@ def rings(image: np.ndarray, x: float, y: float, radius: float) -> Rings:
     >>> int(r.disk.sum()), int(r.annulus.sum())
     (13, 36)
     """
-    area = ring_runs(image, [(x, y, radius)])
-    x0, y0, x1, y1 = (int(v) for v in area.boxes[0])
-    run, offset = area.pixels()
-    rows, cols = area.row.take(run) - y0, area.col.take(run) + offset - x0
-    disk = np.zeros((y1 - y0, x1 - x0), bool)
-    annulus = np.zeros_like(disk)
-    disk[rows, cols] = ~area.annulus.take(run)
-    annulus[rows, cols] = area.annulus.take(run)
+    if radius <= 0:
+        raise ValueError(f"lens radius must be positive; got {radius}")
+    h, w = image.shape[:2]
+    outer = 2 * radius
+    x0, y0, x1, y1 = clip_box((x - outer, y - outer, x + outer, y + outer), w, h)
+    yy, xx = np.mgrid[y0:y1, x0:x1]
+    dist2 = (xx + 0.5 - x) ** 2 + (yy + 0.5 - y) ** 2
+    disk = dist2 <= radius**2
+    annulus = ~disk & (dist2 <= outer**2)
     return Rings(image[y0:y1, x0:x1], disk, annulus)
 
 
@@ -153,12 +154,14 @@ def _run(x: np.ndarray, dy2: np.ndarray, limit: np.ndarray) -> tuple[np.ndarray,
 
 
 def ring_runs(image: np.ndarray, lenses: Sequence[tuple[float, float, float]]) -> RingRuns:
-    """The :func:`rings` patches and the A1 and A3 runs of every lens ``(x, y, radius)``.
+    """The :func:`rings` patches and A1 and A3 pixels of every lens ``(x, y, radius)`` at once.
 
-    A pixel lies in A1 when its squared distance ``(col + 0.5 - x) ** 2 + (row + 0.5 - y) ** 2``
-    is at most ``radius ** 2``, else in A3 when at most ``(2 radius) ** 2``. Each patch row's
-    A1 and A3 pixels are runs of columns (:func:`_run`), so only the rows are computed: an
-    A3 run left of the A1 run and one right of it.
+    The same pixels as :func:`rings` (one lens at a time, where its per-pixel test is the
+    faster): a pixel lies in A1 when its squared distance
+    ``(col + 0.5 - x) ** 2 + (row + 0.5 - y) ** 2`` is at most ``radius ** 2``, else in A3 when
+    at most ``(2 radius) ** 2``. Each patch row's A1 and A3 pixels are runs of columns
+    (:func:`_run`), so only the rows are computed: an A3 run left of the A1 run and one right
+    of it.
 
     Raises
     ------
@@ -167,8 +170,9 @@ def ring_runs(image: np.ndarray, lenses: Sequence[tuple[float, float, float]]) -
     """
     h, w = image.shape[:2]
     x, y, radius = np.array(lenses, np.float64).reshape(-1, 3).T
-    for bad in np.flatnonzero(radius <= 0)[:1]:
-        raise ValueError(f"lens radius must be positive; got {lenses[bad][2]}")
+    bad = np.flatnonzero(radius <= 0)
+    if bad.size:
+        raise ValueError(f"lens radius must be positive; got {lenses[bad[0]][2]}")
     outer = 2 * radius
     box = np.column_stack(
         [
@@ -178,12 +182,10 @@ def ring_runs(image: np.ndarray, lenses: Sequence[tuple[float, float, float]]) -
             np.minimum(h, np.ceil(y + outer)),
         ]
     ).astype(np.int64)
-    for bad in np.flatnonzero((box[:, 2] <= box[:, 0]) | (box[:, 3] <= box[:, 1]))[:1]:
-        clip_box(
-            (x[bad] - outer[bad], y[bad] - outer[bad], x[bad] + outer[bad], y[bad] + outer[bad]),
-            w,
-            h,
-        )
+    bad = np.flatnonzero((box[:, 2] <= box[:, 0]) | (box[:, 3] <= box[:, 1]))
+    if bad.size:
+        cx, cy, r = lenses[bad[0]]
+        clip_box((cx - 2 * r, cy - 2 * r, cx + 2 * r, cy + 2 * r), w, h)  # raises, as rings() did
     # the squares as Python computes them (rings() did), not NumPy's x * x
     radius2, outer2 = (
         np.array([(r**2, (2 * r) ** 2) for _, _, r in lenses], np.float64).reshape(-1, 2).T

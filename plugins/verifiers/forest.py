@@ -7,7 +7,9 @@ one tree level per step, by the rule of scikit-learn's ``_predict_one_from_raw_d
 ``<= num_threshold`` goes left, a missing (NaN) value goes where ``missing_go_to_left`` says.
 The leaf values are summed tree after tree onto the baseline, in scikit-learn's order, and the
 probability is the same ``scipy.special.expit``, so the probabilities equal scikit-learn's to
-the bit (``tests/test_verifier_forest.py``).
+the bit (``tests/test_verifier_forest.py``). The trees are read from the estimator's
+``_predictors`` and ``_baseline_prediction`` (scikit-learn's own arrays; that test would catch
+a change of them).
 """
 
 from __future__ import annotations
