@@ -133,24 +133,23 @@ class RingRuns:
 
 def _run(x: np.ndarray, dy2: np.ndarray, limit: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Per row, the columns ``c`` with ``(c + 0.5 - x) ** 2 + dy2 <= limit`` as ``[lo, hi)``
-    (``lo == hi``: none).
+    (``hi <= lo``: none).
 
     Those columns are one run: along a row the rounded squared distance falls, then rises
-    (every rounding step is monotone). Its ends are estimated with a square root and then
-    settled by the exact test on the two columns either side of each estimate.
+    (every rounding step is monotone). Its ends are estimated with a square root, off by at
+    most one column (the estimate and the test differ by rounding only, far below a pixel), and
+    each is then settled by the exact test on the column beyond it and on itself.
     """
+
+    def inside(c: np.ndarray) -> np.ndarray:
+        return (c + 0.5 - x) ** 2 + dy2 <= limit
+
     half = np.sqrt(np.maximum(limit - dy2, 0.0))
-    window = np.arange(-2, 3)
-    ends = []
-    for estimate in (np.ceil(x - 0.5 - half), np.floor(x - 0.5 + half)):
-        cols = estimate.astype(np.int64)[:, None] + window
-        ends.append((cols, (cols + 0.5 - x[:, None]) ** 2 + dy2[:, None] <= limit[:, None]))
-    (first, first_in), (last, last_in) = ends
-    found = first_in.any(axis=1)
-    rows = np.arange(len(x))
-    lo = first[rows, first_in.argmax(axis=1)]
-    hi = last[rows, len(window) - 1 - last_in[:, ::-1].argmax(axis=1)] + 1
-    return np.where(found, lo, 0), np.where(found, hi, 0)
+    lo = np.ceil(x - 0.5 - half).astype(np.int64)
+    lo = np.where(inside(lo - 1), lo - 1, np.where(inside(lo), lo, lo + 1))
+    hi = np.floor(x - 0.5 + half).astype(np.int64)
+    hi = np.where(inside(hi + 1), hi + 1, np.where(inside(hi), hi, hi - 1))
+    return lo, hi + 1
 
 
 def ring_runs(image: np.ndarray, lenses: Sequence[tuple[float, float, float]]) -> RingRuns:
@@ -195,9 +194,12 @@ def ring_runs(image: np.ndarray, lenses: Sequence[tuple[float, float, float]]) -
     row_y = np.arange(len(row_owner)) + np.repeat(box[:, 1] - np.cumsum(heights) + heights, heights)
     row_x, dy2 = x[row_owner], (row_y + 0.5 - y[row_owner]) ** 2
     left, right = box[row_owner, 0], box[row_owner, 2]
-    lo, hi = (np.clip(end, left, right) for end in _run(row_x, dy2, outer2[row_owner]))
+    limits = np.concatenate([outer2[row_owner], radius2[row_owner]])  # A1 and A3, then A1
+    both = _run(np.tile(row_x, 2), np.tile(dy2, 2), limits)
+    rows = len(row_owner)
+    lo, hi = (np.clip(end[:rows], left, right) for end in both)
     hi = np.maximum(hi, lo)
-    disk_lo, disk_hi = (np.clip(end, lo, hi) for end in _run(row_x, dy2, radius2[row_owner]))
+    disk_lo, disk_hi = (np.clip(end[rows:], lo, hi) for end in both)
     disk_hi = np.maximum(disk_hi, disk_lo)
     ends = np.column_stack([lo, disk_lo, disk_hi, hi])
     length = np.diff(ends, axis=1).ravel()
