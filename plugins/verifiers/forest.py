@@ -29,19 +29,22 @@ if TYPE_CHECKING:  # scikit-learn loads when a model is fitted or read, not on i
 class Forest:
     """The trees of a fitted binary classifier as flat node arrays.
 
-    ``roots`` (T,) index each tree's root in the node arrays; ``children`` (nodes, 2) hold the
-    left and right child (a leaf is its own child on both sides, so that a descent of
-    ``depth`` steps leaves every pair on its leaf); ``value`` is a leaf's raw value.
+    ``roots`` (T,) index each tree's root in the node arrays, deepest tree first, and
+    ``depths`` (T,) are those trees' depths (at a step of the descent, only the trees still
+    deeper take part); ``order`` (T,) gives the place of each of scikit-learn's trees in that
+    list. ``children`` (nodes x 2, flat) hold each node's left and right child (a leaf is its
+    own child on both sides); ``value`` is a leaf's raw value.
     """
 
     baseline: float
     roots: np.ndarray
+    depths: np.ndarray
+    order: np.ndarray
     feature: np.ndarray
     threshold: np.ndarray
     nan_left: np.ndarray
     children: np.ndarray
     value: np.ndarray
-    depth: int
 
     @classmethod
     def of(cls, estimator: HistGradientBoostingClassifier, where: str) -> Forest:
@@ -71,15 +74,18 @@ class Forest:
                 np.where(leaf, own, nodes["right"].astype(np.int64) + offset),
             ]
         )
+        depths = np.array([tree.nodes["depth"].max() for tree in trees])
+        deepest = np.argsort(-depths, kind="stable")
         return cls(
             baseline=float(estimator._baseline_prediction.ravel()[0]),
-            roots=np.cumsum(sizes) - sizes,
+            roots=(np.cumsum(sizes) - sizes)[deepest],
+            depths=depths[deepest],
+            order=np.argsort(deepest),
             feature=np.where(leaf, 0, nodes["feature_idx"]),
             threshold=nodes["num_threshold"].astype(np.float64),
             nan_left=nodes["missing_go_to_left"].astype(bool),
             children=children.ravel(),
             value=nodes["value"].astype(np.float64),
-            depth=int(nodes["depth"].max()),
         )
 
     def probability(self, features: np.ndarray) -> np.ndarray:
@@ -90,15 +96,17 @@ class Forest:
         x = np.asarray(features, np.float64)
         rows, columns = x.shape
         flat = x.ravel()
-        base = np.repeat(np.arange(rows) * columns, len(self.roots))
-        node = np.tile(self.roots, rows)
+        node = np.repeat(self.roots, rows)  # tree-major: the trees still descending lead
+        base = np.tile(np.arange(rows) * columns, len(self.roots))
         missing = bool(np.isnan(flat).any())
-        for _ in range(self.depth):
-            value = flat.take(base + self.feature.take(node))
-            right = ~(value <= self.threshold.take(node))
+        for step in range(int(self.depths[0]) if len(self.depths) else 0):
+            active = int(np.count_nonzero(self.depths > step)) * rows
+            at = node[:active]
+            value = flat.take(base[:active] + self.feature.take(at))
+            right = ~(value <= self.threshold.take(at))
             if missing:
-                right &= ~(np.isnan(value) & self.nan_left.take(node))
-            node = self.children.take(2 * node + right)
-        leaves = self.value.take(node).reshape(rows, len(self.roots))
-        start = np.zeros((rows, 1)) + self.baseline
-        return expit(np.cumsum(np.hstack([start, leaves]), axis=1)[:, -1])
+                right &= ~(np.isnan(value) & self.nan_left.take(at))
+            node[:active] = self.children.take(2 * at + right)
+        leaves = self.value.take(node).reshape(len(self.roots), rows)[self.order]
+        start = np.zeros((1, rows)) + self.baseline
+        return expit(np.cumsum(np.vstack([start, leaves]), axis=0)[-1])
