@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from threadpoolctl import threadpool_limits
 
 from tsrkit.datasets import open_dataset
 from tsrkit.models import ModelError
@@ -53,7 +54,8 @@ def test_missing_values_follow_the_learned_side():
     y = (x[:, 0] + x[:, 1] > 0).astype(int)
     x[rng.random(x.shape) < 0.15] = np.nan
     y[np.isnan(x[:, 0])] = 1  # a missing first feature means positive: learned as a side
-    model = HistGradientBoostingClassifier(max_iter=30, random_state=0).fit(x, y)
+    with threadpool_limits(1):  # two OpenMP threads on a loaded machine take seconds
+        model = HistGradientBoostingClassifier(max_iter=30, random_state=0).fit(x, y)
     forest = Forest.of(model, "memory")
     assert forest.nan_left.any() and not forest.nan_left.all()
     test = rng.normal(size=(100, 4))
@@ -66,8 +68,9 @@ def test_categorical_splits_are_refused():
 
     rng = np.random.default_rng(3)
     x = np.column_stack([rng.integers(0, 4, 200), rng.normal(size=200)])
-    model = HistGradientBoostingClassifier(max_iter=5, categorical_features=[0]).fit(
-        x, (x[:, 0] == 2).astype(int)
-    )
+    with threadpool_limits(1):
+        model = HistGradientBoostingClassifier(max_iter=5, categorical_features=[0]).fit(
+            x, (x[:, 0] == 2).astype(int)
+        )
     with pytest.raises(ModelError, match="categorical"):
         Forest.of(model, "memory")
