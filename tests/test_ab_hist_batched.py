@@ -4,6 +4,7 @@ real frames of three cameras and on synthetic ones."""
 
 from __future__ import annotations
 
+import cv2
 import numpy as np
 import pytest
 from oracles.ab_hist_oracle import lens_areas, lens_scores
@@ -89,3 +90,17 @@ def test_no_candidates_and_a_lens_outside_the_frame():
     assert classifier.classify(Frame(image, "t"), []) == []
     with pytest.raises(ValueError, match="outside"):
         classifier.classify(Frame(image, "t"), [Candidate.from_circle(200, 200, 3, 1.0)])
+
+
+def test_grey_and_bgra_frames_read_as_their_bgr():
+    classifier = get_registry().create("classifier", "ab-hist")
+    bgr = render_frame(5, 7, 320, 240, SynthOptions())[0]
+    candidates = circles(np.random.default_rng(2), 320, 240, n=10)
+    expected = [d.state_scores for d in classifier.classify(Frame(bgr, "t"), candidates)]
+    bgra = cv2.cvtColor(bgr, cv2.COLOR_BGR2BGRA)
+    assert [d.state_scores for d in classifier.classify(Frame(bgra, "t"), candidates)] == expected
+    grey = cv2.cvtColor(bgr, cv2.COLOR_BGR2GRAY)
+    assert [d.state_scores for d in classifier.classify(Frame(grey, "t"), candidates)] == [
+        d.state_scores
+        for d in classifier.classify(Frame(cv2.cvtColor(grey, cv2.COLOR_GRAY2BGR), "t"), candidates)
+    ]

@@ -138,12 +138,14 @@ def lens_histograms(
     tuple of ndarray
         A1 and A3 histograms, each (N, bins, bins), and a boolean (N,).
     """
+    if image.ndim == 2:
+        image = cv2.cvtColor(image, cv2.COLOR_GRAY2BGR)
     n = len(lenses)
     area = ring_runs(image, [(c.x, c.y, c.radius) for c in lenses])
     run, offset = area.pixels()
     region = (area.owner * 2 + area.annulus).take(run)  # A1 of lens i: 2i, A3: 2i + 1
     where = (area.row * image.shape[1] + area.col).take(run) + offset
-    pixels = np.take(image.reshape(-1, 3), where, axis=0)[None]
+    pixels = np.take(image.reshape(-1, image.shape[2]), where, axis=0)[None]  # BGR or BGRA
     lab = cv2.cvtColor(pixels, cv2.COLOR_BGR2LAB)[0]
     saturation = mean_saturations(cv2.cvtColor(pixels, cv2.COLOR_BGR2HSV)[0][:, 1], region, 2 * n)
     ab = (lab[:, 1].astype(np.intp) << 8) | lab[:, 2]
