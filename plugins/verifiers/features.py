@@ -101,9 +101,11 @@ def stacked_hog(lightness: np.ndarray, rows: int) -> np.ndarray:
     its own patch alone (the outer black row has no gradient, stacked or at the image border),
     and with one-cell blocks no block straddles two patches.
 
-    The steps are ``hog``'s own (float32 central differences, scikit-image's orientation
-    histograms), with its block-by-block L1 normalisation (a Python loop, one pass per cell)
-    done for all cells in one array operation: the same numbers (``tests/test_verifier.py``).
+    The steps are ``hog``'s own (float32 central differences, then the orientation histograms
+    of ``skimage.feature._hoghistogram``, the compiled routine ``hog`` calls), with its
+    block-by-block L1 normalisation (a Python loop, one pass per cell) done for all cells in
+    one array operation: the same numbers, which ``tests/test_verifier.py`` checks against
+    ``hog`` itself (and so against a change of that private routine).
     """
     n, height, width = lightness.shape
     small = cv2.resize(
