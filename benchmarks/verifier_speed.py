@@ -1,10 +1,12 @@
 """Single-thread speed of the learned verifier on 1280x720 frames at 50 candidates.
 
 Candidates are 50 circles of radius 2-20 px at random places of synthetic 1280x720 road scenes
-(half of them given a 1:3 housing box, as a housing stage would); the verifier (features +
-shipped model, after its housing stage) runs on each frame, then the recommended preset's state
-classifier (``--classifier``, ab-hist) on all 50 candidates (the worst case: none rejected);
-medians over frames and repeats are reported, with the features alone beside them.
+(half of them given a 1:3 housing box, as a housing stage would); the verifier (its housing
+stage, features, shipped model) runs on each frame, then the recommended preset's state
+classifier (``--classifier``, ab-hist) on all 50 candidates (the worst case: none rejected).
+Medians over frames and repeats are reported, wall clock and process CPU time, with the
+stages timed one by one beside them: the housing stage, the features, the model's prediction
+(one pass over its trees, and scikit-learn's ``predict_proba`` for comparison) and the state.
 
 Run: python benchmarks/verifier_speed.py [--frames 20] [--repeats 5] [--candidates 50]
 """
@@ -20,6 +22,8 @@ import argparse  # noqa: E402
 import dataclasses  # noqa: E402
 import statistics  # noqa: E402
 import time  # noqa: E402
+from collections.abc import Callable  # noqa: E402
+from functools import partial  # noqa: E402
 
 import cv2  # noqa: E402
 import numpy as np  # noqa: E402
@@ -45,6 +49,13 @@ def candidates(rng: np.random.Generator, n: int) -> list[Candidate]:
     return out
 
 
+def timed(stage: Callable[[], object]) -> tuple[float, float]:
+    """Wall clock and process CPU time of one call, in ms."""
+    wall, cpu = time.perf_counter(), time.process_time()
+    stage()
+    return (time.perf_counter() - wall) * 1000, (time.process_time() - cpu) * 1000
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--frames", type=int, default=20)
@@ -53,6 +64,7 @@ def main() -> None:
     parser.add_argument("--classifier", default="ab-hist", help="state classifier timed after")
     args = parser.parse_args()
     verifier = get_registry().create("verifier", "verifier", {"threshold": 0.5})
+    housing = get_registry().create("verifier", "housing")
     rng = np.random.default_rng(0)
     frames = [
         Frame(render_frame(i, 7, 1280, 720, SynthOptions())[0], f"synth{i}")
@@ -62,29 +74,40 @@ def main() -> None:
     classifier = get_registry().create("classifier", args.classifier)
     verifier.verify(frames[0], sets[0])  # load the models once
     classifier.classify(frames[0], sets[0])
-    whole, feats, states = [], [], []
+    times: dict[str, list[tuple[float, float]]] = {}
+    cpu_start = time.process_time()
     for _ in range(args.repeats):
         for frame, cands in zip(frames, sets):
-            t0 = time.perf_counter()
-            verifier.verify(frame, cands)
-            t1 = time.perf_counter()
-            candidate_features(frame.image, cands)
-            t2 = time.perf_counter()
-            classifier.classify(frame, cands)
-            t3 = time.perf_counter()
-            whole.append((t1 - t0) * 1000)
-            feats.append((t2 - t1) * 1000)
-            states.append((t3 - t2) * 1000)
+            housed = housing.verify(frame, cands)
+            features = candidate_features(frame.image, housed)
+            stages = {
+                "verifier (housing + features + model)": partial(verifier.verify, frame, cands),
+                f"{args.classifier} on all candidates": partial(classifier.classify, frame, cands),
+                "  housing stage": partial(housing.verify, frame, cands),
+                "  features": partial(candidate_features, frame.image, housed),
+                "  model (one pass over the trees)": partial(verifier.forest.probability, features),
+                "  model (scikit-learn predict_proba)": partial(
+                    verifier.estimator.predict_proba, features
+                ),
+            }
+            for name, stage in stages.items():
+                times.setdefault(name, []).append(timed(stage))
+    cpu_total = time.process_time() - cpu_start
+
+    def median(name: str, k: int) -> float:
+        return statistics.median(t[k] for t in times[name])
+
     print(
-        f"verifier on 1280x720, {args.candidates} candidates, one thread: "
-        f"median {statistics.median(whole):.2f} ms/frame (features alone "
-        f"{statistics.median(feats):.2f} ms); {len(whole)} timings"
+        f"1280x720, {args.candidates} candidates, one thread, {args.frames} frames x "
+        f"{args.repeats} repeats; median ms per frame (wall / process CPU):"
     )
-    total = [w + s for w, s in zip(whole, states)]
+    for name in times:
+        print(f"  {name:40s} {median(name, 0):7.2f} / {median(name, 1):7.2f}")
+    total = [(v[0] + s[0], v[1] + s[1]) for v, s in zip(*(times[n] for n in list(times)[:2]))]
     print(
-        f"+ {args.classifier} on all {args.candidates} candidates: median "
-        f"{statistics.median(states):.2f} ms; housing + verifier + state: median "
-        f"{statistics.median(total):.2f} ms/frame"
+        f"housing + verifier + state: median {statistics.median(t[0] for t in total):.2f} ms "
+        f"wall, {statistics.median(t[1] for t in total):.2f} ms CPU per frame (all stages and "
+        f"the comparison runs: {cpu_total:.1f} s CPU)"
     )
 
 

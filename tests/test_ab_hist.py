@@ -9,7 +9,7 @@ from oracles.lamps import COLOURS, lamp, training_set
 from tsrkit.models import ModelError, load_model, save_model
 from tsrkit.registry import get_registry
 from tsrkit.types import Candidate, Frame
-from tsrkit_plugins.classifiers.ab_hist import ab_histogram, similarity
+from tsrkit_plugins.classifiers.ab_hist import ab_cells, ab_histograms, similarities
 from tsrkit_plugins.classifiers.decision import discriminative_ratio
 
 
@@ -32,27 +32,39 @@ def model_path(tmp_path_factory):
     return path
 
 
-def test_histogram_matches_numpy_histogram2d():
+def test_histograms_match_numpy_histogram2d_region_by_region():
     rng = np.random.default_rng(3)
-    lab = rng.integers(0, 256, (12, 15, 3), dtype=np.uint8)
-    mask = rng.random((12, 15)) < 0.6
-    expected, _, _ = np.histogram2d(
-        lab[..., 1][mask], lab[..., 2][mask], bins=8, range=[[0, 256], [0, 256]]
-    )
-    got = ab_histogram(lab, mask, 8)
-    assert np.allclose(got, expected / mask.sum())
-    assert got.sum() == pytest.approx(1.0)
-    assert not ab_histogram(lab, np.zeros_like(mask), 8).any()
+    lab = rng.integers(0, 256, (180, 3), dtype=np.uint8)
+    region = rng.integers(0, 3, 180)
+    mask = (rng.random(180) < 0.6) & (region != 2)
+    cells = ab_cells(8, 0.0).take(lab[:, 1].astype(int) * 256 + lab[:, 2])
+    got = ab_histograms(np.where(mask, cells, 64), region, 3, 8)
+    for i in range(2):
+        chosen = mask & (region == i)
+        expected, _, _ = np.histogram2d(
+            lab[chosen, 1], lab[chosen, 2], bins=8, range=[[0, 256], [0, 256]]
+        )
+        assert np.allclose(got[i], expected / chosen.sum())
+        assert got[i].sum() == pytest.approx(1.0)
+    assert got.shape == (3, 8, 8) and not got[2].any()
+
+
+def test_cells_leave_out_colours_below_the_chroma_floor():
+    cells = ab_cells(8, 10.0)
+    assert cells[128 * 256 + 128] == 64  # grey (a = b = 128): chroma 0, the spare cell
+    assert cells[200 * 256 + 128] == 6 * 8 + 4  # chroma 72: a in bin 6, b in bin 4
+    assert cells[133 * 256 + 134] == 64 and ab_cells(8, 0.0)[133 * 256 + 134] == 4 * 8 + 4
 
 
 def test_similarity_is_one_for_equal_and_zero_for_disjoint_histograms():
     h = np.array([[1.0, 2.0], [0.0, 0.0]], np.float32)
     other = np.array([[0.0, 0.0], [0.0, 5.0]], np.float32)
-    assert similarity(h, 3 * h) == pytest.approx(1.0)
-    assert similarity(h, other) == pytest.approx(0.0)
-    assert similarity(h, np.zeros_like(h)) == 0.0
     half = np.array([[1.0, 0.0], [0.0, 1.0]], np.float32)
-    assert similarity(np.array([[1.0, 0.0], [0.0, 0.0]], np.float32), half) == pytest.approx(0.5)
+    got = similarities(np.stack([h, np.zeros_like(h)]), np.stack([3 * h, other, half]))
+    assert got[0, :2] == pytest.approx([1.0, 0.0])
+    assert got[1].tolist() == [0.0, 0.0, 0.0]
+    single = np.array([[[1.0, 0.0], [0.0, 0.0]]], np.float32)
+    assert similarities(single, half[None])[0, 0] == pytest.approx(0.5)
 
 
 @pytest.mark.parametrize("state", ["red", "yellow", "green"])

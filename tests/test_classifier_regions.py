@@ -17,6 +17,7 @@ from tsrkit_plugins.classifiers.regions import (
     is_housing,
     labelled_lenses,
     lens_of,
+    ring_runs,
     rings,
 )
 
@@ -134,3 +135,44 @@ def test_find_lens_passes_over_blue_sky():
     image[:20] = (235, 190, 90)  # bright saturated sky blue where the top lens would be
     lens = find_lens(image, (0, 0, 20, 60))
     assert abs(lens.y - 50) <= 2
+
+
+def test_ring_runs_hold_exactly_the_pixels_of_rings_for_any_lens():
+    """The row runs of ring_runs (many lenses at once) give exactly the masks of the per-pixel
+    test of rings(), for lenses of any size and sub-pixel place, clipped by the border or not."""
+    rng = np.random.default_rng(0)
+    image = np.zeros((60, 90, 3), np.uint8)
+    lenses = []
+    for _ in range(3000):
+        r = float(rng.choice([rng.uniform(0.01, 1.5), rng.uniform(0.5, 30), rng.integers(1, 12)]))
+        x = float(rng.choice([rng.uniform(-5, 95), rng.integers(0, 90) + 0.5]))
+        y = float(rng.choice([rng.uniform(-5, 65), rng.integers(0, 60) + 0.5]))
+        try:
+            rings(image, x, y, r)
+        except ValueError:
+            continue
+        lenses.append((x, y, r))
+    runs = ring_runs(image, lenses)
+    run, offset = runs.pixels()
+    owner, rows = runs.owner.take(run), runs.row.take(run)
+    cols, annulus = runs.col.take(run) + offset, runs.annulus.take(run)
+    bounds = np.cumsum([0, *np.bincount(owner, minlength=len(lenses))])
+    assert np.all(np.diff(owner) >= 0)  # lens by lens
+    for i, (x, y, r) in enumerate(lenses):
+        area = rings(image, x, y, r)
+        x0, y0 = runs.boxes[i, :2]
+        assert runs.boxes[i].tolist() == [x0, y0, x0 + area.disk.shape[1], y0 + area.disk.shape[0]]
+        mine = slice(bounds[i], bounds[i + 1])
+        disk, ring = np.zeros_like(area.disk), np.zeros_like(area.annulus)
+        disk[rows[mine] - y0, cols[mine] - x0] = ~annulus[mine]
+        ring[rows[mine] - y0, cols[mine] - x0] = annulus[mine]
+        assert np.array_equal(disk, area.disk) and np.array_equal(ring, area.annulus)
+        assert (disk | ring).sum() == bounds[i + 1] - bounds[i]  # no pixel twice
+
+
+def test_ring_runs_refuse_what_rings_refuses():
+    image = np.zeros((10, 10, 3), np.uint8)
+    with pytest.raises(ValueError, match="outside"):
+        ring_runs(image, [(5, 5, 2), (50, 50, 3)])
+    with pytest.raises(ValueError, match="positive"):
+        ring_runs(image, [(5, 5, 2), (5, 5, 0)])

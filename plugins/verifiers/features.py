@@ -13,7 +13,7 @@ from collections.abc import Sequence
 
 import cv2
 import numpy as np
-from skimage.feature import hog
+from skimage.feature._hoghistogram import hog_histograms
 
 from tsrkit.geometry import Box
 from tsrkit.types import Candidate
@@ -91,8 +91,8 @@ def sample_boxes(
 
 
 def stacked_hog(lightness: np.ndarray, rows: int) -> np.ndarray:
-    """Per-cell HOG (L1-normalised orientation histograms) of every patch in one
-    ``skimage.feature.hog`` call.
+    """Per-cell HOG (L1-normalised orientation histograms) of every patch at once, equal to
+    ``skimage.feature.hog`` of the stacked patches with one-cell blocks.
 
     ``lightness`` is (N, H, W), CIELab L of 8-bit Lab (0-255), ``H`` and ``W`` even. Each patch
     is shrunk by ``HOG_SHRINK`` (the cost of HOG grows with the pixel count), framed by two
@@ -100,6 +100,12 @@ def stacked_hog(lightness: np.ndarray, rows: int) -> np.ndarray:
     stacked vertically: the black rows keep every gradient, and so every cell, a function of
     its own patch alone (the outer black row has no gradient, stacked or at the image border),
     and with one-cell blocks no block straddles two patches.
+
+    The steps are ``hog``'s own (float32 central differences, then the orientation histograms
+    of ``skimage.feature._hoghistogram``, the compiled routine ``hog`` calls), with its
+    block-by-block L1 normalisation (a Python loop, one pass per cell) done for all cells in
+    one array operation: the same numbers, which ``tests/test_verifier.py`` checks against
+    ``hog`` itself (and so against a change of that private routine).
     """
     n, height, width = lightness.shape
     small = cv2.resize(
@@ -111,15 +117,26 @@ def stacked_hog(lightness: np.ndarray, rows: int) -> np.ndarray:
     cell_rows, remainder = divmod(framed.shape[1], rows)
     if remainder:
         raise ValueError(f"{framed.shape[1]} framed rows do not split into {rows} cells")
-    blocks = hog(
-        framed.reshape(-1, framed.shape[2]),
-        orientations=ORIENTATIONS,
-        pixels_per_cell=(cell_rows, framed.shape[2]),
-        cells_per_block=(1, 1),
-        block_norm="L1",
-        feature_vector=False,
+    image = framed.reshape(-1, framed.shape[2])
+    g_row = np.zeros_like(image)
+    g_row[1:-1] = image[2:] - image[:-2]
+    g_col = np.zeros_like(image)
+    g_col[:, 1:-1] = image[:, 2:] - image[:, :-2]
+    cells = np.zeros((n * rows, 1, ORIENTATIONS))
+    hog_histograms(
+        g_col.astype(float),
+        g_row.astype(float),
+        image.shape[1],
+        cell_rows,
+        image.shape[1],
+        image.shape[0],
+        1,
+        n * rows,
+        ORIENTATIONS,
+        cells,
     )
-    return blocks.reshape(n, -1).astype(np.float32)
+    blocks = (cells / (np.abs(cells).sum(axis=-1, keepdims=True) + 1e-5)).astype(np.float32)
+    return blocks.reshape(n, -1)
 
 
 #: Cosine and sine of every OpenCV 8-bit hue (0-179, 2 degrees a step).

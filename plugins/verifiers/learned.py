@@ -28,6 +28,7 @@ from tsrkit.plugin import Detector, Verifier
 from tsrkit.registry import get_registry
 from tsrkit.types import Candidate, Frame, Sample
 from tsrkit_plugins.verifiers.features import candidate_features, feature_names, layout
+from tsrkit_plugins.verifiers.forest import Forest
 from tsrkit_plugins.verifiers.mining import Labelled, Stage, hard_negatives, labelled_candidates
 from tsrkit_plugins.verifiers.persistence import estimator_arrays, load_estimator
 
@@ -122,6 +123,7 @@ class LearnedVerifier(Verifier):
     def __init__(self, **params):
         super().__init__(**params)
         self._estimator: HistGradientBoostingClassifier | None = None
+        self._forest: Forest | None = None
 
     @property
     def estimator(self) -> HistGradientBoostingClassifier:
@@ -152,12 +154,19 @@ class LearnedVerifier(Verifier):
             self._estimator = load_estimator(model, where)
         return self._estimator
 
+    @property
+    def forest(self) -> Forest:
+        """The estimator's trees as flat arrays (:mod:`forest`), for one-pass prediction."""
+        if self._forest is None:
+            self._forest = Forest.of(self.estimator, str(self.params["model"] or DEFAULT_MODEL))
+        return self._forest
+
     def probabilities(self, frame: Frame, candidates: Sequence[Candidate]) -> np.ndarray:
-        """The probability that each candidate is a lit traffic light."""
+        """The probability that each candidate is a lit traffic light (the estimator's
+        ``predict_proba``, computed in one pass over its trees: :mod:`forest`)."""
         if not candidates:
             return np.zeros(0)
-        features = candidate_features(frame.image, candidates)
-        return self.estimator.predict_proba(features)[:, 1]
+        return self.forest.probability(candidate_features(frame.image, candidates))
 
     def verify(self, frame: Frame, candidates: Sequence[Candidate]) -> list[Candidate]:
         candidates = self._stage()(frame, list(candidates))

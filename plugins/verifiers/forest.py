@@ -1,0 +1,112 @@
+"""The learned verifier's trees, evaluated for every candidate of a frame at once.
+
+scikit-learn's ``HistGradientBoostingClassifier.predict_proba`` validates its input and walks
+its trees one call per tree (150 calls of per-call overhead for 50 candidates). Here the nodes
+of all trees are one set of flat arrays and every (candidate, tree) pair descends together,
+one tree level per step, by the rule of scikit-learn's ``_predict_one_from_raw_data``: a value
+``<= num_threshold`` goes left, a missing (NaN) value goes where ``missing_go_to_left`` says.
+The leaf values are summed tree after tree onto the baseline, in scikit-learn's order, and the
+probability is the same ``scipy.special.expit``, so the probabilities equal scikit-learn's to
+the bit (``tests/test_verifier_forest.py``). The trees are read from the estimator's
+``_predictors`` and ``_baseline_prediction`` (scikit-learn's own arrays; that test would catch
+a change of them).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from tsrkit.models import ModelError
+
+if TYPE_CHECKING:  # scikit-learn loads when a model is fitted or read, not on import
+    from sklearn.ensemble import HistGradientBoostingClassifier
+
+
+@dataclass(frozen=True)
+class Forest:
+    """The trees of a fitted binary classifier as flat node arrays.
+
+    ``roots`` (T,) index each tree's root in the node arrays, deepest tree first, and
+    ``depths`` (T,) are those trees' depths (at a step of the descent, only the trees still
+    deeper take part); ``order`` (T,) gives the place of each of scikit-learn's trees in that
+    list. ``children`` (nodes x 2, flat) hold each node's left and right child (a leaf is its
+    own child on both sides); ``value`` is a leaf's raw value.
+    """
+
+    baseline: float
+    roots: np.ndarray
+    depths: np.ndarray
+    order: np.ndarray
+    feature: np.ndarray
+    threshold: np.ndarray
+    nan_left: np.ndarray
+    children: np.ndarray
+    value: np.ndarray
+
+    @classmethod
+    def of(cls, estimator: HistGradientBoostingClassifier, where: str) -> Forest:
+        """The trees of ``estimator`` (read from ``where``).
+
+        Raises
+        ------
+        ModelError
+            Not one tree per iteration (binary), or a categorical split.
+        """
+        trees = [tree for iteration in estimator._predictors for tree in iteration]
+        if estimator.n_trees_per_iteration_ != 1 or any(
+            tree.nodes["is_categorical"].any() for tree in trees
+        ):
+            raise ModelError(
+                f"model {where}: the verifier reads binary classifiers without categorical "
+                "splits only"
+            )
+        nodes = np.concatenate([tree.nodes for tree in trees])
+        sizes = np.array([len(tree.nodes) for tree in trees])
+        offset = np.repeat(np.cumsum(sizes) - sizes, sizes)
+        leaf = nodes["is_leaf"].astype(bool)
+        own = np.arange(len(nodes))
+        children = np.column_stack(
+            [
+                np.where(leaf, own, nodes["left"].astype(np.int64) + offset),
+                np.where(leaf, own, nodes["right"].astype(np.int64) + offset),
+            ]
+        )
+        depths = np.array([tree.nodes["depth"].max() for tree in trees])
+        deepest = np.argsort(-depths, kind="stable")
+        return cls(
+            baseline=float(estimator._baseline_prediction.ravel()[0]),
+            roots=(np.cumsum(sizes) - sizes)[deepest],
+            depths=depths[deepest],
+            order=np.argsort(deepest),
+            feature=np.where(leaf, 0, nodes["feature_idx"]),
+            threshold=nodes["num_threshold"].astype(np.float64),
+            nan_left=nodes["missing_go_to_left"].astype(bool),
+            children=children.ravel(),
+            value=nodes["value"].astype(np.float64),
+        )
+
+    def probability(self, features: np.ndarray) -> np.ndarray:
+        """The probability of the positive class for each row of ``features`` (float64, as
+        scikit-learn converts them)."""
+        from scipy.special import expit
+
+        x = np.asarray(features, np.float64)
+        rows, columns = x.shape
+        flat = x.ravel()
+        node = np.repeat(self.roots, rows)  # tree-major: the trees still descending lead
+        base = np.tile(np.arange(rows) * columns, len(self.roots))
+        missing = bool(np.isnan(flat).any())
+        for step in range(int(self.depths[0]) if len(self.depths) else 0):
+            active = int(np.count_nonzero(self.depths > step)) * rows
+            at = node[:active]
+            value = flat.take(base[:active] + self.feature.take(at))
+            right = ~(value <= self.threshold.take(at))
+            if missing:
+                right &= ~(np.isnan(value) & self.nan_left.take(at))
+            node[:active] = self.children.take(2 * at + right)
+        leaves = self.value.take(node).reshape(len(self.roots), rows)[self.order]
+        start = np.zeros((1, rows)) + self.baseline
+        return expit(np.cumsum(np.vstack([start, leaves]), axis=0)[-1])
