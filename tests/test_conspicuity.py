@@ -67,29 +67,30 @@ def kernel_window(tables, terms, row, col, count, out):
     ck.window_sum(tables.reshape(-1), offsets, 0, mid, len(terms), base, count, out)
 
 
-def window_sums(channel, pad, windows, row, prefix=ck.LIGHT_PREFIX):
-    """Kernel sums of several planned windows on one row of a channel mirrored by ``pad``."""
-    padded = cs.mirror(channel, pad)
-    tables = ck.prefix_tables(padded, padded)
-    out = np.zeros((len(windows), channel.shape[1]), np.int32)
+def window_sums(channel, pad, windows, row, dtype=np.int32):
+    """Kernel sums of several planned windows on one row of a channel mirrored by ``pad``, with
+    tables and sums in ``dtype``."""
+    tables = ck.prefix_tables(cs.mirror(channel, pad), dtype)
+    out = np.zeros((len(windows), channel.shape[1]), dtype)
     for window, plan in zip(out, windows):
-        terms = np.array(cs.kernel_terms(plan, prefix), np.int32)
+        terms = np.array(cs.kernel_terms(plan), np.int32)
         kernel_window(tables, terms, pad + 1 + row, pad, channel.shape[1], window)
     return out
 
 
 def test_prefix_tables_are_row_prefixes_and_their_column_integrals():
-    light, sat = cs.lightness(random_image(7)), cs.saturation(random_image(7))
-    tables = ck.prefix_tables(light, sat)
-    for channel, prefix, integral in (
-        (light, ck.LIGHT_PREFIX, ck.LIGHT_INTEGRAL),
-        (sat, ck.SAT_PREFIX, ck.SAT_INTEGRAL),
-    ):
+    for channel in (cs.lightness(random_image(7)), cs.saturation(random_image(7))):
+        tables = ck.prefix_tables(channel)
+        prefix, integral = tables[ck.PREFIX], tables[ck.INTEGRAL]
         rows = np.cumsum(channel, axis=1, dtype=np.int64)
-        assert not tables[prefix, 0].any() and not tables[prefix, :, 0].any()
-        assert np.array_equal(tables[prefix, 1:, 1:], rows)
-        assert np.array_equal(tables[integral, 1:, 1:], np.cumsum(rows, axis=0))
-        assert not tables[integral, 0].any() and not tables[integral, :, 0].any()
+        assert not prefix[0].any() and not prefix[:, 0].any()
+        assert np.array_equal(prefix[1:, 1:], rows)
+        assert np.array_equal(integral[1:, 1:], np.cumsum(rows, axis=0))
+        assert not integral[0].any() and not integral[:, 0].any()
+        # int16 tables hold the same entries modulo 2**16 (they pass 32767 here).
+        narrow = ck.prefix_tables(channel, np.int16)
+        assert narrow.dtype == np.int16 and tables.max() > 32767
+        assert np.array_equal(narrow, tables.astype(np.int16))
 
 
 def test_window_sums_are_exact_integer_sums():
@@ -117,9 +118,9 @@ def test_window_sums_are_exact_integer_sums():
 def test_window_sums_survive_wrapping_integrals():
     # Column integrals of a bright 3000 x 3000 frame pass 2**31; the window sums stay exact.
     bright = np.full((3000, 3000), 255, np.uint8)
-    tables = ck.prefix_tables(bright, bright)
-    assert tables[ck.LIGHT_INTEGRAL].min() < 0
-    terms = np.array(cs.kernel_terms(cs.disk_plan(3), ck.LIGHT_PREFIX), np.int32)
+    tables = ck.prefix_tables(bright)
+    assert tables[ck.INTEGRAL].min() < 0
+    terms = np.array(cs.kernel_terms(cs.disk_plan(3)), np.int32)
     out = np.zeros(4, np.int32)
     kernel_window(tables, terms, 2990, 2990, 4, out)
     assert np.all(out == 255 * cs.disk_size(3))
@@ -180,7 +181,7 @@ def test_disk_and_annulus_sizes():
     assert cs.quarter_disk_size(1) == 3
     sat = np.zeros((20, 20), np.uint8)
     sat[10, 10] = 255
-    sums = window_sums(sat, 8, [cs.disk_plan(2), cs.disk_plan(4)], 10, ck.SAT_PREFIX)
+    sums = window_sums(sat, 8, [cs.disk_plan(2), cs.disk_plan(4)], 10)
     feature = np.zeros(20, np.float32)
     ck.saturation_feature(sums[0], sums[1], cs.mean_scale(13), cs.mean_scale(49 - 13), 20, feature)
     # At the lit pixel the disk mean wins (1/13); three columns away only the annulus sees it.
@@ -267,18 +268,63 @@ def test_candidates_on_real_frames_match_the_round_one_implementation(shared_dat
 
 def test_map_does_not_depend_on_how_the_rows_are_split_into_runs():
     image = random_image(6, (30, 41))
-    tables, pad = cs.channel_tables(image, list(range(1, 11)), 0)
+    tables = cs.channel_tables(image, list(range(1, 11)), 0)
     whole = cs.products_on_runs(
-        tables, pad, cs.full_runs(30, 41), list(range(1, 11)), (1.0, 1.0, 1.0), 0, "max"
+        *tables, cs.full_runs(30, 41), list(range(1, 11)), (1.0, 1.0, 1.0), 0, "max"
     )
     pieces = np.array([(i, a, b) for i in range(30) for a, b in ((0, 7), (7, 8), (8, 41))])
-    split = cs.products_on_runs(tables, pad, pieces, list(range(1, 11)), (1.0, 1.0, 1.0), 0, "max")
+    split = cs.products_on_runs(*tables, pieces, list(range(1, 11)), (1.0, 1.0, 1.0), 0, "max")
     assert np.array_equal(whole[0], split[0]) and np.array_equal(whole[1], split[1])
     assert whole[0].max() > 0
     partial = cs.products_on_runs(
-        tables, pad, pieces[pieces[:, 1] == 7], list(range(1, 11)), (1.0, 1.0, 1.0), 0, "max"
+        *tables, pieces[pieces[:, 1] == 7], list(range(1, 11)), (1.0, 1.0, 1.0), 0, "max"
     )
     assert np.array_equal(partial[0][:, 7], whole[0][:, 7]) and not partial[0][:, 8:].any()
+
+
+def test_lightness_windows_are_exact_in_int16_at_their_largest():
+    # All-white lightness: every radius-10 window at its largest magnitude (the quadrant box
+    # 121 * 255 = 30855, the axes term -43 * 255), summed over tables that wrap many times.
+    white = np.full((50, 3000), 255, np.uint8)
+    windows = [cs.box_plan(10, q) for q in cs.QUADRANTS] + [cs.quarter_plan(10, (1, 1))]
+    windows.append(cs.axes_plan(10))
+    narrow = window_sums(white, 10, windows, 20, np.int16)
+    assert np.array_equal(narrow, window_sums(white, 10, windows, 20))
+    assert narrow[0, 2990] == 30855 and narrow[4, 2990] == 255 * cs.quarter_disk_size(10)
+    assert narrow[5, 2990] == -255 * (4 * 10 + 3)
+
+
+@pytest.mark.parametrize(
+    "radii, margin, dtype",
+    [((1, 2, 10), 0, np.int16), ((3,), 7, np.int16), ((11,), 0, np.int32), ((4,), 8, np.int32)],
+)
+def test_lightness_tables_are_int16_only_while_every_window_fits(radii, margin, dtype):
+    assert cs.light_table_type(radii, margin) is dtype
+    assert cs.channel_tables(random_image(1), radii, margin)[0].dtype == dtype
+
+
+def test_int16_lightness_gives_the_int32_map_bit_for_bit(shared_datasets):
+    root = shared_datasets / "dtld_fridtjofs"
+    entry = json.loads((root / "annotations.json").read_text())[0]
+    image = cv2.imread(str(root / entry["file"]))[:200, :360]
+    radii = list(range(1, 11))
+    light, sat, pad = cs.channel_tables(image, radii, 0)
+    assert light.dtype == np.int16
+    runs = cs.full_runs(*image.shape[:2])
+    for rule, weights in (("max", (1.0, 1.0, 1.0)), ("min", (1.0, 2.0, 0.5))):
+        narrow = cs.products_on_runs(light, sat, pad, runs, radii, weights, 0, rule)
+        wide = cs.products_on_runs(
+            ck.prefix_tables(cs.mirror(cs.lightness(image), pad)),
+            sat,
+            pad,
+            runs,
+            radii,
+            weights,
+            0,
+            rule,
+        )
+        assert np.array_equal(narrow[0], wide[0]) and np.array_equal(narrow[1], wide[1])
+        assert narrow[0].max() > 0
 
 
 def test_unusable_settings_fail_at_construction_as_a_parameter_error():

@@ -25,8 +25,10 @@ Speed: every window sum is an exact integer sum of entries of one row-prefix tab
 channel (rows of equal half-width merged into one look-up in its column integral; the plan of
 each window is computed once per radius and executed by the numba kernel in
 ``conspicuity_kernel.py``, one image row at a time), the full lightness disk is assembled from
-its four quarters, saturation disks are shared between radii, and the root of Eq. 3.1 is taken
-once after the maximum of Eq. 3.2 (the root is monotonic, so the arg-max is unchanged).
+its four quarters, saturation disks are shared between radii, the lightness sums run in int16
+when every lightness window is small enough to be exact there (:func:`light_table_type`), and
+the root of Eq. 3.1 is taken once after the maximum of Eq. 3.2 (the root is monotonic, so the
+arg-max is unchanged).
 ``tests/oracles/conspicuity_oracle.py`` is the direct reference these are tested against.
 """
 
@@ -45,8 +47,7 @@ from tsrkit.params import Param, ParamError
 from tsrkit.plugin import Detector
 from tsrkit.types import Candidate, Frame
 from tsrkit_plugins.detectors.conspicuity.conspicuity_kernel import (
-    LIGHT_PREFIX,
-    SAT_PREFIX,
+    NARROW_PIXELS,
     best_products,
     flat_offsets,
     positive_ends,
@@ -176,10 +177,10 @@ def axes_plan(radius: int):
     )
 
 
-def kernel_terms(plan, prefix_table: int) -> list[tuple[int, int, int, int]]:
-    """A plan's ``(on_integral, dy, dc, sign)`` terms as kernel rows ``(table, dy, dc, sign)``
-    for the channel whose prefix table is ``prefix_table`` (its integral follows it)."""
-    return [(prefix_table + int(on_integral), dy, dc, sign) for on_integral, dy, dc, sign in plan]
+def kernel_terms(plan) -> list[tuple[int, int, int, int]]:
+    """A plan's ``(on_integral, dy, dc, sign)`` terms as kernel rows ``(plane, dy, dc, sign)``
+    of a channel's table stack (``conspicuity_kernel.PREFIX`` or ``INTEGRAL``)."""
+    return [(int(on_integral), dy, dc, sign) for on_integral, dy, dc, sign in plan]
 
 
 def mean_scale(count: int) -> np.float32:
@@ -224,11 +225,11 @@ def kernel_plan(radii: tuple[int, ...], margin: int) -> KernelPlan:
     """
     light = []
     for r in radii:
-        light += [kernel_terms(quarter_plan(r, q), LIGHT_PREFIX) for q in QUADRANTS]
-        light += [kernel_terms(box_plan(r + margin, q), LIGHT_PREFIX) for q in QUADRANTS]
-        light.append(kernel_terms(axes_plan(r), LIGHT_PREFIX))
+        light += [kernel_terms(quarter_plan(r, q)) for q in QUADRANTS]
+        light += [kernel_terms(box_plan(r + margin, q)) for q in QUADRANTS]
+        light.append(kernel_terms(axes_plan(r)))
     sat_radii = sorted(set(radii) | {2 * r for r in radii})
-    sat = [kernel_terms(disk_plan(r), SAT_PREFIX) for r in sat_radii]
+    sat = [kernel_terms(disk_plan(r)) for r in sat_radii]
     n_quarter = [quarter_disk_size(r) for r in radii]
     n_box = [(r + margin + 1) ** 2 for r in radii]
     scales = [
@@ -332,21 +333,46 @@ def conspicuity_map(
         raise ValueError(
             f"expected a BGR uint8 image of shape (H, W, 3); got {image.dtype} {image.shape}"
         )
-    tables, pad = channel_tables(image, radii, margin)
+    light_tables, sat_tables, pad = channel_tables(image, radii, margin)
     best, best_radius = products_on_runs(
-        tables, pad, full_runs(*image.shape[:2]), radii, weights, margin, quadrant_rule
+        light_tables,
+        sat_tables,
+        pad,
+        full_runs(*image.shape[:2]),
+        radii,
+        weights,
+        margin,
+        quadrant_rule,
     )
     return ConspicuityMap(weighted_root(best, weights), best_radius)
 
 
-def channel_tables(image: np.ndarray, radii: Sequence[int], margin: int) -> tuple[np.ndarray, int]:
-    """Prefix tables of the mirrored lightness and saturation, with the padding they need."""
+def light_table_type(radii: Sequence[int], margin: int) -> type:
+    """int16 when no lightness window holds more than :data:`conspicuity_kernel.NARROW_PIXELS`
+    pixels, int32 otherwise. The windows of radius ``r`` are the quadrant boxes of A1 + A2
+    (``(r + m + 1)**2`` pixels), the quarters of A1 inside them, and the shared axes (minus
+    ``4 r + 3`` pixels, the centre three times); with the paper's radii 1..10 and margin 0, at
+    most 121."""
+    largest = max((max(radii) + margin + 1) ** 2, 4 * max(radii) + 3)
+    return np.int16 if largest <= NARROW_PIXELS else np.int32
+
+
+def channel_tables(
+    image: np.ndarray, radii: Sequence[int], margin: int
+) -> tuple[np.ndarray, np.ndarray, int]:
+    """Prefix tables of the mirrored lightness (:func:`light_table_type`) and saturation
+    (int32), with the padding they need."""
     pad = max(2 * max(radii), max(radii) + margin)
-    return prefix_tables(mirror(lightness(image), pad), mirror(saturation(image), pad)), pad
+    return (
+        prefix_tables(mirror(lightness(image), pad), light_table_type(radii, margin)),
+        prefix_tables(mirror(saturation(image), pad)),
+        pad,
+    )
 
 
 def products_on_runs(
-    tables: np.ndarray,
+    light_tables: np.ndarray,
+    sat_tables: np.ndarray,
     pad: int,
     runs: np.ndarray,
     radii: Sequence[int],
@@ -357,18 +383,19 @@ def products_on_runs(
     """Eq. 3.1 under its root, maximised over the radii (Eq. 3.2), on the pixels of ``runs``;
     returns the float32 maximum (0 elsewhere) and the int32 arg-max radius (smallest radius
     elsewhere and on ties)."""
-    shape = (tables.shape[1] - 1 - 2 * pad, tables.shape[2] - 1 - 2 * pad)
+    shape = (sat_tables.shape[1] - 1 - 2 * pad, sat_tables.shape[2] - 1 - 2 * pad)
     plan = kernel_plan(tuple(radii), margin)
     best = np.zeros(shape, np.float32)
     best_radius = np.full(shape, min(radii), np.int32)
     best_products(
-        tables,
+        light_tables,
+        sat_tables,
         pad,
         runs,
-        flat_offsets(plan.light_terms, tables.shape),
+        flat_offsets(plan.light_terms, light_tables.shape),
         plan.light_starts,
         plan.light_mids,
-        flat_offsets(plan.sat_terms, tables.shape),
+        flat_offsets(plan.sat_terms, sat_tables.shape),
         plan.sat_starts,
         plan.sat_mids,
         plan.sat_inner,
