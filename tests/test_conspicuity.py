@@ -2,6 +2,7 @@
 hand-computed micro images."""
 
 import json
+from itertools import pairwise
 
 import cv2
 import numpy as np
@@ -294,36 +295,44 @@ def test_lightness_windows_are_exact_in_int16_at_their_largest():
     assert narrow[5, 2990] == -255 * (4 * 10 + 3)
 
 
+def test_saturation_disk_bands_are_exact_in_uint16_and_add_up_to_the_disk():
+    white = np.full((60, 3000), 255, np.uint8)
+    for radius in (9, 10, 14, 20):
+        bands = cs.disk_bands(radius, ck.BAND_PIXELS)
+        assert bands[0][0] == -radius and bands[-1][1] == radius
+        assert all(a[1] + 1 == b[0] for a, b in pairwise(bands))
+        windows = [cs.disk_plan(radius, *band) for band in bands] + [cs.disk_plan(radius)]
+        wide = window_sums(white, 20, windows, 25)
+        narrow = window_sums(white, 20, windows[:-1], 25, np.uint16)
+        assert np.array_equal(narrow, wide[:-1]) and narrow.max() <= 65535
+        assert np.all(narrow.astype(np.int64).sum(axis=0) == wide[-1])
+        assert wide[-1, 2990] == 255 * cs.disk_size(radius)
+    assert len(cs.disk_bands(20, ck.BAND_PIXELS)) == 6 and cs.disk_bands(20, None) == ((-20, 20),)
+
+
 @pytest.mark.parametrize(
-    "radii, margin, dtype",
-    [((1, 2, 10), 0, np.int16), ((3,), 7, np.int16), ((11,), 0, np.int32), ((4,), 8, np.int32)],
+    "radii, margin, narrow",
+    [((1, 2, 10), 0, True), ((3,), 7, True), ((11,), 0, False), ((4,), 8, False)],
 )
-def test_lightness_tables_are_int16_only_while_every_window_fits(radii, margin, dtype):
-    assert cs.light_table_type(radii, margin) is dtype
-    assert cs.channel_tables(random_image(1), radii, margin)[0].dtype == dtype
+def test_sums_are_16_bit_only_while_every_lightness_window_fits(radii, margin, narrow):
+    assert cs.narrow_sums(radii, margin) is narrow
+    light, sat, _ = cs.channel_tables(random_image(1), radii, margin)
+    assert (light.dtype, sat.dtype) == ((np.int16, np.uint16) if narrow else (np.int32, np.int32))
 
 
-def test_int16_lightness_gives_the_int32_map_bit_for_bit(shared_datasets):
+def test_16_bit_tables_give_the_32_bit_map_bit_for_bit(shared_datasets):
     root = shared_datasets / "dtld_fridtjofs"
     entry = json.loads((root / "annotations.json").read_text())[0]
     image = cv2.imread(str(root / entry["file"]))[:200, :360]
     radii = list(range(1, 11))
     light, sat, pad = cs.channel_tables(image, radii, 0)
-    assert light.dtype == np.int16
+    assert (light.dtype, sat.dtype) == (np.int16, np.uint16)
+    wide = [ck.prefix_tables(cs.mirror(f(image), pad)) for f in (cs.lightness, cs.saturation)]
     runs = cs.full_runs(*image.shape[:2])
     for rule, weights in (("max", (1.0, 1.0, 1.0)), ("min", (1.0, 2.0, 0.5))):
         narrow = cs.products_on_runs(light, sat, pad, runs, radii, weights, 0, rule)
-        wide = cs.products_on_runs(
-            ck.prefix_tables(cs.mirror(cs.lightness(image), pad)),
-            sat,
-            pad,
-            runs,
-            radii,
-            weights,
-            0,
-            rule,
-        )
-        assert np.array_equal(narrow[0], wide[0]) and np.array_equal(narrow[1], wide[1])
+        expected = cs.products_on_runs(*wide, pad, runs, radii, weights, 0, rule)
+        assert np.array_equal(narrow[0], expected[0]) and np.array_equal(narrow[1], expected[1])
         assert narrow[0].max() > 0
 
 

@@ -47,6 +47,7 @@ from tsrkit.params import Param, ParamError
 from tsrkit.plugin import Detector
 from tsrkit.types import Candidate, Frame
 from tsrkit_plugins.detectors.conspicuity.conspicuity_kernel import (
+    BAND_PIXELS,
     NARROW_PIXELS,
     best_products,
     flat_offsets,
@@ -131,14 +132,30 @@ def compile_terms(
 
 
 @cache
-def disk_plan(radius: int):
-    """Plan of the disk ``|d| <= radius`` (numerator of Eq. 3.3 and Eq. 3.10)."""
+def disk_plan(radius: int, top: int | None = None, bottom: int | None = None):
+    """Plan of the disk ``|d| <= radius`` (numerator of Eq. 3.3 and Eq. 3.10), or of its rows
+    ``top..bottom`` (a band, see :func:`disk_bands`)."""
     w = half_widths(radius)
     runs = []
-    for dy in range(-radius, radius + 1):
+    for dy in range(-radius if top is None else top, (radius if bottom is None else bottom) + 1):
         half = w[abs(dy)]
         runs += [(dy, half + 1, 1), (dy, -half, -1)]
     return compile_terms(runs)
+
+
+@cache
+def disk_bands(radius: int, limit: int | None) -> tuple[tuple[int, int], ...]:
+    """The disk's rows ``(top, bottom)`` cut, from the top, into consecutive bands of at most
+    ``limit`` pixels each (one band when ``limit`` is None)."""
+    w = half_widths(radius)
+    bands, top, pixels = [], -radius, 0
+    for dy in range(-radius, radius + 1):
+        width = 2 * w[abs(dy)] + 1
+        if limit is not None and pixels + width > limit:
+            bands.append((top, dy - 1))
+            top, pixels = dy, 0
+        pixels += width
+    return (*bands, (top, radius))
 
 
 @cache
@@ -199,6 +216,7 @@ class KernelPlan:
     sat_terms: np.ndarray
     sat_starts: np.ndarray
     sat_mids: np.ndarray
+    sat_bands: np.ndarray
     sat_inner: np.ndarray
     sat_outer: np.ndarray
     radii: np.ndarray
@@ -221,7 +239,8 @@ def kernel_plan(radii: tuple[int, ...], margin: int) -> KernelPlan:
 
     Per radius: the four quarters of A1, the four quadrant boxes of A1 + A2 (half-side
     ``r + m``) and the shared axes on lightness; the saturation disks of radius ``r`` and ``2 r``
-    are planned once per distinct radius (the annulus A3 is their difference).
+    are planned once per distinct radius (the annulus A3 is their difference), as bands of at
+    most :data:`conspicuity_kernel.BAND_PIXELS` pixels with :func:`narrow_sums`.
     """
     light = []
     for r in radii:
@@ -229,7 +248,9 @@ def kernel_plan(radii: tuple[int, ...], margin: int) -> KernelPlan:
         light += [kernel_terms(box_plan(r + margin, q)) for q in QUADRANTS]
         light.append(kernel_terms(axes_plan(r)))
     sat_radii = sorted(set(radii) | {2 * r for r in radii})
-    sat = [kernel_terms(disk_plan(r)) for r in sat_radii]
+    limit = BAND_PIXELS if narrow_sums(radii, margin) else None
+    bands = [disk_bands(r, limit) for r in sat_radii]
+    sat = [kernel_terms(disk_plan(r, *band)) for r, rows in zip(sat_radii, bands) for band in rows]
     n_quarter = [quarter_disk_size(r) for r in radii]
     n_box = [(r + margin + 1) ** 2 for r in radii]
     scales = [
@@ -250,6 +271,7 @@ def kernel_plan(radii: tuple[int, ...], margin: int) -> KernelPlan:
         sat_terms,
         sat_starts,
         positive_ends(sat_terms, sat_starts),
+        np.cumsum([0] + [len(rows) for rows in bands]).astype(np.int64),
         np.array([sat_radii.index(r) for r in radii], np.int64),
         np.array([sat_radii.index(2 * r) for r in radii], np.int64),
         np.array(radii, np.int32),
@@ -347,25 +369,27 @@ def conspicuity_map(
     return ConspicuityMap(weighted_root(best, weights), best_radius)
 
 
-def light_table_type(radii: Sequence[int], margin: int) -> type:
-    """int16 when no lightness window holds more than :data:`conspicuity_kernel.NARROW_PIXELS`
-    pixels, int32 otherwise. The windows of radius ``r`` are the quadrant boxes of A1 + A2
-    (``(r + m + 1)**2`` pixels), the quarters of A1 inside them, and the shared axes (minus
-    ``4 r + 3`` pixels, the centre three times); with the paper's radii 1..10 and margin 0, at
-    most 121."""
-    largest = max((max(radii) + margin + 1) ** 2, 4 * max(radii) + 3)
-    return np.int16 if largest <= NARROW_PIXELS else np.int32
+def narrow_sums(radii: Sequence[int], margin: int) -> bool:
+    """Whether the kernel sums in 16 bits: true when no lightness window holds more than
+    :data:`conspicuity_kernel.NARROW_PIXELS` pixels (int16 lightness tables); the saturation
+    disks are then summed in bands of at most :data:`conspicuity_kernel.BAND_PIXELS` pixels
+    (uint16 saturation tables). The lightness windows of radius ``r`` are the quadrant boxes of
+    A1 + A2 (``(r + m + 1)**2`` pixels), the quarters of A1 inside them, and the shared axes
+    (minus ``4 r + 3`` pixels, the centre three times): with the paper's radii 1..10 and margin
+    0, at most 121 pixels, and the saturation disks (radius up to 20) take 1-5 bands."""
+    return max((max(radii) + margin + 1) ** 2, 4 * max(radii) + 3) <= NARROW_PIXELS
 
 
 def channel_tables(
     image: np.ndarray, radii: Sequence[int], margin: int
 ) -> tuple[np.ndarray, np.ndarray, int]:
-    """Prefix tables of the mirrored lightness (:func:`light_table_type`) and saturation
-    (int32), with the padding they need."""
+    """Prefix tables of the mirrored lightness and saturation (int16 and uint16 with
+    :func:`narrow_sums`, int32 otherwise), with the padding they need."""
     pad = max(2 * max(radii), max(radii) + margin)
+    narrow = narrow_sums(radii, margin)
     return (
-        prefix_tables(mirror(lightness(image), pad), light_table_type(radii, margin)),
-        prefix_tables(mirror(saturation(image), pad)),
+        prefix_tables(mirror(lightness(image), pad), np.int16 if narrow else np.int32),
+        prefix_tables(mirror(saturation(image), pad), np.uint16 if narrow else np.int32),
         pad,
     )
 
@@ -398,6 +422,7 @@ def products_on_runs(
         flat_offsets(plan.sat_terms, sat_tables.shape),
         plan.sat_starts,
         plan.sat_mids,
+        plan.sat_bands,
         plan.sat_inner,
         plan.sat_outer,
         plan.radii,

@@ -20,7 +20,9 @@ every lightness window holds at most :data:`NARROW_PIXELS` pixels (radius + marg
 paper's defaults), the lightness tables and buffers are int16: the tables wrap modulo 2**16,
 each window sum is computed modulo 2**16, and since its true value lies in [-32768, 32767] it
 comes out exact, with twice the lanes per vector operation (the lightness windows take about
-half the time they took in int32). Being exact integer sums, none of this changes a value
+half the time they took in int32). The saturation disks (up to 1257 pixels) are then summed
+the same way in uint16, in bands of rows of at most :data:`BAND_PIXELS` pixels whose sums
+(in [0, 65535]) are added in int32. Being exact integer sums, none of this changes a value
 (``bench_conspicuity.py --baseline`` checks the maps and the candidates against an earlier
 commit's).
 """
@@ -38,6 +40,10 @@ PREFIX, INTEGRAL = range(2)
 #: The most pixels a window of a uint8 channel may hold for its sum (at most
 #: ``255 * NARROW_PIXELS`` in magnitude) to be exact in int16 arithmetic.
 NARROW_PIXELS = np.iinfo(np.int16).max // 255
+
+#: The most pixels a band of a saturation disk may hold for its (non-negative) sum to be exact
+#: in uint16 arithmetic.
+BAND_PIXELS = np.iinfo(np.uint16).max // 255
 
 #: Lightness windows per radius, in this order: the four quarters of A1, the four quadrant
 #: boxes of A1 + A2, and the shared axes that rebuild the full disk from its quarters.
@@ -273,6 +279,7 @@ def best_products(
     sat_offsets,
     sat_starts,
     sat_mids,
+    sat_bands,
     sat_inner,
     sat_outer,
     radii,
@@ -302,7 +309,10 @@ def best_products(
         ``light_starts[k * LIGHT_WINDOWS + w]`` to the next start, its positive terms ending at
         ``light_mids[k * LIGHT_WINDOWS + w]``.
     sat_offsets, sat_starts, sat_mids : ndarray
-        The same for the saturation disks, disk ``d`` spanning ``sat_starts[d:d + 2]``.
+        The same for the bands of the saturation disks, band ``b`` spanning
+        ``sat_starts[b:b + 2]``.
+    sat_bands : ndarray
+        Disk ``d`` is the sum of bands ``sat_bands[d]`` to ``sat_bands[d + 1]`` (exclusive).
     sat_inner, sat_outer : ndarray
         Per radius index, the saturation disk of radius ``r`` and of ``2 r``.
     radii, n_quarter, n_box : ndarray
@@ -317,7 +327,8 @@ def best_products(
     """
     longest = max(1, np.max(runs[:, 2] - runs[:, 1])) if runs.shape[0] else 1
     light = np.zeros((LIGHT_WINDOWS, longest), light_tables.dtype)
-    sat = np.zeros((sat_starts.shape[0] - 1, longest), np.int32)
+    sat = np.zeros((sat_bands.shape[0] - 1, longest), np.int32)
+    band = np.zeros(longest, sat_tables.dtype)
     contrast = np.zeros(longest, np.int64)
     disk = np.zeros(longest, np.int32)
     features = np.zeros((3, longest), np.float32)
@@ -329,16 +340,21 @@ def best_products(
         i, x0, count = runs[run, 0], runs[run, 1], runs[run, 2] - runs[run, 1]
         base = (pad + 1 + i) * sat_tables.shape[2] + pad + x0
         for d in range(sat.shape[0]):
-            window_sum(
-                sat_flat,
-                sat_offsets,
-                sat_starts[d],
-                sat_mids[d],
-                sat_starts[d + 1],
-                base,
-                count,
-                sat[d],
-            )
+            total = sat[d]
+            total[:count] = 0
+            for b in range(sat_bands[d], sat_bands[d + 1]):
+                window_sum(
+                    sat_flat,
+                    sat_offsets,
+                    sat_starts[b],
+                    sat_mids[b],
+                    sat_starts[b + 1],
+                    base,
+                    count,
+                    band,
+                )
+                for x in range(count):
+                    total[x] += band[x]
         for k in range(radii.shape[0]):
             for w in range(LIGHT_WINDOWS):
                 start = k * LIGHT_WINDOWS + w
