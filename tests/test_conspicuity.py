@@ -336,6 +336,42 @@ def test_16_bit_tables_give_the_32_bit_map_bit_for_bit(shared_datasets):
         assert narrow[0].max() > 0
 
 
+def test_fused_float32_combination_equals_the_integer_steps_bit_for_bit():
+    # Window sums up to their 16-bit extremes; the fused pass (float32 arithmetic) against the
+    # separate int64 steps, for every radius of the paper's plan.
+    rng = np.random.default_rng(8)
+    count, plan = 4000, cs.kernel_plan(tuple(range(1, 11)), 0)
+    for k, radius in enumerate(plan.radii):
+        nq, nb = int(plan.n_quarter[k]), int(plan.n_box[k])
+        light = np.zeros((ck.LIGHT_WINDOWS, count), np.int16)
+        light[:4] = rng.integers(0, 255 * nq + 1, (4, count))
+        light[4:8] = np.minimum(
+            light[:4] + rng.integers(0, 255 * (nb - nq) + 1, (4, count)), 255 * nb
+        )
+        light[8] = -rng.integers(0, 255 * (4 * radius + 3) + 1, count)
+        inner = rng.integers(0, 255 * cs.disk_size(radius) + 1, count).astype(np.int32)
+        outer = inner + rng.integers(
+            0, 255 * (cs.disk_size(2 * radius) - cs.disk_size(radius)) + 1, count
+        ).astype(np.int32)
+        start = rng.uniform(0, 0.3, count).astype(np.float32)
+        fused = (start.copy(), np.zeros(count, np.int32))
+        ck.unit_max_product(light, inner, outer, nq, nb, plan.scales[k], radius, count, *fused)
+        contrast, disk = np.zeros(count, np.int64), np.zeros(count, np.int32)
+        features, product = np.zeros((3, count), np.float32), np.zeros(count, np.float32)
+        ck.lightness_contrast(light, nq, nb, False, count, contrast)
+        ck.disk_from_quarters(light, count, disk)
+        features[0] = disk.astype(np.float32) * plan.scales[k, 0]
+        features[1] = contrast.astype(np.float32) * plan.scales[k, 1]
+        ck.saturation_feature(
+            inner, outer, plan.scales[k, 2], plan.scales[k, 3], count, features[2]
+        )
+        ck.weighted_product(*features, np.ones(3, np.float32), count, product)
+        steps = (start.copy(), np.zeros(count, np.int32))
+        ck.keep_best(product, radius, count, *steps)
+        assert np.array_equal(fused[0], steps[0]) and np.array_equal(fused[1], steps[1])
+        assert np.count_nonzero(fused[1]) > count // 10
+
+
 def test_unusable_settings_fail_at_construction_as_a_parameter_error():
     import tsrkit
     from tsrkit.params import ParamError

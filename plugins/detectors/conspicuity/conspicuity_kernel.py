@@ -231,8 +231,15 @@ def unit_max_product(
 ):
     """:func:`lightness_contrast` (printed maximum), :func:`disk_from_quarters`,
     :func:`saturation_feature`, :func:`weighted_product` (unit weights) and :func:`keep_best`
-    fused into one pass per pixel, with the same integer and float32 operations in the same
-    order (the paper's defaults, Table 5-1): the same values, one loop instead of nine."""
+    fused into one pass per pixel for 16-bit sums (the paper's defaults, Table 5-1): the same
+    values, one loop instead of nine.
+
+    The integer steps run in float32, which holds every integer below 2**24 exactly: with
+    lightness windows of at most ``NARROW_PIXELS`` = 128 pixels, ``n_box * D_k`` and
+    ``n_quarter * B_k`` stay below ``128 * 128 * 255``, the disk below ``4 * 128 * 255`` and
+    the saturation disks (radius up to 2 * 10) below ``1257 * 255``, so every sum, product and
+    difference is the exact integer the int64 steps give, and the float32 steps after them are
+    the same operations in the same order."""
     l0, l1, l2, l3, l4, l5, l6, l7, l8 = (
         light[0],
         light[1],
@@ -244,24 +251,18 @@ def unit_max_product(
         light[7],
         light[8],
     )
-    nq, nb = np.int64(n_quarter), np.int64(n_box)
+    nq, nb = np.float32(n_quarter), np.float32(n_box)
     for x in range(count):
+        q0, q1, q2, q3 = np.float32(l0[x]), np.float32(l1[x]), np.float32(l2[x]), np.float32(l3[x])
         contrast = max(
-            max(
-                nb * np.int64(l0[x]) - nq * np.int64(l4[x]),
-                nb * np.int64(l1[x]) - nq * np.int64(l5[x]),
-            ),
-            max(
-                nb * np.int64(l2[x]) - nq * np.int64(l6[x]),
-                nb * np.int64(l3[x]) - nq * np.int64(l7[x]),
-            ),
+            max(nb * q0 - nq * np.float32(l4[x]), nb * q1 - nq * np.float32(l5[x])),
+            max(nb * q2 - nq * np.float32(l6[x]), nb * q3 - nq * np.float32(l7[x])),
         )
-        contrast = max(contrast, np.int64(0))
-        disk = np.int64(l0[x]) + l1[x] + l2[x] + l3[x] + l8[x]
-        product = (np.float32(disk) * scales[0]) * (np.float32(contrast) * scales[1])
-        product *= max(
-            np.float32(inner[x]) * scales[2], np.float32(np.int64(outer[x]) - inner[x]) * scales[3]
-        )
+        contrast = max(contrast, np.float32(0))
+        disk = q0 + q1 + q2 + q3 + np.float32(l8[x])
+        product = (disk * scales[0]) * (contrast * scales[1])
+        ring = np.float32(outer[x]) - np.float32(inner[x])
+        product *= max(np.float32(inner[x]) * scales[2], ring * scales[3])
         if product > best[x]:
             best[x] = product
             best_radius[x] = radius
@@ -288,6 +289,7 @@ def best_products(
     scales,
     weights,
     use_min,
+    fused,
     best,
     best_radius,
 ):
@@ -324,6 +326,9 @@ def best_products(
         float32 (w_L, w_LC, w_S).
     use_min : bool
         Combine the quadrants by minimum instead of the printed maximum (Eq. 3.5).
+    fused : bool
+        Combine by :func:`unit_max_product`; only for 16-bit sums, unit weights and the printed
+        maximum.
     """
     longest = max(1, np.max(runs[:, 2] - runs[:, 1])) if runs.shape[0] else 1
     light = np.zeros((LIGHT_WINDOWS, longest), light_tables.dtype)
@@ -335,7 +340,6 @@ def best_products(
     product = np.zeros(longest, np.float32)
     light_flat = light_tables.reshape(light_tables.size)
     sat_flat = sat_tables.reshape(sat_tables.size)
-    unit_max = not use_min and weights[0] == 1 and weights[1] == 1 and weights[2] == 1
     for run in range(runs.shape[0]):
         i, x0, count = runs[run, 0], runs[run, 1], runs[run, 2] - runs[run, 1]
         base = (pad + 1 + i) * sat_tables.shape[2] + pad + x0
@@ -369,7 +373,7 @@ def best_products(
                     light[w],
                 )
             inner, outer = sat[sat_inner[k]], sat[sat_outer[k]]
-            if unit_max:
+            if fused:
                 unit_max_product(
                     light,
                     inner,
