@@ -78,9 +78,9 @@ def thresholds(cmap, params):
     peaks = []
     plain = localization.normalise
 
-    def recording(wcm):
-        peaks.append(float(wcm.max()))
-        return plain(wcm)
+    def recording(wcm, peak=None):
+        peaks.append(float(wcm.max()) if peak is None else peak)
+        return plain(wcm, peak)
 
     localization.normalise = recording
     try:
