@@ -336,9 +336,9 @@ def test_16_bit_tables_give_the_32_bit_map_bit_for_bit(shared_datasets):
         assert narrow[0].max() > 0
 
 
-def test_fused_float32_combination_equals_the_integer_steps_bit_for_bit():
-    # Window sums up to their 16-bit extremes; the fused pass (float32 arithmetic) against the
-    # separate int64 steps, for every radius of the paper's plan.
+def test_fused_combination_equals_the_integer_steps_bit_for_bit():
+    # Window sums up to their 16-bit extremes; the fused pass (in float32 and in int64) against
+    # the separate int64 steps, for every radius of the paper's plan.
     rng = np.random.default_rng(8)
     count, plan = 4000, cs.kernel_plan(tuple(range(1, 11)), 0)
     for k, radius in enumerate(plan.radii):
@@ -355,7 +355,13 @@ def test_fused_float32_combination_equals_the_integer_steps_bit_for_bit():
         ).astype(np.int32)
         start = rng.uniform(0, 0.3, count).astype(np.float32)
         fused = (start.copy(), np.zeros(count, np.int32))
-        ck.unit_max_product(light, inner, outer, nq, nb, plan.scales[k], radius, count, *fused)
+        wide = (start.copy(), np.zeros(count, np.int32))
+        ck.unit_max_product(
+            light, inner, outer, nq, nb, plan.scales[k], radius, count, *fused, np.float32
+        )
+        ck.unit_max_product(
+            light, inner, outer, nq, nb, plan.scales[k], radius, count, *wide, np.int64
+        )
         contrast, disk = np.zeros(count, np.int64), np.zeros(count, np.int32)
         features, product = np.zeros((3, count), np.float32), np.zeros(count, np.float32)
         ck.lightness_contrast(light, nq, nb, False, count, contrast)
@@ -369,6 +375,7 @@ def test_fused_float32_combination_equals_the_integer_steps_bit_for_bit():
         steps = (start.copy(), np.zeros(count, np.int32))
         ck.keep_best(product, radius, count, *steps)
         assert np.array_equal(fused[0], steps[0]) and np.array_equal(fused[1], steps[1])
+        assert np.array_equal(wide[0], steps[0]) and np.array_equal(wide[1], steps[1])
         assert np.count_nonzero(fused[1]) > count // 10
 
 

@@ -431,7 +431,7 @@ def products_on_runs(
         plan.scales,
         np.asarray(weights, np.float32),
         quadrant_rule == "min",
-        narrow_sums(radii, margin) and quadrant_rule == "max" and all(w == 1 for w in weights),
+        np.float32 if narrow_sums(radii, margin) else np.int64,
         best,
         best_radius,
     )

@@ -227,19 +227,19 @@ def keep_best(product, radius, count, best, best_radius):
 
 @njit(cache=True, nogil=True)
 def unit_max_product(
-    light, inner, outer, n_quarter, n_box, scales, radius, count, best, best_radius
+    light, inner, outer, n_quarter, n_box, scales, radius, count, best, best_radius, exact
 ):
     """:func:`lightness_contrast` (printed maximum), :func:`disk_from_quarters`,
     :func:`saturation_feature`, :func:`weighted_product` (unit weights) and :func:`keep_best`
-    fused into one pass per pixel for 16-bit sums (the paper's defaults, Table 5-1): the same
-    values, one loop instead of nine.
+    fused into one pass per pixel (the paper's defaults, Table 5-1): the same values, one loop
+    instead of nine.
 
-    The integer steps run in float32, which holds every integer below 2**24 exactly: with
-    lightness windows of at most ``NARROW_PIXELS`` = 128 pixels, ``n_box * D_k`` and
-    ``n_quarter * B_k`` stay below ``128 * 128 * 255``, the disk below ``4 * 128 * 255`` and
-    the saturation disks (radius up to 2 * 10) below ``1257 * 255``, so every sum, product and
-    difference is the exact integer the int64 steps give, and the float32 steps after them are
-    the same operations in the same order."""
+    The integer steps run in the number type ``exact``: int64 always holds them; float32 holds
+    every integer below 2**24 exactly, and with 16-bit sums (lightness windows of at most
+    ``NARROW_PIXELS`` = 128 pixels) ``n_box * D_k`` and ``n_quarter * B_k`` stay below
+    ``128 * 128 * 255``, the disk below ``4 * 128 * 255`` and the saturation disks (radius up to
+    2 * 10) below ``1257 * 255``, so every sum, product and difference is the same integer, in
+    twice the lanes. The float32 steps after them are the same operations in the same order."""
     l0, l1, l2, l3, l4, l5, l6, l7, l8 = (
         light[0],
         light[1],
@@ -251,17 +251,17 @@ def unit_max_product(
         light[7],
         light[8],
     )
-    nq, nb = np.float32(n_quarter), np.float32(n_box)
+    nq, nb = exact(n_quarter), exact(n_box)
     for x in range(count):
-        q0, q1, q2, q3 = np.float32(l0[x]), np.float32(l1[x]), np.float32(l2[x]), np.float32(l3[x])
+        q0, q1, q2, q3 = exact(l0[x]), exact(l1[x]), exact(l2[x]), exact(l3[x])
         contrast = max(
-            max(nb * q0 - nq * np.float32(l4[x]), nb * q1 - nq * np.float32(l5[x])),
-            max(nb * q2 - nq * np.float32(l6[x]), nb * q3 - nq * np.float32(l7[x])),
+            max(nb * q0 - nq * exact(l4[x]), nb * q1 - nq * exact(l5[x])),
+            max(nb * q2 - nq * exact(l6[x]), nb * q3 - nq * exact(l7[x])),
         )
-        contrast = max(contrast, np.float32(0))
-        disk = q0 + q1 + q2 + q3 + np.float32(l8[x])
-        product = (disk * scales[0]) * (contrast * scales[1])
-        ring = np.float32(outer[x]) - np.float32(inner[x])
+        contrast = max(contrast, exact(0))
+        disk = q0 + q1 + q2 + q3 + exact(l8[x])
+        product = (np.float32(disk) * scales[0]) * (np.float32(contrast) * scales[1])
+        ring = np.float32(exact(outer[x]) - exact(inner[x]))
         product *= max(np.float32(inner[x]) * scales[2], ring * scales[3])
         if product > best[x]:
             best[x] = product
@@ -289,7 +289,7 @@ def best_products(
     scales,
     weights,
     use_min,
-    fused,
+    exact,
     best,
     best_radius,
 ):
@@ -326,9 +326,10 @@ def best_products(
         float32 (w_L, w_LC, w_S).
     use_min : bool
         Combine the quadrants by minimum instead of the printed maximum (Eq. 3.5).
-    fused : bool
-        Combine by :func:`unit_max_product`; only for 16-bit sums, unit weights and the printed
-        maximum.
+    exact : type
+        ``np.float32`` for 16-bit sums, ``np.int64`` otherwise: the number type of the integer
+        steps of :func:`unit_max_product`, which combines when the weights are 1 and the rule is
+        the printed maximum.
     """
     longest = max(1, np.max(runs[:, 2] - runs[:, 1])) if runs.shape[0] else 1
     light = np.zeros((LIGHT_WINDOWS, longest), light_tables.dtype)
@@ -338,6 +339,7 @@ def best_products(
     disk = np.zeros(longest, np.int32)
     features = np.zeros((3, longest), np.float32)
     product = np.zeros(longest, np.float32)
+    fused = not use_min and weights[0] == 1 and weights[1] == 1 and weights[2] == 1
     light_flat = light_tables.reshape(light_tables.size)
     sat_flat = sat_tables.reshape(sat_tables.size)
     for run in range(runs.shape[0]):
@@ -385,6 +387,7 @@ def best_products(
                     count,
                     best[i, x0 : x0 + count],
                     best_radius[i, x0 : x0 + count],
+                    exact,
                 )
                 continue
             lightness_contrast(light, n_quarter[k], n_box[k], use_min, count, contrast)
