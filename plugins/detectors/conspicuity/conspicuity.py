@@ -25,10 +25,10 @@ Speed: every window sum is an exact integer sum of entries of one row-prefix tab
 channel (rows of equal half-width merged into one look-up in its column integral; the plan of
 each window is computed once per radius and executed by the numba kernel in
 ``conspicuity_kernel.py``, one image row at a time), the full lightness disk is assembled from
-its four quarters, saturation disks are shared between radii, the lightness sums run in int16
-when every lightness window is small enough to be exact there (:func:`light_table_type`), and
-the root of Eq. 3.1 is taken once after the maximum of Eq. 3.2 (the root is monotonic, so the
-arg-max is unchanged).
+its four quarters, saturation disks are shared between radii, the sums run in 16 bits when
+every lightness window is small enough to be exact there (:func:`narrow_sums`: int16 lightness,
+uint16 saturation in bands of rows), and the root of Eq. 3.1 is taken once after the maximum
+of Eq. 3.2 (the root is monotonic, so the arg-max is unchanged).
 ``tests/oracles/conspicuity_oracle.py`` is the direct reference these are tested against.
 """
 
@@ -376,7 +376,7 @@ def narrow_sums(radii: Sequence[int], margin: int) -> bool:
     (uint16 saturation tables). The lightness windows of radius ``r`` are the quadrant boxes of
     A1 + A2 (``(r + m + 1)**2`` pixels), the quarters of A1 inside them, and the shared axes
     (minus ``4 r + 3`` pixels, the centre three times): with the paper's radii 1..10 and margin
-    0, at most 121 pixels, and the saturation disks (radius up to 20) take 1-5 bands."""
+    0, at most 121 pixels, and the saturation disks (radius up to 20) take 1-6 bands."""
     return max((max(radii) + margin + 1) ** 2, 4 * max(radii) + 3) <= NARROW_PIXELS
 
 
