@@ -2,6 +2,7 @@
 hand-computed micro images."""
 
 import json
+from itertools import pairwise
 
 import cv2
 import numpy as np
@@ -67,29 +68,30 @@ def kernel_window(tables, terms, row, col, count, out):
     ck.window_sum(tables.reshape(-1), offsets, 0, mid, len(terms), base, count, out)
 
 
-def window_sums(channel, pad, windows, row, prefix=ck.LIGHT_PREFIX):
-    """Kernel sums of several planned windows on one row of a channel mirrored by ``pad``."""
-    padded = cs.mirror(channel, pad)
-    tables = ck.prefix_tables(padded, padded)
-    out = np.zeros((len(windows), channel.shape[1]), np.int32)
+def window_sums(channel, pad, windows, row, dtype=np.int32):
+    """Kernel sums of several planned windows on one row of a channel mirrored by ``pad``, with
+    tables and sums in ``dtype``."""
+    tables = ck.prefix_tables(cs.mirror(channel, pad), dtype)
+    out = np.zeros((len(windows), channel.shape[1]), dtype)
     for window, plan in zip(out, windows):
-        terms = np.array(cs.kernel_terms(plan, prefix), np.int32)
+        terms = np.array(cs.kernel_terms(plan), np.int32)
         kernel_window(tables, terms, pad + 1 + row, pad, channel.shape[1], window)
     return out
 
 
 def test_prefix_tables_are_row_prefixes_and_their_column_integrals():
-    light, sat = cs.lightness(random_image(7)), cs.saturation(random_image(7))
-    tables = ck.prefix_tables(light, sat)
-    for channel, prefix, integral in (
-        (light, ck.LIGHT_PREFIX, ck.LIGHT_INTEGRAL),
-        (sat, ck.SAT_PREFIX, ck.SAT_INTEGRAL),
-    ):
+    for channel in (cs.lightness(random_image(7)), cs.saturation(random_image(7))):
+        tables = ck.prefix_tables(channel)
+        prefix, integral = tables[ck.PREFIX], tables[ck.INTEGRAL]
         rows = np.cumsum(channel, axis=1, dtype=np.int64)
-        assert not tables[prefix, 0].any() and not tables[prefix, :, 0].any()
-        assert np.array_equal(tables[prefix, 1:, 1:], rows)
-        assert np.array_equal(tables[integral, 1:, 1:], np.cumsum(rows, axis=0))
-        assert not tables[integral, 0].any() and not tables[integral, :, 0].any()
+        assert not prefix[0].any() and not prefix[:, 0].any()
+        assert np.array_equal(prefix[1:, 1:], rows)
+        assert np.array_equal(integral[1:, 1:], np.cumsum(rows, axis=0))
+        assert not integral[0].any() and not integral[:, 0].any()
+        # int16 tables hold the same entries modulo 2**16 (they pass 32767 here).
+        narrow = ck.prefix_tables(channel, np.int16)
+        assert narrow.dtype == np.int16 and tables.max() > 32767
+        assert np.array_equal(narrow, tables.astype(np.int16))
 
 
 def test_window_sums_are_exact_integer_sums():
@@ -117,9 +119,9 @@ def test_window_sums_are_exact_integer_sums():
 def test_window_sums_survive_wrapping_integrals():
     # Column integrals of a bright 3000 x 3000 frame pass 2**31; the window sums stay exact.
     bright = np.full((3000, 3000), 255, np.uint8)
-    tables = ck.prefix_tables(bright, bright)
-    assert tables[ck.LIGHT_INTEGRAL].min() < 0
-    terms = np.array(cs.kernel_terms(cs.disk_plan(3), ck.LIGHT_PREFIX), np.int32)
+    tables = ck.prefix_tables(bright)
+    assert tables[ck.INTEGRAL].min() < 0
+    terms = np.array(cs.kernel_terms(cs.disk_plan(3)), np.int32)
     out = np.zeros(4, np.int32)
     kernel_window(tables, terms, 2990, 2990, 4, out)
     assert np.all(out == 255 * cs.disk_size(3))
@@ -180,7 +182,7 @@ def test_disk_and_annulus_sizes():
     assert cs.quarter_disk_size(1) == 3
     sat = np.zeros((20, 20), np.uint8)
     sat[10, 10] = 255
-    sums = window_sums(sat, 8, [cs.disk_plan(2), cs.disk_plan(4)], 10, ck.SAT_PREFIX)
+    sums = window_sums(sat, 8, [cs.disk_plan(2), cs.disk_plan(4)], 10)
     feature = np.zeros(20, np.float32)
     ck.saturation_feature(sums[0], sums[1], cs.mean_scale(13), cs.mean_scale(49 - 13), 20, feature)
     # At the lit pixel the disk mean wins (1/13); three columns away only the annulus sees it.
@@ -267,18 +269,114 @@ def test_candidates_on_real_frames_match_the_round_one_implementation(shared_dat
 
 def test_map_does_not_depend_on_how_the_rows_are_split_into_runs():
     image = random_image(6, (30, 41))
-    tables, pad = cs.channel_tables(image, list(range(1, 11)), 0)
+    tables = cs.channel_tables(image, list(range(1, 11)), 0)
     whole = cs.products_on_runs(
-        tables, pad, cs.full_runs(30, 41), list(range(1, 11)), (1.0, 1.0, 1.0), 0, "max"
+        *tables, cs.full_runs(30, 41), list(range(1, 11)), (1.0, 1.0, 1.0), 0, "max"
     )
     pieces = np.array([(i, a, b) for i in range(30) for a, b in ((0, 7), (7, 8), (8, 41))])
-    split = cs.products_on_runs(tables, pad, pieces, list(range(1, 11)), (1.0, 1.0, 1.0), 0, "max")
+    split = cs.products_on_runs(*tables, pieces, list(range(1, 11)), (1.0, 1.0, 1.0), 0, "max")
     assert np.array_equal(whole[0], split[0]) and np.array_equal(whole[1], split[1])
     assert whole[0].max() > 0
     partial = cs.products_on_runs(
-        tables, pad, pieces[pieces[:, 1] == 7], list(range(1, 11)), (1.0, 1.0, 1.0), 0, "max"
+        *tables, pieces[pieces[:, 1] == 7], list(range(1, 11)), (1.0, 1.0, 1.0), 0, "max"
     )
     assert np.array_equal(partial[0][:, 7], whole[0][:, 7]) and not partial[0][:, 8:].any()
+
+
+def test_lightness_windows_are_exact_in_int16_at_their_largest():
+    # All-white lightness: every radius-10 window at its largest magnitude (the quadrant box
+    # 121 * 255 = 30855, the axes term -43 * 255), summed over tables that wrap many times.
+    white = np.full((50, 3000), 255, np.uint8)
+    windows = [cs.box_plan(10, q) for q in cs.QUADRANTS] + [cs.quarter_plan(10, (1, 1))]
+    windows.append(cs.axes_plan(10))
+    narrow = window_sums(white, 10, windows, 20, np.int16)
+    assert np.array_equal(narrow, window_sums(white, 10, windows, 20))
+    assert narrow[0, 2990] == 30855 and narrow[4, 2990] == 255 * cs.quarter_disk_size(10)
+    assert narrow[5, 2990] == -255 * (4 * 10 + 3)
+
+
+def test_saturation_disk_bands_are_exact_in_uint16_and_add_up_to_the_disk():
+    white = np.full((60, 3000), 255, np.uint8)
+    for radius in (9, 10, 14, 20):
+        bands = cs.disk_bands(radius, ck.BAND_PIXELS)
+        assert bands[0][0] == -radius and bands[-1][1] == radius
+        assert all(a[1] + 1 == b[0] for a, b in pairwise(bands))
+        windows = [cs.disk_plan(radius, *band) for band in bands] + [cs.disk_plan(radius)]
+        wide = window_sums(white, 20, windows, 25)
+        narrow = window_sums(white, 20, windows[:-1], 25, np.uint16)
+        assert np.array_equal(narrow, wide[:-1]) and narrow.max() <= 65535
+        assert np.all(narrow.astype(np.int64).sum(axis=0) == wide[-1])
+        assert wide[-1, 2990] == 255 * cs.disk_size(radius)
+    assert len(cs.disk_bands(20, ck.BAND_PIXELS)) == 6 and cs.disk_bands(20, None) == ((-20, 20),)
+
+
+@pytest.mark.parametrize(
+    "radii, margin, narrow",
+    [((1, 2, 10), 0, True), ((3,), 7, True), ((11,), 0, False), ((4,), 8, False)],
+)
+def test_sums_are_16_bit_only_while_every_lightness_window_fits(radii, margin, narrow):
+    assert cs.narrow_sums(radii, margin) is narrow
+    light, sat, _ = cs.channel_tables(random_image(1), radii, margin)
+    assert (light.dtype, sat.dtype) == ((np.int16, np.uint16) if narrow else (np.int32, np.int32))
+
+
+def test_16_bit_tables_give_the_32_bit_map_bit_for_bit(shared_datasets):
+    root = shared_datasets / "dtld_fridtjofs"
+    entry = json.loads((root / "annotations.json").read_text())[0]
+    image = cv2.imread(str(root / entry["file"]))[:200, :360]
+    radii = list(range(1, 11))
+    light, sat, pad = cs.channel_tables(image, radii, 0)
+    assert (light.dtype, sat.dtype) == (np.int16, np.uint16)
+    wide = [ck.prefix_tables(cs.mirror(f(image), pad)) for f in (cs.lightness, cs.saturation)]
+    runs = cs.full_runs(*image.shape[:2])
+    for rule, weights in (("max", (1.0, 1.0, 1.0)), ("min", (1.0, 2.0, 0.5))):
+        narrow = cs.products_on_runs(light, sat, pad, runs, radii, weights, 0, rule)
+        expected = cs.products_on_runs(*wide, pad, runs, radii, weights, 0, rule)
+        assert np.array_equal(narrow[0], expected[0]) and np.array_equal(narrow[1], expected[1])
+        assert narrow[0].max() > 0
+
+
+def test_fused_combination_equals_the_integer_steps_bit_for_bit():
+    # Window sums up to their 16-bit extremes; the fused pass (in float32 and in int64) against
+    # the separate int64 steps, for every radius of the paper's plan.
+    rng = np.random.default_rng(8)
+    count, plan = 4000, cs.kernel_plan(tuple(range(1, 11)), 0)
+    for k, radius in enumerate(plan.radii):
+        nq, nb = int(plan.n_quarter[k]), int(plan.n_box[k])
+        light = np.zeros((ck.LIGHT_WINDOWS, count), np.int16)
+        light[:4] = rng.integers(0, 255 * nq + 1, (4, count))
+        light[4:8] = np.minimum(
+            light[:4] + rng.integers(0, 255 * (nb - nq) + 1, (4, count)), 255 * nb
+        )
+        light[8] = -rng.integers(0, 255 * (4 * radius + 3) + 1, count)
+        inner = rng.integers(0, 255 * cs.disk_size(radius) + 1, count).astype(np.int32)
+        outer = inner + rng.integers(
+            0, 255 * (cs.disk_size(2 * radius) - cs.disk_size(radius)) + 1, count
+        ).astype(np.int32)
+        start = rng.uniform(0, 0.3, count).astype(np.float32)
+        fused = (start.copy(), np.zeros(count, np.int32))
+        wide = (start.copy(), np.zeros(count, np.int32))
+        ck.unit_max_product(
+            light, inner, outer, nq, nb, plan.scales[k], radius, count, *fused, np.float32
+        )
+        ck.unit_max_product(
+            light, inner, outer, nq, nb, plan.scales[k], radius, count, *wide, np.int64
+        )
+        contrast, disk = np.zeros(count, np.int64), np.zeros(count, np.int32)
+        features, product = np.zeros((3, count), np.float32), np.zeros(count, np.float32)
+        ck.lightness_contrast(light, nq, nb, False, count, contrast)
+        ck.disk_from_quarters(light, count, disk)
+        features[0] = disk.astype(np.float32) * plan.scales[k, 0]
+        features[1] = contrast.astype(np.float32) * plan.scales[k, 1]
+        ck.saturation_feature(
+            inner, outer, plan.scales[k, 2], plan.scales[k, 3], count, features[2]
+        )
+        ck.weighted_product(*features, np.ones(3, np.float32), count, product)
+        steps = (start.copy(), np.zeros(count, np.int32))
+        ck.keep_best(product, radius, count, *steps)
+        assert np.array_equal(fused[0], steps[0]) and np.array_equal(fused[1], steps[1])
+        assert np.array_equal(wide[0], steps[0]) and np.array_equal(wide[1], steps[1])
+        assert np.count_nonzero(fused[1]) > count // 10
 
 
 def test_unusable_settings_fail_at_construction_as_a_parameter_error():

@@ -142,3 +142,30 @@ def test_region_of_interest():
     assert loc.region_of_interest(image, 0.6).shape[0] == 60
     with pytest.raises(ValueError):
         loc.region_of_interest(image, 0.0)
+
+
+def test_clear_found_zeroes_the_raw_peaks_and_the_digital_disks():
+    rng = np.random.default_rng(3)
+    wcm = rng.uniform(0.1, 1.0, (30, 40)).astype(np.float32)
+    raw = np.zeros((30, 40), np.uint8)
+    raw[5, 7] = raw[20, 30] = 1
+    centres = np.array([[10.4, 12.6], [28.0, 39.0], [-1.0, 3.0]])  # the last two cut by edges
+    radius = np.array([3, 2, 1])
+    loc.clear_found(wcm, raw, centres, radius)
+    dy, dx = np.mgrid[:30, :40]
+    expected = raw > 0
+    for (row, col), r in zip(np.rint(centres), radius):
+        expected |= (dy - row) ** 2 + (dx - col) ** 2 <= r * r
+    assert np.array_equal(wcm == 0, expected)
+
+
+def test_normalise_divides_in_place_and_drmshift_takes_a_known_reach():
+    wcm = np.array([[1.0, 4.0], [2.0, 0.0]], np.float32)
+    assert loc.normalise(wcm) is wcm and wcm.tolist() == [[0.25, 1.0], [0.5, 0.0]]
+    cm = blob((40, 40), (20.0, 18.0), 3.0).astype(np.float32)
+    rm = np.full((40, 40), 4, np.int32)
+    rm[0, 0] = 9  # the map's maximum, out of every window's way
+    starts = np.array([[15.0, 15.0], [24.0, 22.0]])
+    found = loc.drmshift(cm, starts, rm)
+    for got, want in zip(loc.drmshift(cm, starts, rm, reach=9), found):
+        assert np.array_equal(got, want)

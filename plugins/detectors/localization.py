@@ -124,15 +124,19 @@ def region_of_interest(image: np.ndarray, top: float) -> np.ndarray:
     return image[: max(1, int(round(image.shape[0] * top)))]
 
 
-def normalise(wcm: np.ndarray) -> np.ndarray:
-    """Eq. 3.13: divide the working map by its maximum (unchanged when the maximum is 0)."""
-    peak = float(wcm.max())
-    return wcm / np.float32(peak) if peak > 0 else wcm
+def normalise(wcm: np.ndarray, peak: float | None = None) -> np.ndarray:
+    """Eq. 3.13: divide the float32 working map by its maximum ``peak`` (found when not given)
+    in place, and return it (unchanged when the maximum is 0)."""
+    peak = float(wcm.max()) if peak is None else peak
+    if peak > 0:
+        np.divide(wcm, np.float32(peak), out=wcm)
+    return wcm
 
 
 def peak_mask(wcm: np.ndarray, h_peak: float) -> np.ndarray:
-    """Eq. 3.14: 1 where the normalised working map exceeds ``h_peak`` (uint8 mask)."""
-    return (wcm > h_peak).astype(np.uint8)
+    """Eq. 3.14: 1 where the normalised working map exceeds ``h_peak`` (uint8 mask, a view of
+    the comparison's booleans)."""
+    return np.greater(wcm, h_peak).view(np.uint8)
 
 
 def denoise(mask: np.ndarray) -> np.ndarray:
@@ -194,6 +198,7 @@ def drmshift(
     radii: np.ndarray | None = None,
     tol: float = 0.5,
     n_max: int = 10,
+    reach: int | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Algorithm 3-1 (dynamic radius mean shift) for many start points at once.
 
@@ -211,6 +216,9 @@ def drmshift(
         Converge threshold ``h_c``: stop when the centre moves less than this.
     n_max : int
         Maximum number of iterations.
+    reach : int, optional
+        The largest window radius (the maximum of ``radius_map`` or ``radii``), when the caller
+        knows it already.
 
     Returns
     -------
@@ -224,8 +232,8 @@ def drmshift(
         if radii is None:
             raise ValueError("drmshift needs a radius_map or fixed radii")
         fixed = np.asarray(radii, dtype=np.int64).reshape(-1)
-        reach = int(fixed.max(initial=0))
-    else:
+        reach = int(fixed.max(initial=0)) if reach is None else reach
+    elif reach is None:
         reach = int(radius_map.max(initial=0))
     dy, dx = _window_offsets(reach)
     active = np.ones(len(centres), bool)
@@ -287,12 +295,11 @@ def too_many(new_count: int, found_count: int, n_pi: int) -> bool:
 def clear_found(
     wcm: np.ndarray, raw_peaks: np.ndarray, centres: np.ndarray, radius: np.ndarray
 ) -> None:
-    """Steps 3.1-3.2: zero the raw peak pixels and the new candidate disks in the working map."""
-    wcm[raw_peaks > 0] = 0
-    disks = np.zeros(wcm.shape, np.uint8)
+    """Steps 3.1-3.2: zero the raw peak pixels and the new candidate disks in the working map
+    (the disks drawn with value 0 straight into it)."""
+    np.putmask(wcm, raw_peaks, 0)
     for (row, col), r in zip(np.rint(centres).astype(int), radius):
-        cv2.circle(disks, (int(col), int(row)), int(r), 1, -1)
-    wcm[disks > 0] = 0
+        cv2.circle(wcm, (int(col), int(row)), int(r), 0, -1)
 
 
 def localize(
@@ -315,20 +322,22 @@ def localize(
     list of Candidate
         At most ``n_top``, best score first; score is ``cm`` at the candidate's centre.
     """
-    wcm = np.asarray(cm, dtype=np.float32).copy()
+    wcm = np.array(cm, dtype=np.float32)
     found_c = np.zeros((0, 2))
     found_r = np.zeros(0, np.int64)
+    reach = None if radius_map is None else int(radius_map.max(initial=0))
     for _ in range(params["max_iter"]):
-        if not wcm.max() > 0:
+        peak = float(wcm.max())
+        if not peak > 0:
             break
-        wcm = normalise(wcm)
+        normalise(wcm, peak)
         raw = peak_mask(wcm, params["h_peak"])
         blobs = components(denoise(raw))
         keep = shape_filter(blobs, params["asp_min"], params["pd_min"])
         starts = blobs.centroids[keep][:, ::-1]
         sizes = np.maximum(1, np.rint(np.sqrt(blobs.areas[keep] / np.pi))).astype(np.int64)
         centres, radius = drmshift(
-            wcm, starts, radius_map, sizes, params["shift_tol"], params["shift_iter"]
+            wcm, starts, radius_map, sizes, params["shift_tol"], params["shift_iter"], reach
         )
         chosen = non_overlapping(centres, radius, found_c, found_r)
         if too_many(len(chosen), len(found_r), params["n_pi"]):

@@ -25,8 +25,10 @@ Speed: every window sum is an exact integer sum of entries of one row-prefix tab
 channel (rows of equal half-width merged into one look-up in its column integral; the plan of
 each window is computed once per radius and executed by the numba kernel in
 ``conspicuity_kernel.py``, one image row at a time), the full lightness disk is assembled from
-its four quarters, saturation disks are shared between radii, and the root of Eq. 3.1 is taken
-once after the maximum of Eq. 3.2 (the root is monotonic, so the arg-max is unchanged).
+its four quarters, saturation disks are shared between radii, the sums run in 16 bits when
+every lightness window is small enough to be exact there (:func:`narrow_sums`: int16 lightness,
+uint16 saturation in bands of rows), and the root of Eq. 3.1 is taken once after the maximum
+of Eq. 3.2 (the root is monotonic, so the arg-max is unchanged).
 ``tests/oracles/conspicuity_oracle.py`` is the direct reference these are tested against.
 """
 
@@ -45,8 +47,8 @@ from tsrkit.params import Param, ParamError
 from tsrkit.plugin import Detector
 from tsrkit.types import Candidate, Frame
 from tsrkit_plugins.detectors.conspicuity.conspicuity_kernel import (
-    LIGHT_PREFIX,
-    SAT_PREFIX,
+    BAND_PIXELS,
+    NARROW_PIXELS,
     best_products,
     flat_offsets,
     positive_ends,
@@ -130,14 +132,30 @@ def compile_terms(
 
 
 @cache
-def disk_plan(radius: int):
-    """Plan of the disk ``|d| <= radius`` (numerator of Eq. 3.3 and Eq. 3.10)."""
+def disk_plan(radius: int, top: int | None = None, bottom: int | None = None):
+    """Plan of the disk ``|d| <= radius`` (numerator of Eq. 3.3 and Eq. 3.10), or of its rows
+    ``top..bottom`` (a band, see :func:`disk_bands`)."""
     w = half_widths(radius)
     runs = []
-    for dy in range(-radius, radius + 1):
+    for dy in range(-radius if top is None else top, (radius if bottom is None else bottom) + 1):
         half = w[abs(dy)]
         runs += [(dy, half + 1, 1), (dy, -half, -1)]
     return compile_terms(runs)
+
+
+@cache
+def disk_bands(radius: int, limit: int | None) -> tuple[tuple[int, int], ...]:
+    """The disk's rows ``(top, bottom)`` cut, from the top, into consecutive bands of at most
+    ``limit`` pixels each (one band when ``limit`` is None)."""
+    w = half_widths(radius)
+    bands, top, pixels = [], -radius, 0
+    for dy in range(-radius, radius + 1):
+        width = 2 * w[abs(dy)] + 1
+        if limit is not None and pixels + width > limit:
+            bands.append((top, dy - 1))
+            top, pixels = dy, 0
+        pixels += width
+    return (*bands, (top, radius))
 
 
 @cache
@@ -176,10 +194,10 @@ def axes_plan(radius: int):
     )
 
 
-def kernel_terms(plan, prefix_table: int) -> list[tuple[int, int, int, int]]:
-    """A plan's ``(on_integral, dy, dc, sign)`` terms as kernel rows ``(table, dy, dc, sign)``
-    for the channel whose prefix table is ``prefix_table`` (its integral follows it)."""
-    return [(prefix_table + int(on_integral), dy, dc, sign) for on_integral, dy, dc, sign in plan]
+def kernel_terms(plan) -> list[tuple[int, int, int, int]]:
+    """A plan's ``(on_integral, dy, dc, sign)`` terms as kernel rows ``(plane, dy, dc, sign)``
+    of a channel's table stack (``conspicuity_kernel.PREFIX`` or ``INTEGRAL``)."""
+    return [(int(on_integral), dy, dc, sign) for on_integral, dy, dc, sign in plan]
 
 
 def mean_scale(count: int) -> np.float32:
@@ -198,6 +216,7 @@ class KernelPlan:
     sat_terms: np.ndarray
     sat_starts: np.ndarray
     sat_mids: np.ndarray
+    sat_bands: np.ndarray
     sat_inner: np.ndarray
     sat_outer: np.ndarray
     radii: np.ndarray
@@ -220,15 +239,18 @@ def kernel_plan(radii: tuple[int, ...], margin: int) -> KernelPlan:
 
     Per radius: the four quarters of A1, the four quadrant boxes of A1 + A2 (half-side
     ``r + m``) and the shared axes on lightness; the saturation disks of radius ``r`` and ``2 r``
-    are planned once per distinct radius (the annulus A3 is their difference).
+    are planned once per distinct radius (the annulus A3 is their difference), as bands of at
+    most :data:`conspicuity_kernel.BAND_PIXELS` pixels with :func:`narrow_sums`.
     """
     light = []
     for r in radii:
-        light += [kernel_terms(quarter_plan(r, q), LIGHT_PREFIX) for q in QUADRANTS]
-        light += [kernel_terms(box_plan(r + margin, q), LIGHT_PREFIX) for q in QUADRANTS]
-        light.append(kernel_terms(axes_plan(r), LIGHT_PREFIX))
+        light += [kernel_terms(quarter_plan(r, q)) for q in QUADRANTS]
+        light += [kernel_terms(box_plan(r + margin, q)) for q in QUADRANTS]
+        light.append(kernel_terms(axes_plan(r)))
     sat_radii = sorted(set(radii) | {2 * r for r in radii})
-    sat = [kernel_terms(disk_plan(r), SAT_PREFIX) for r in sat_radii]
+    limit = BAND_PIXELS if narrow_sums(radii, margin) else None
+    bands = [disk_bands(r, limit) for r in sat_radii]
+    sat = [kernel_terms(disk_plan(r, *band)) for r, rows in zip(sat_radii, bands) for band in rows]
     n_quarter = [quarter_disk_size(r) for r in radii]
     n_box = [(r + margin + 1) ** 2 for r in radii]
     scales = [
@@ -249,6 +271,7 @@ def kernel_plan(radii: tuple[int, ...], margin: int) -> KernelPlan:
         sat_terms,
         sat_starts,
         positive_ends(sat_terms, sat_starts),
+        np.cumsum([0] + [len(rows) for rows in bands]).astype(np.int64),
         np.array([sat_radii.index(r) for r in radii], np.int64),
         np.array([sat_radii.index(2 * r) for r in radii], np.int64),
         np.array(radii, np.int32),
@@ -332,21 +355,48 @@ def conspicuity_map(
         raise ValueError(
             f"expected a BGR uint8 image of shape (H, W, 3); got {image.dtype} {image.shape}"
         )
-    tables, pad = channel_tables(image, radii, margin)
+    light_tables, sat_tables, pad = channel_tables(image, radii, margin)
     best, best_radius = products_on_runs(
-        tables, pad, full_runs(*image.shape[:2]), radii, weights, margin, quadrant_rule
+        light_tables,
+        sat_tables,
+        pad,
+        full_runs(*image.shape[:2]),
+        radii,
+        weights,
+        margin,
+        quadrant_rule,
     )
     return ConspicuityMap(weighted_root(best, weights), best_radius)
 
 
-def channel_tables(image: np.ndarray, radii: Sequence[int], margin: int) -> tuple[np.ndarray, int]:
-    """Prefix tables of the mirrored lightness and saturation, with the padding they need."""
+def narrow_sums(radii: Sequence[int], margin: int) -> bool:
+    """Whether the kernel sums in 16 bits: true when no lightness window holds more than
+    :data:`conspicuity_kernel.NARROW_PIXELS` pixels (int16 lightness tables); the saturation
+    disks are then summed in bands of at most :data:`conspicuity_kernel.BAND_PIXELS` pixels
+    (uint16 saturation tables). The lightness windows of radius ``r`` are the quadrant boxes of
+    A1 + A2 (``(r + m + 1)**2`` pixels), the quarters of A1 inside them, and the shared axes
+    (minus ``4 r + 3`` pixels, the centre three times): with the paper's radii 1..10 and margin
+    0, at most 121 pixels, and the saturation disks (radius up to 20) take 1-6 bands."""
+    return max((max(radii) + margin + 1) ** 2, 4 * max(radii) + 3) <= NARROW_PIXELS
+
+
+def channel_tables(
+    image: np.ndarray, radii: Sequence[int], margin: int
+) -> tuple[np.ndarray, np.ndarray, int]:
+    """Prefix tables of the mirrored lightness and saturation (int16 and uint16 with
+    :func:`narrow_sums`, int32 otherwise), with the padding they need."""
     pad = max(2 * max(radii), max(radii) + margin)
-    return prefix_tables(mirror(lightness(image), pad), mirror(saturation(image), pad)), pad
+    narrow = narrow_sums(radii, margin)
+    return (
+        prefix_tables(mirror(lightness(image), pad), np.int16 if narrow else np.int32),
+        prefix_tables(mirror(saturation(image), pad), np.uint16 if narrow else np.int32),
+        pad,
+    )
 
 
 def products_on_runs(
-    tables: np.ndarray,
+    light_tables: np.ndarray,
+    sat_tables: np.ndarray,
     pad: int,
     runs: np.ndarray,
     radii: Sequence[int],
@@ -357,20 +407,22 @@ def products_on_runs(
     """Eq. 3.1 under its root, maximised over the radii (Eq. 3.2), on the pixels of ``runs``;
     returns the float32 maximum (0 elsewhere) and the int32 arg-max radius (smallest radius
     elsewhere and on ties)."""
-    shape = (tables.shape[1] - 1 - 2 * pad, tables.shape[2] - 1 - 2 * pad)
+    shape = (sat_tables.shape[1] - 1 - 2 * pad, sat_tables.shape[2] - 1 - 2 * pad)
     plan = kernel_plan(tuple(radii), margin)
     best = np.zeros(shape, np.float32)
     best_radius = np.full(shape, min(radii), np.int32)
     best_products(
-        tables,
+        light_tables,
+        sat_tables,
         pad,
         runs,
-        flat_offsets(plan.light_terms, tables.shape),
+        flat_offsets(plan.light_terms, light_tables.shape),
         plan.light_starts,
         plan.light_mids,
-        flat_offsets(plan.sat_terms, tables.shape),
+        flat_offsets(plan.sat_terms, sat_tables.shape),
         plan.sat_starts,
         plan.sat_mids,
+        plan.sat_bands,
         plan.sat_inner,
         plan.sat_outer,
         plan.radii,
@@ -379,6 +431,7 @@ def products_on_runs(
         plan.scales,
         np.asarray(weights, np.float32),
         quadrant_rule == "min",
+        np.float32 if narrow_sums(radii, margin) else np.int64,
         best,
         best_radius,
     )

@@ -10,14 +10,21 @@ NumPy/OpenCV execution (commit e57479b) are applied in the same order, so with u
 the values are bit for bit the same (other weights use ``powf`` instead of ``cv2.pow``: within
 6e-8). A full frame is one run per row; a caller may pass any subset of pixels as runs.
 
-Integer sums wrap modulo 2**32 in the int32 buffers like the int32 tables do, so the true sums
-(which are small) come out exact even when the column integrals of a large frame overflow.
+Integer sums wrap in the buffers like the tables do (modulo 2**32 in int32, 2**16 in int16), so
+the true sums (which are small) come out exact even when the column integrals overflow.
 
 Speed (issue 16): the tables are built in one compiled pass per channel; every term is a flat
 offset into the flattened tables, so each read is a contiguous run the compiler vectorises; and
-a window adds its terms in groups of four, reading and writing its buffer once per group. Being
-integer sums, none of this changes a value (``bench_conspicuity.py --baseline`` checks the maps
-and the candidates against an earlier commit's).
+a window adds its terms in groups of four, reading and writing its buffer once per group. When
+every lightness window holds at most :data:`NARROW_PIXELS` pixels (radius + margin <= 10, the
+paper's defaults), the lightness tables and buffers are int16: the tables wrap modulo 2**16,
+each window sum is computed modulo 2**16, and since its true value lies in [-32768, 32767] it
+comes out exact, with twice the lanes per vector operation (the lightness windows take about
+half the time they took in int32). The saturation disks (up to 1257 pixels) are then summed
+the same way in uint16, in bands of rows of at most :data:`BAND_PIXELS` pixels whose sums
+(in [0, 65535]) are added in int32. Being exact integer sums, none of this changes a value
+(``bench_conspicuity.py --baseline`` checks the maps and the candidates against an earlier
+commit's).
 """
 
 from __future__ import annotations
@@ -27,33 +34,40 @@ from itertools import pairwise
 import numpy as np
 from numba import njit
 
-#: Row of the table stack for each (channel, kind): lightness prefix, lightness integral,
-#: saturation prefix, saturation integral.
-LIGHT_PREFIX, LIGHT_INTEGRAL, SAT_PREFIX, SAT_INTEGRAL = range(4)
+#: Plane of a channel's table stack: the row prefix sums, and their column integrals.
+PREFIX, INTEGRAL = range(2)
+
+#: The most pixels a window of a uint8 channel may hold for its sum (at most
+#: ``255 * NARROW_PIXELS`` in magnitude) to be exact in int16 arithmetic.
+NARROW_PIXELS = np.iinfo(np.int16).max // 255
+
+#: The most pixels a band of a saturation disk may hold for its (non-negative) sum to be exact
+#: in uint16 arithmetic.
+BAND_PIXELS = np.iinfo(np.uint16).max // 255
 
 #: Lightness windows per radius, in this order: the four quarters of A1, the four quadrant
 #: boxes of A1 + A2, and the shared axes that rebuild the full disk from its quarters.
 LIGHT_WINDOWS = 9
 
 
-def prefix_tables(light: np.ndarray, sat: np.ndarray) -> np.ndarray:
-    """Stack of row prefix sums and their column integrals of two mirrored uint8 channels.
+def prefix_tables(channel: np.ndarray, dtype: type = np.int32) -> np.ndarray:
+    """Row prefix sums of a mirrored uint8 channel and their column integrals, stacked.
 
-    ``table[k, y, c]`` for a prefix table is the sum of padded row ``y - 1`` left of column
-    ``c`` (row 0 and column 0 are zero); an integral table sums the prefix rows ``0..y``.
-    int32 integrals may wrap on large frames; differences stay exact modulo 2**32.
+    ``table[PREFIX, y, c]`` is the sum of padded row ``y - 1`` left of column ``c`` (row 0 and
+    column 0 are zero); ``table[INTEGRAL]`` sums the prefix rows ``0..y``. Entries are stored
+    in ``dtype`` (int32, or int16 for :data:`NARROW_PIXELS` windows) and wrap modulo its
+    range; differences of entries stay exact modulo it.
     """
-    height, width = light.shape
-    stack = np.zeros((4, height + 1, width + 1), np.int32)
-    fill_tables(light, stack[LIGHT_PREFIX], stack[LIGHT_INTEGRAL])
-    fill_tables(sat, stack[SAT_PREFIX], stack[SAT_INTEGRAL])
+    height, width = channel.shape
+    stack = np.zeros((2, height + 1, width + 1), dtype)
+    fill_tables(channel, stack[PREFIX], stack[INTEGRAL])
     return stack
 
 
 @njit(cache=True, nogil=True)
 def fill_tables(channel, prefix, integral):
     """Row prefix sums of ``channel`` into ``prefix`` and their running column sums into
-    ``integral`` (both zero on entry), in one pass over the rows; int32 stores wrap."""
+    ``integral`` (both zero on entry), in one pass over the rows; integer stores wrap."""
     height, width = channel.shape
     for y in range(height):
         total = 0
@@ -67,8 +81,8 @@ def fill_tables(channel, prefix, integral):
 
 
 def flat_offsets(terms: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
-    """Offsets of terms (table, dy, dc, sign) in the flattened table stack of ``shape``,
-    relative to a pixel's flat index in the first table."""
+    """Offsets of terms (plane, dy, dc, sign) in the flattened table stack of ``shape``,
+    relative to a pixel's flat index in the prefix plane."""
     terms = terms.astype(np.int64)
     return (terms[:, 0] * shape[1] + terms[:, 1]) * shape[2] + terms[:, 2]
 
@@ -95,8 +109,8 @@ def window_sum(flat, offsets, first, mid, last, base, count, out):
     in the flattened ``flat`` tables.
 
     Terms are added four at a time, or two positive and two negative ones, so that ``out`` is
-    read and written once per group rather than once per term; int32 sums wrap, so the
-    grouping does not change the result.
+    read and written once per group rather than once per term; stores into ``out`` (of the
+    tables' integer type) wrap, so the grouping does not change the result.
     """
     target = out[:count]
     target[:] = 0
@@ -213,12 +227,19 @@ def keep_best(product, radius, count, best, best_radius):
 
 @njit(cache=True, nogil=True)
 def unit_max_product(
-    light, inner, outer, n_quarter, n_box, scales, radius, count, best, best_radius
+    light, inner, outer, n_quarter, n_box, scales, radius, count, best, best_radius, exact
 ):
     """:func:`lightness_contrast` (printed maximum), :func:`disk_from_quarters`,
     :func:`saturation_feature`, :func:`weighted_product` (unit weights) and :func:`keep_best`
-    fused into one pass per pixel, with the same integer and float32 operations in the same
-    order (the paper's defaults, Table 5-1): the same values, one loop instead of nine."""
+    fused into one pass per pixel (the paper's defaults, Table 5-1): the same values, one loop
+    instead of nine.
+
+    The integer steps run in the number type ``exact``: int64 always holds them; float32 holds
+    every integer below 2**24 exactly, and with 16-bit sums (lightness windows of at most
+    ``NARROW_PIXELS`` = 128 pixels) ``n_box * D_k`` and ``n_quarter * B_k`` stay below
+    ``128 * 128 * 255``, the disk below ``4 * 128 * 255`` and the saturation disks (radius up to
+    2 * 10) below ``1257 * 255``, so every sum, product and difference is the same integer, in
+    twice the lanes. The float32 steps after them are the same operations in the same order."""
     l0, l1, l2, l3, l4, l5, l6, l7, l8 = (
         light[0],
         light[1],
@@ -230,24 +251,18 @@ def unit_max_product(
         light[7],
         light[8],
     )
-    nq, nb = np.int64(n_quarter), np.int64(n_box)
+    nq, nb = exact(n_quarter), exact(n_box)
     for x in range(count):
+        q0, q1, q2, q3 = exact(l0[x]), exact(l1[x]), exact(l2[x]), exact(l3[x])
         contrast = max(
-            max(
-                nb * np.int64(l0[x]) - nq * np.int64(l4[x]),
-                nb * np.int64(l1[x]) - nq * np.int64(l5[x]),
-            ),
-            max(
-                nb * np.int64(l2[x]) - nq * np.int64(l6[x]),
-                nb * np.int64(l3[x]) - nq * np.int64(l7[x]),
-            ),
+            max(nb * q0 - nq * exact(l4[x]), nb * q1 - nq * exact(l5[x])),
+            max(nb * q2 - nq * exact(l6[x]), nb * q3 - nq * exact(l7[x])),
         )
-        contrast = max(contrast, np.int64(0))
-        disk = np.int64(l0[x]) + l1[x] + l2[x] + l3[x] + l8[x]
+        contrast = max(contrast, exact(0))
+        disk = q0 + q1 + q2 + q3 + exact(l8[x])
         product = (np.float32(disk) * scales[0]) * (np.float32(contrast) * scales[1])
-        product *= max(
-            np.float32(inner[x]) * scales[2], np.float32(np.int64(outer[x]) - inner[x]) * scales[3]
-        )
+        ring = np.float32(exact(outer[x]) - exact(inner[x]))
+        product *= max(np.float32(inner[x]) * scales[2], ring * scales[3])
         if product > best[x]:
             best[x] = product
             best_radius[x] = radius
@@ -255,7 +270,8 @@ def unit_max_product(
 
 @njit(cache=True, nogil=True)
 def best_products(
-    tables,
+    light_tables,
+    sat_tables,
     pad,
     runs,
     light_offsets,
@@ -264,6 +280,7 @@ def best_products(
     sat_offsets,
     sat_starts,
     sat_mids,
+    sat_bands,
     sat_inner,
     sat_outer,
     radii,
@@ -272,6 +289,7 @@ def best_products(
     scales,
     weights,
     use_min,
+    exact,
     best,
     best_radius,
 ):
@@ -280,8 +298,9 @@ def best_products(
 
     Parameters
     ----------
-    tables : ndarray
-        int32 (4, H + 2 pad + 1, W + 2 pad + 1) from :func:`prefix_tables`.
+    light_tables, sat_tables : ndarray
+        (2, H + 2 pad + 1, W + 2 pad + 1) from :func:`prefix_tables`: lightness (int16 or
+        int32; the window buffers take its type) and saturation (int32).
     pad : int
         Mirror padding of the tables.
     runs : ndarray
@@ -292,7 +311,10 @@ def best_products(
         ``light_starts[k * LIGHT_WINDOWS + w]`` to the next start, its positive terms ending at
         ``light_mids[k * LIGHT_WINDOWS + w]``.
     sat_offsets, sat_starts, sat_mids : ndarray
-        The same for the saturation disks, disk ``d`` spanning ``sat_starts[d:d + 2]``.
+        The same for the bands of the saturation disks, band ``b`` spanning
+        ``sat_starts[b:b + 2]``.
+    sat_bands : ndarray
+        Disk ``d`` is the sum of bands ``sat_bands[d]`` to ``sat_bands[d + 1]`` (exclusive).
     sat_inner, sat_outer : ndarray
         Per radius index, the saturation disk of radius ``r`` and of ``2 r``.
     radii, n_quarter, n_box : ndarray
@@ -304,35 +326,46 @@ def best_products(
         float32 (w_L, w_LC, w_S).
     use_min : bool
         Combine the quadrants by minimum instead of the printed maximum (Eq. 3.5).
+    exact : type
+        ``np.float32`` for 16-bit sums, ``np.int64`` otherwise: the number type of the integer
+        steps of :func:`unit_max_product`, which combines when the weights are 1 and the rule is
+        the printed maximum.
     """
     longest = max(1, np.max(runs[:, 2] - runs[:, 1])) if runs.shape[0] else 1
-    light = np.zeros((LIGHT_WINDOWS, longest), np.int32)
-    sat = np.zeros((sat_starts.shape[0] - 1, longest), np.int32)
+    light = np.zeros((LIGHT_WINDOWS, longest), light_tables.dtype)
+    sat = np.zeros((sat_bands.shape[0] - 1, longest), np.int32)
+    band = np.zeros(longest, sat_tables.dtype)
     contrast = np.zeros(longest, np.int64)
     disk = np.zeros(longest, np.int32)
     features = np.zeros((3, longest), np.float32)
     product = np.zeros(longest, np.float32)
-    flat = tables.reshape(tables.size)
-    unit_max = not use_min and weights[0] == 1 and weights[1] == 1 and weights[2] == 1
+    fused = not use_min and weights[0] == 1 and weights[1] == 1 and weights[2] == 1
+    light_flat = light_tables.reshape(light_tables.size)
+    sat_flat = sat_tables.reshape(sat_tables.size)
     for run in range(runs.shape[0]):
         i, x0, count = runs[run, 0], runs[run, 1], runs[run, 2] - runs[run, 1]
-        base = (pad + 1 + i) * tables.shape[2] + pad + x0
+        base = (pad + 1 + i) * sat_tables.shape[2] + pad + x0
         for d in range(sat.shape[0]):
-            window_sum(
-                flat,
-                sat_offsets,
-                sat_starts[d],
-                sat_mids[d],
-                sat_starts[d + 1],
-                base,
-                count,
-                sat[d],
-            )
+            total = sat[d]
+            total[:count] = 0
+            for b in range(sat_bands[d], sat_bands[d + 1]):
+                window_sum(
+                    sat_flat,
+                    sat_offsets,
+                    sat_starts[b],
+                    sat_mids[b],
+                    sat_starts[b + 1],
+                    base,
+                    count,
+                    band,
+                )
+                for x in range(count):
+                    total[x] += band[x]
         for k in range(radii.shape[0]):
             for w in range(LIGHT_WINDOWS):
                 start = k * LIGHT_WINDOWS + w
                 window_sum(
-                    flat,
+                    light_flat,
                     light_offsets,
                     light_starts[start],
                     light_mids[start],
@@ -342,7 +375,7 @@ def best_products(
                     light[w],
                 )
             inner, outer = sat[sat_inner[k]], sat[sat_outer[k]]
-            if unit_max:
+            if fused:
                 unit_max_product(
                     light,
                     inner,
@@ -354,6 +387,7 @@ def best_products(
                     count,
                     best[i, x0 : x0 + count],
                     best_radius[i, x0 : x0 + count],
+                    exact,
                 )
                 continue
             lightness_contrast(light, n_quarter[k], n_box[k], use_min, count, contrast)
