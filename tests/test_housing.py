@@ -88,7 +88,10 @@ def test_every_fitted_housing_holds_its_lens():
     lenses = [(float(x), float(y), float(r)) for x, y, r in zip(
         rng.uniform(20, 300, 200), rng.uniform(20, 220, 200), rng.uniform(1, 12, 200)
     )]  # fmt: skip
-    boxes, _, radii = fit_housings(gray, lenses)
-    x, y, _ = np.array(lenses).T
+    boxes, _, used = fit_housings(gray, lenses)
+    x, y, radii = used.T  # the lens each fit measured and used
     assert np.all(boxes[:, 0] <= x - radii) and np.all(boxes[:, 2] >= x + radii)
     assert np.all(boxes[:, 1] <= y - radii) and np.all(boxes[:, 3] >= y + radii)
+    cx, cy, _ = np.array(lenses).T  # and the candidate's own centre
+    assert np.all((boxes[:, 0] <= cx) & (cx <= boxes[:, 2]))
+    assert np.all((boxes[:, 1] <= cy) & (cy <= boxes[:, 3]))

@@ -2,9 +2,10 @@
 
 Works after any detector (``-V housing``): each candidate keeps its lens (``x``, ``y``,
 ``radius``, ``lens_bbox`` in records) and gains ``housing`` and ``housing_score``
-(:mod:`.fit`), so records, COCO output and IoU metrics evaluate housing boxes on datasets that
-box housings (``--eval-box housing``). Candidates whose housings overlap a better-scored one's
-are the same light and are dropped (``nms_iou``); ``min_score`` drops poor fits.
+(:mod:`.fit`, from the lit lens measured near the candidate, :mod:`.lens`), so records, COCO
+output and IoU metrics evaluate housing boxes on datasets that box housings (``--eval-box
+housing``). Candidates whose housings overlap a better-scored one's are the same light and are
+dropped (``nms_iou``); ``min_score`` drops poor fits.
 """
 
 from __future__ import annotations
@@ -29,7 +30,7 @@ def suppress(candidates: list[Candidate], threshold: float) -> list[Candidate]:
     overlap = iou_matrix([c.housing for c in candidates], [c.housing for c in candidates])
     kept: list[int] = []
     for i in range(len(candidates)):
-        if all(overlap[i, j] <= threshold for j in kept):
+        if not kept or overlap[i, kept].max() <= threshold:
             kept.append(i)
     return [candidates[i] for i in kept]
 
