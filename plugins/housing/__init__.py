@@ -5,7 +5,8 @@ Works after any detector (``-V housing``): each candidate keeps its lens (``x``,
 (:mod:`.fit`, from the lit lens measured near the candidate, :mod:`.lens`), so records, COCO
 output and IoU metrics evaluate housing boxes on datasets that box housings (``--eval-box
 housing``). Candidates whose housings overlap a better-scored one's are the same light and are
-dropped (``nms_iou``); ``min_score`` drops poor fits.
+dropped (``nms_iou``); ``min_score`` drops poor fits. ``margin`` widens every housing to a
+dataset's box convention (:mod:`.margin`: learn it from a training split).
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from tsrkit.params import Param
 from tsrkit.plugin import Verifier
 from tsrkit.types import Candidate, Frame
 from tsrkit_plugins.housing.fit import fit_housings
+from tsrkit_plugins.housing.margin import widen
 
 
 def suppress(candidates: list[Candidate], threshold: float) -> list[Candidate]:
@@ -59,6 +61,15 @@ class Housing(Verifier):
             max=1.0,
             help="drop candidates whose housing fit scores below this (0 keeps all)",
         ),
+        Param(
+            "margin",
+            "float",
+            0.0,
+            min=0.0,
+            max=1.0,
+            help="widen each housing on every side by this share of its short side: a "
+            "dataset's box convention, learned from its training split (learn_margin)",
+        ),
     )
 
     def verify(self, frame: Frame, candidates: Sequence[Candidate]) -> list[Candidate]:
@@ -66,6 +77,7 @@ class Housing(Verifier):
             return []
         gray = cv2.cvtColor(frame.image, cv2.COLOR_BGR2GRAY)
         boxes, scores, _ = fit_housings(gray, [(c.x, c.y, c.radius) for c in candidates])
+        boxes = widen(boxes, self.params["margin"])
         fitted = [
             replace(c, housing=tuple(float(v) for v in box), housing_score=float(score))
             for c, box, score in zip(candidates, boxes, scores)
