@@ -5,7 +5,9 @@ Works after any detector (``-V housing``): each candidate keeps its lens (``x``,
 (:mod:`.fit`, from the lit lens measured near the candidate, :mod:`.lens`), so records, COCO
 output and IoU metrics evaluate housing boxes on datasets that box housings (``--eval-box
 housing``). Candidates whose housings overlap a better-scored one's are the same light and are
-dropped (``nms_iou``); ``min_score`` drops poor fits. ``margin`` widens every housing to a
+dropped (``nms_iou``); ``min_score`` drops poor fits; ``rescore`` weighs each candidate's
+score by its fit (housing AP50 of the ``union`` candidates, ranked by their agreement alone:
+cinTA test 0.28 -> 0.34, ``benchmarks/RESULTS.housing.md``). ``margin`` widens every housing to a
 dataset's box convention (:mod:`.margin`: learn it from a training split).
 """
 
@@ -70,6 +72,13 @@ class Housing(Verifier):
             help="widen each housing on every side by this share of its short side: a "
             "dataset's box convention, learned from its training split (learn_margin)",
         ),
+        Param(
+            "rescore",
+            "bool",
+            True,
+            help="multiply each candidate's score by its housing fit score: a lamp in a dark "
+            "head ranks above a lamp-like blob without one",
+        ),
     )
 
     def verify(self, frame: Frame, candidates: Sequence[Candidate]) -> list[Candidate]:
@@ -78,10 +87,16 @@ class Housing(Verifier):
         gray = cv2.cvtColor(frame.image, cv2.COLOR_BGR2GRAY)
         boxes, scores, _ = fit_housings(gray, [(c.x, c.y, c.radius) for c in candidates])
         boxes = widen(boxes, self.params["margin"])
+        weigh = self.params["rescore"]
         fitted = [
-            replace(c, housing=tuple(float(v) for v in box), housing_score=float(score))
-            for c, box, score in zip(candidates, boxes, scores)
-            if score >= self.params["min_score"]
+            replace(
+                c,
+                housing=tuple(float(v) for v in box),
+                housing_score=float(fit),
+                score=c.score * float(fit) if weigh else c.score,
+            )
+            for c, box, fit in zip(candidates, boxes, scores)
+            if fit >= self.params["min_score"]
         ]
         return suppress(sorted(fitted, key=lambda c: -c.score), self.params["nms_iou"])
 
