@@ -45,16 +45,17 @@ def test_stage_keeps_the_lens_adds_the_housing_and_drops_duplicates():
     lens = Candidate.from_circle(150, 100, 8, 0.9)
     twin = Candidate.from_circle(151, 101, 7, 0.5)  # the same light found twice
     sky = Candidate.from_circle(40, 20, 6, 0.7)
-    stage = get_registry().create("verifier", "housing", {"rescore": False})
+    stage = get_registry().create("verifier", "housing")
     out = stage.verify(Frame(image, "x"), [twin, sky, lens])
     assert [c.score for c in out] == [0.9, 0.7]
-    weighed = get_registry().create("verifier", "housing").verify(Frame(image, "x"), [lens, sky])
+    weigh = get_registry().create("verifier", "housing", {"rescore": True})
+    weighed = weigh.verify(Frame(image, "x"), [lens, sky])
     assert [c.score for c in weighed] == [c.score * c.housing_score for c in out]  # x fit
     best = out[0]
     assert (best.x, best.y, best.radius, best.bbox) == (lens.x, lens.y, lens.radius, lens.bbox)
     assert iou_matrix([head.housing], [best.housing])[0, 0] >= 0.8
     assert best.housing_score > out[1].housing_score
-    strict = get_registry().create("verifier", "housing", {"min_score": 0.5, "rescore": False})
+    strict = get_registry().create("verifier", "housing", {"min_score": 0.5})
     assert [c.score for c in strict.verify(Frame(image, "x"), [lens, sky])] == [0.9]
 
 

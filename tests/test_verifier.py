@@ -156,18 +156,17 @@ def test_prior_blends_the_detectors_score_with_the_probability(trained):
     own = [0.0, 0.5, 1.0, 7.0][: len(candidates)]  # detector scores, clipped to [0, 1]
     candidates = [dataclasses.replace(c, score=s) for c, s in zip(candidates, own)]
     # the verifier fits housings first (after=housing): read the probability after that stage
-    # (here without its rescoring, which the verifier's own stage applies: score x fit)
-    stage = get_registry().create("verifier", "housing", {"rescore": False})
-    candidates = stage.verify(frame, candidates)
+    candidates = get_registry().create("verifier", "housing").verify(frame, candidates)
     plain = make(model=str(trained[0]), threshold=0.0)
     probability = plain.probabilities(frame, candidates)
     blended = make(model=str(trained[0]), threshold=0.0, prior=0.7).verify(frame, candidates)
-    own = {(c.x, c.y): min(c.score * c.housing_score, 1.0) for c in candidates}
-    expected = {(c.x, c.y): 0.3 * p + 0.7 * own[c.x, c.y] for c, p in zip(candidates, probability)}
+    expected = {
+        (c.x, c.y): 0.3 * p + 0.7 * min(c.score, 1.0) for c, p in zip(candidates, probability)
+    }
     assert blended  # the housing stage may merge duplicates; the survivors are blended
     assert [c.score for c in blended] == pytest.approx([expected[c.x, c.y] for c in blended])
-    alone = make(model=str(trained[0]), prior=1.0, threshold=0.0).verify(frame, candidates)
-    assert alone and {c.score for c in alone} <= set(own.values())
+    alone = make(model=str(trained[0]), prior=1.0).verify(frame, candidates)  # threshold 0.5
+    assert alone and {c.score for c in alone} <= {0.5, 1.0}
 
 
 def test_corrupt_foreign_or_mismatched_models_are_one_clear_error(trained, tmp_path):
