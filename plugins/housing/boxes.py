@@ -13,18 +13,19 @@ def integral(gray: np.ndarray) -> np.ndarray:
 
 
 def box_sums(table: np.ndarray, boxes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Sums and pixel counts of ``boxes`` (..., 4) as (x0, y0, x1, y1), rounded to pixels and
-    clipped to the image."""
+    """Sums (in the table's integer type) and pixel counts of ``boxes`` (..., 4) as
+    (x0, y0, x1, y1), rounded to pixels and clipped to the image."""
     height, width = table.shape[0] - 1, table.shape[1] - 1
     corners = np.rint(boxes)
     np.clip(corners, 0.0, np.array([width, height, width, height], np.float64), out=corners)
     corners = corners.astype(np.intp)
-    x0, y0, x1, y1 = np.moveaxis(corners, -1, 0)
-    x1, y1 = np.maximum(x1, x0), np.maximum(y1, y0)
+    x0, y0, x1, y1 = (corners[..., k] for k in range(4))
+    np.maximum(x1, x0, out=x1)
+    np.maximum(y1, y0, out=y1)
     flat, stride = table.ravel(), width + 1
     top, bottom = y0 * stride, y1 * stride
     total = flat[bottom + x1] - flat[top + x1] - flat[bottom + x0] + flat[top + x0]
-    return total.astype(np.float64), ((x1 - x0) * (y1 - y0)).astype(np.float64)
+    return total, ((x1 - x0) * (y1 - y0)).astype(np.float64)
 
 
 def box_means(table: np.ndarray, boxes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
