@@ -33,10 +33,11 @@ def suppress(candidates: list[Candidate], threshold: float) -> list[Candidate]:
     """Greedy non-maximum suppression on the housings of score-ordered ``candidates``."""
     if threshold >= 1.0 or len(candidates) < 2:
         return candidates
-    overlap = iou_matrix([c.housing for c in candidates], [c.housing for c in candidates])
+    housings = [c.housing for c in candidates]
+    overlap = (iou_matrix(housings, housings) > threshold).tolist()
     kept: list[int] = []
-    for i in range(len(candidates)):
-        if not kept or overlap[i, kept].max() <= threshold:
+    for i, row in enumerate(overlap):
+        if not any(row[j] for j in kept):
             kept.append(i)
     return [candidates[i] for i in kept]
 
@@ -93,11 +94,11 @@ class Housing(Verifier):
         fitted = [
             replace(
                 c,
-                housing=tuple(float(v) for v in box),
-                housing_score=float(fit),
-                score=c.score * float(fit) if weigh else c.score,
+                housing=tuple(box),
+                housing_score=fit,
+                score=c.score * fit if weigh else c.score,
             )
-            for c, box, fit in zip(candidates, boxes, scores)
+            for c, box, fit in zip(candidates, boxes.tolist(), scores.tolist())
             if fit >= self.params["min_score"]
         ]
         return suppress(sorted(fitted, key=lambda c: -c.score), self.params["nms_iou"])
