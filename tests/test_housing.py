@@ -48,6 +48,9 @@ def test_stage_keeps_the_lens_adds_the_housing_and_drops_duplicates():
     stage = get_registry().create("verifier", "housing")
     out = stage.verify(Frame(image, "x"), [twin, sky, lens])
     assert [c.score for c in out] == [0.9, 0.7]
+    weigh = get_registry().create("verifier", "housing", {"rescore": True})
+    weighed = weigh.verify(Frame(image, "x"), [lens, sky])
+    assert [c.score for c in weighed] == [c.score * c.housing_score for c in out]  # x fit
     best = out[0]
     assert (best.x, best.y, best.radius, best.bbox) == (lens.x, lens.y, lens.radius, lens.bbox)
     assert iou_matrix([head.housing], [best.housing])[0, 0] >= 0.8
@@ -88,7 +91,10 @@ def test_every_fitted_housing_holds_its_lens():
     lenses = [(float(x), float(y), float(r)) for x, y, r in zip(
         rng.uniform(20, 300, 200), rng.uniform(20, 220, 200), rng.uniform(1, 12, 200)
     )]  # fmt: skip
-    boxes, _, radii = fit_housings(gray, lenses)
-    x, y, _ = np.array(lenses).T
+    boxes, _, used = fit_housings(gray, lenses)
+    x, y, radii = used.T  # the lens each fit measured and used
     assert np.all(boxes[:, 0] <= x - radii) and np.all(boxes[:, 2] >= x + radii)
     assert np.all(boxes[:, 1] <= y - radii) and np.all(boxes[:, 3] >= y + radii)
+    cx, cy, _ = np.array(lenses).T  # and the candidate's own centre
+    assert np.all((boxes[:, 0] <= cx) & (cx <= boxes[:, 2]))
+    assert np.all((boxes[:, 1] <= cy) & (cy <= boxes[:, 3]))

@@ -2,9 +2,15 @@
 
 Works after any detector (``-V housing``): each candidate keeps its lens (``x``, ``y``,
 ``radius``, ``lens_bbox`` in records) and gains ``housing`` and ``housing_score``
-(:mod:`.fit`), so records, COCO output and IoU metrics evaluate housing boxes on datasets that
-box housings (``--eval-box housing``). Candidates whose housings overlap a better-scored one's
-are the same light and are dropped (``nms_iou``); ``min_score`` drops poor fits.
+(:mod:`.fit`, from the lit lens measured near the candidate, :mod:`.lens`), so records, COCO
+output and IoU metrics evaluate housing boxes on datasets that box housings (``--eval-box
+housing``). Candidates whose housings overlap a better-scored one's are the same light and are
+dropped (``nms_iou``); ``min_score`` drops poor fits; ``rescore`` weighs each candidate's
+score by its fit, for pipelines without a verifier (housing AP50 of the ``union`` candidates:
+cinTA test 0.28 -> 0.35; after the preset's verifier it lowers held-out recall at its threshold
+and leaves held-out AP50 unchanged, so it is off by default: ``benchmarks/RESULTS.housing.md``).
+``margin`` widens every housing to a dataset's box convention (:mod:`.margin`: learn it from a
+training split).
 """
 
 from __future__ import annotations
@@ -20,16 +26,18 @@ from tsrkit.params import Param
 from tsrkit.plugin import Verifier
 from tsrkit.types import Candidate, Frame
 from tsrkit_plugins.housing.fit import fit_housings
+from tsrkit_plugins.housing.margin import widen
 
 
 def suppress(candidates: list[Candidate], threshold: float) -> list[Candidate]:
     """Greedy non-maximum suppression on the housings of score-ordered ``candidates``."""
     if threshold >= 1.0 or len(candidates) < 2:
         return candidates
-    overlap = iou_matrix([c.housing for c in candidates], [c.housing for c in candidates])
+    housings = [c.housing for c in candidates]
+    overlap = (iou_matrix(housings, housings) > threshold).tolist()
     kept: list[int] = []
-    for i in range(len(candidates)):
-        if all(overlap[i, j] <= threshold for j in kept):
+    for i, row in enumerate(overlap):
+        if not any(row[j] for j in kept):
             kept.append(i)
     return [candidates[i] for i in kept]
 
@@ -58,6 +66,22 @@ class Housing(Verifier):
             max=1.0,
             help="drop candidates whose housing fit scores below this (0 keeps all)",
         ),
+        Param(
+            "margin",
+            "float",
+            0.0,
+            min=0.0,
+            max=1.0,
+            help="widen each housing on every side by this share of its short side: a "
+            "dataset's box convention, learned from its training split (learn_margin)",
+        ),
+        Param(
+            "rescore",
+            "bool",
+            False,
+            help="multiply each candidate's score by its housing fit score: a lamp in a dark "
+            "head ranks above a lamp-like blob without one (for pipelines without a verifier)",
+        ),
     )
 
     def verify(self, frame: Frame, candidates: Sequence[Candidate]) -> list[Candidate]:
@@ -65,10 +89,17 @@ class Housing(Verifier):
             return []
         gray = cv2.cvtColor(frame.image, cv2.COLOR_BGR2GRAY)
         boxes, scores, _ = fit_housings(gray, [(c.x, c.y, c.radius) for c in candidates])
+        boxes = widen(boxes, self.params["margin"])
+        weigh = self.params["rescore"]
         fitted = [
-            replace(c, housing=tuple(float(v) for v in box), housing_score=float(score))
-            for c, box, score in zip(candidates, boxes, scores)
-            if score >= self.params["min_score"]
+            replace(
+                c,
+                housing=tuple(box),
+                housing_score=fit,
+                score=c.score * fit if weigh else c.score,
+            )
+            for c, box, fit in zip(candidates, boxes.tolist(), scores.tolist())
+            if fit >= self.params["min_score"]
         ]
         return suppress(sorted(fitted, key=lambda c: -c.score), self.params["nms_iou"])
 

@@ -1,28 +1,35 @@
 """Fitting a signal housing around a lit lens: the dark rectangle the lamp sits in.
 
 Beyond the documents (issue 11): the field's datasets box whole housings while every method of
-the three documents outputs a lens. For each lens ``(x, y, r)`` the fit
+the three documents outputs a lens. For each candidate lens ``(x, y, r)`` the fit
 
-1. **searches** layouts: vertical and horizontal heads of :data:`LENS_COUNTS` lenses, the lit
+1. **measures** the lit lens near the candidate (:mod:`.lens`): its centre and radius, the unit
+   of every layout;
+2. **searches** layouts: vertical and horizontal heads of :data:`LENS_COUNTS` lenses, the lit
    lens at every position, housing widths of :data:`WIDTHS` x ``r`` and lens pitches of
    :data:`PITCHES` x width; each hypothesis is scored by its darkness contrast, the mean grey
    level of a band just outside the box against the mean inside it (the lit lens left out),
-   ``(outside - inside) / outside``;
-2. **refines** each edge of the best box within ``+-REFINE x r`` to the offset where a strip
-   just outside is brightest against a strip just inside (a gradient projection across the edge);
-3. **scores** the refined box by its contrast, clipped to [0, 1].
+   ``(outside - inside) / outside``. A coarse pass tries every orientation, lens count and lit
+   position at the middle width and pitch over the radii of :func:`radius_options`; a fine pass
+   tries every width and pitch of the coarse winner's head at 0.85-1.17x its radius;
+3. **refines** each edge of the best box within ``+-REFINE x r`` to the offset where a strip
+   just outside is brightest against a strip just inside (a gradient projection across the
+   edge), keeps the box at least :data:`MIN_ASPECT` widths long (a head of three lenses) and
+   around its lens;
+4. **scores** the refined box by its contrast, clipped to [0, 1].
 
-Every box sum is four look-ups in one integral image of the frame, and all hypotheses of all
-candidates are scored in one vectorised pass.
+Every box sum is four look-ups in one integral image of the frame (:mod:`.boxes`), and all
+hypotheses of all candidates are scored in one vectorised pass.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 
-import cv2
 import numpy as np
+
+from tsrkit_plugins.housing.boxes import box_means, box_sums, integral
+from tsrkit_plugins.housing.lens import measure_lenses
 
 #: Lens counts of the heads searched.
 LENS_COUNTS = (3, 4)
@@ -34,53 +41,40 @@ PITCHES = (0.65, 0.8, 1.0)
 #: Lens radii (px) tried besides the detector's own: many detectors (FRST, top-hat) give a centre
 #: but no reliable radius, and one lens radius is the unit of every layout.
 RADIUS_LADDER = (2.0, 3.0, 4.0, 6.0, 8.0, 11.0, 16.0, 23.0, 32.0, 45.0, 64.0)
+#: Span of the ladder around the lens radius: a detector's radius (0.5-3x), or a measured lit
+#: lens's (0.6-1.8x: a large dark region several lens sizes away no longer wins).
+SPAN_GIVEN = (0.5, 3.0)
+SPAN_MEASURED = (0.6, 1.8)
 #: Second-pass radius factors around the first pass's choice.
 FINE = np.array([0.85, 0.92, 1.0, 1.08, 1.17])
 #: Edge refinement range, in lens radii: across the head, and along it (the two ends move by
 #: up to about one lens cell, so a head with one lens more or less than its layout still fits).
 REFINE = 0.5
 REFINE_ALONG = 3.2
+#: Offsets tried per edge, evenly over its range.
+REFINE_STEPS = 13
 #: Width of the band outside the box and of the edge strips, in lens radii (at least 1 px).
 BAND = 0.6
+#: Shortest head after refinement, in housing widths: the shortest layout searched (three lenses
+#: at pitch 0.65) is 1.95 widths long.
+MIN_ASPECT = 1.8
 
-
-@dataclass(frozen=True)
-class Layout:
-    """One head layout searched: orientation, lens count, lit position, width, pitch."""
-
-    vertical: bool
-    lenses: int
-    lit: int
-    width: float
-    pitch: float
-
-
-LAYOUTS = tuple(
-    Layout(vertical, n, lit, w, p)
-    for vertical in (True, False)
-    for n in LENS_COUNTS
-    for lit in range(n)
-    for w in WIDTHS
-    for p in PITCHES
+#: Every layout searched, one row each: vertical (1/0), lens count, lit position (0: top or
+#: left), width (lens radii), pitch (share of the width).
+LAYOUTS = np.array(
+    [
+        (vertical, n, lit, w, p)
+        for vertical in (1, 0)
+        for n in LENS_COUNTS
+        for lit in range(n)
+        for w in WIDTHS
+        for p in PITCHES
+    ],
+    dtype=np.float64,
 )
-
-
-def integral(gray: np.ndarray) -> np.ndarray:
-    """int32 (H + 1, W + 1) integral image of a grey uint8 image (exact up to 8 MP)."""
-    return cv2.integral(gray, sdepth=cv2.CV_32S)
-
-
-def box_sums(table: np.ndarray, boxes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Sums and pixel counts of ``boxes`` (..., 4) as (x0, y0, x1, y1), rounded to pixels and
-    clipped to the image."""
-    height, width = table.shape[0] - 1, table.shape[1] - 1
-    x0 = np.clip(np.rint(boxes[..., 0]), 0, width).astype(np.int64)
-    y0 = np.clip(np.rint(boxes[..., 1]), 0, height).astype(np.int64)
-    x1 = np.clip(np.rint(boxes[..., 2]), 0, width).astype(np.int64)
-    y1 = np.clip(np.rint(boxes[..., 3]), 0, height).astype(np.int64)
-    x1, y1 = np.maximum(x1, x0), np.maximum(y1, y0)
-    total = table[y1, x1] - table[y0, x1] - table[y1, x0] + table[y0, x0]
-    return total.astype(np.float64), ((x1 - x0) * (y1 - y0)).astype(np.float64)
+#: The layouts of the coarse pass: the middle width and pitch (the extreme pitches as well fitted
+#: no better on the development splits, at twice the cost).
+COARSE = LAYOUTS[(LAYOUTS[:, 3] == 2.8) & (LAYOUTS[:, 4] == 0.8)]
 
 
 def grow(boxes: np.ndarray, margin: np.ndarray) -> np.ndarray:
@@ -91,7 +85,7 @@ def grow(boxes: np.ndarray, margin: np.ndarray) -> np.ndarray:
 
 def contrast(table: np.ndarray, boxes: np.ndarray, lens: np.ndarray, band: np.ndarray):
     """``(outside - inside) / outside`` of each box: inside without the lens square, outside a
-    ``band`` wide frame around the box."""
+    ``band`` wide frame around the box (``lens`` and ``band`` broadcast against ``boxes``)."""
     inner, inner_n = box_sums(table, boxes)
     lens_sum, lens_n = box_sums(table, lens)
     outer, outer_n = box_sums(table, grow(boxes, band))
@@ -100,30 +94,33 @@ def contrast(table: np.ndarray, boxes: np.ndarray, lens: np.ndarray, band: np.nd
     return (outside - inside) / np.maximum(outside, 1.0)
 
 
-#: The layouts of the first, coarse pass (one width, the extreme pitches).
-COARSE = tuple(lay for lay in LAYOUTS if lay.width == 2.8 and lay.pitch in (0.65, 1.0))
-
-
-def layout_boxes(x, y, r, layouts: Sequence[Layout] = LAYOUTS) -> np.ndarray:
-    """(N, len(layouts), 4) housing boxes of each layout around lenses ``(x, y, r)``."""
-    out = np.zeros((len(x), len(layouts), 4))
-    for k, layout in enumerate(layouts):
-        half = layout.width * r / 2
-        pitch = layout.pitch * layout.width * r
-        start = -(layout.lit + 0.5) * pitch
-        end = start + layout.lenses * pitch
-        if layout.vertical:
-            out[:, k] = np.stack([x - half, y + start, x + half, y + end], axis=1)
-        else:
-            out[:, k] = np.stack([x + start, y - half, x + end, y + half], axis=1)
-    return out
+def layout_boxes(x, y, r, layouts: np.ndarray) -> np.ndarray:
+    """Housing boxes (..., 4) of ``layouts`` (rows of :data:`LAYOUTS`, (..., 5)) around lenses
+    ``(x, y, r)``; all broadcast together."""
+    vertical, lenses, lit, width, pitch = np.moveaxis(layouts, -1, 0)
+    half = width * r / 2
+    step = pitch * width * r
+    start = -(lit + 0.5) * step
+    end = start + lenses * step
+    vertical = vertical.astype(bool)
+    along, across = np.where(vertical, y, x), np.where(vertical, x, y)
+    a0, a1, c0, c1 = along + start, along + end, across - half, across + half
+    return np.stack(
+        [
+            np.where(vertical, c0, a0),
+            np.where(vertical, a0, c0),
+            np.where(vertical, c1, a1),
+            np.where(vertical, a1, c1),
+        ],
+        axis=-1,
+    )
 
 
 def refine(table: np.ndarray, boxes: np.ndarray, r: np.ndarray) -> np.ndarray:
     """Move each edge of ``boxes`` (N, 4) within ``+-REFINE r`` (the ends: ``+-REFINE_ALONG r``)
     to where the strip outside it is brightest against the strip inside it (sides: 0 left,
     1 top, 2 right, 3 bottom)."""
-    steps = np.linspace(-1.0, 1.0, 25)
+    steps = np.linspace(-1.0, 1.0, REFINE_STEPS)
     width = np.maximum(BAND * r, 1.0)[:, None]
     rows = np.arange(len(boxes))
     vertical = (boxes[:, 3] - boxes[:, 1]) >= (boxes[:, 2] - boxes[:, 0])
@@ -142,75 +139,88 @@ def refine(table: np.ndarray, boxes: np.ndarray, r: np.ndarray) -> np.ndarray:
             strip[..., axis], strip[..., axis + 2] = np.minimum(a, b), np.maximum(a, b)
             strip[..., 1 - axis] = span[:, None, 0]
             strip[..., 3 - axis] = span[:, None, 1]
-            total, count = box_sums(table, strip)
-            strips.append(total / np.maximum(count, 1))
+            strips.append(box_means(table, strip)[0])
         out[:, side] = edge[rows, np.argmax(strips[0] - strips[1], axis=1)]
-    for low in (0, 1):  # opposite ends that crossed: keep the box at least one radius long
-        middle = (out[:, low] + out[:, low + 2]) / 2
-        crossed = out[:, low + 2] - out[:, low] < r
-        out[crossed, low] = middle[crossed] - r[crossed] / 2
-        out[crossed, low + 2] = middle[crossed] + r[crossed] / 2
     return out
 
 
-def radius_options(r: np.ndarray) -> np.ndarray:
-    """(N, K) lens radii to try per candidate: the detector's radius and 0.8 / 1.25 of it, and
-    the :data:`RADIUS_LADDER` steps within 0.5-3x of it (all steps when it is below 2 px, a
-    detector without a radius estimate); unused slots are NaN."""
-    ladder = np.array(RADIUS_LADDER)
-    own = r[:, None] * np.array([0.8, 1.0, 1.25])
-    steps = np.where(
-        (r[:, None] < 2) | ((ladder >= 0.5 * r[:, None]) & (ladder <= 3 * r[:, None])),
-        ladder,
-        np.nan,
-    )
-    own = np.where(r[:, None] >= 2, own, np.nan)
+def keep_long(refined: np.ndarray, searched: np.ndarray) -> np.ndarray:
+    """``refined`` boxes (N, 4) lengthened along their head's axis to :data:`MIN_ASPECT` x
+    their width where refinement shortened them below it, each end moving back towards the
+    ``searched`` box's (equally when neither end moved in)."""
+    out = refined.copy()
+    vertical = (searched[:, 3] - searched[:, 1]) >= (searched[:, 2] - searched[:, 0])
+    for low, rows in ((1, vertical), (0, ~vertical)):
+        across = out[:, 3 - low] - out[:, 1 - low]
+        missing = np.maximum(MIN_ASPECT * across - (out[:, low + 2] - out[:, low]), 0.0)
+        head = np.maximum(out[:, low] - searched[:, low], 0.0)
+        tail = np.maximum(searched[:, low + 2] - out[:, low + 2], 0.0)
+        share = np.where(head + tail > 0, head / np.maximum(head + tail, 1e-9), 0.5)
+        out[rows, low] -= (missing * share)[rows]
+        out[rows, low + 2] += (missing * (1.0 - share))[rows]
+    return out
+
+
+def radius_options(r: np.ndarray, measured: np.ndarray) -> np.ndarray:
+    """(N, K) lens radii to try per candidate: its radius and 0.8 / 1.25 of it, and the
+    :data:`RADIUS_LADDER` steps within :data:`SPAN_MEASURED` of a measured lens's radius or
+    :data:`SPAN_GIVEN` of a detector's (all steps when that is below 2 px, a detector without
+    a radius estimate); unused slots are NaN."""
+    ladder = np.array(RADIUS_LADDER)[None, :]
+    low = np.where(measured, SPAN_MEASURED[0], SPAN_GIVEN[0])[:, None] * r[:, None]
+    high = np.where(measured, SPAN_MEASURED[1], SPAN_GIVEN[1])[:, None] * r[:, None]
+    steps = np.where((r[:, None] < 2) | ((ladder >= low) & (ladder <= high)), ladder, np.nan)
+    factors = np.where(measured[:, None], [np.nan, 1.0, np.nan], [0.8, 1.0, 1.25])
+    own = np.where(r[:, None] >= 2, r[:, None] * factors, np.nan)
     return np.concatenate([own, steps], axis=1)
 
 
 def best_layouts(
-    table: np.ndarray,
-    x: np.ndarray,
-    y: np.ndarray,
-    options: np.ndarray,
-    layouts: Sequence[Layout] = LAYOUTS,
-) -> tuple[np.ndarray, np.ndarray]:
-    """The best-scoring box (N, 4) over ``layouts`` and every radius of ``options`` (N, K;
-    NaN: unused, not computed), and the radius it used."""
+    table: np.ndarray, x: np.ndarray, y: np.ndarray, options: np.ndarray, layouts: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The best-scoring box (N, 4) over every radius of ``options`` (N, K; NaN: unused, not
+    computed) and ``layouts`` ((L, 5) for all candidates, or (N, L, 5) each its own), with the
+    radius and the layout row it used."""
     owner, option = np.nonzero(~np.isnan(options))
     radii = options[owner, option]
     xs, ys = x[owner], y[owner]
-    boxes = layout_boxes(xs, ys, radii, layouts)  # (M, L, 4)
+    rows = layouts if layouts.ndim == 2 else layouts[owner]
+    boxes = layout_boxes(xs[:, None], ys[:, None], radii[:, None], rows)  # (M, L, 4)
     lens = np.stack([xs - radii, ys - radii, xs + radii, ys + radii], axis=1)[:, None, :]
     band = np.maximum(BAND * radii, 1.0)[:, None]
-    scores = contrast(table, boxes, np.broadcast_to(lens, boxes.shape), band)
+    scores = contrast(table, boxes, lens, band)
     best_layout = np.argmax(scores, axis=1)
     best_score = scores[np.arange(len(owner)), best_layout]
     order = np.lexsort((-best_score, owner))  # per owner, its best hypothesis first
     first = order[np.r_[True, owner[order][1:] != owner[order][:-1]]]
-    return boxes[first, best_layout[first]], radii[first]
+    chosen = rows[best_layout[first]] if rows.ndim == 2 else rows[first, best_layout[first]]
+    return boxes[first, best_layout[first]], radii[first], chosen
+
+
+def head_variants(heads: np.ndarray) -> np.ndarray:
+    """(N, W x P, 5): every width and pitch of each head (orientation, lens count, lit
+    position) of ``heads`` (N, 5)."""
+    grid = np.array([(w, p) for w in WIDTHS for p in PITCHES])
+    out = np.repeat(heads[:, None, :], len(grid), axis=1)
+    out[..., 3:] = grid
+    return out
 
 
 def fit_housings(
     gray: np.ndarray, lenses: Sequence[tuple[float, float, float]]
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Housing boxes (N, 4), fit scores (N,) in [0, 1] and the lens radius each fit chose, around
-    ``lenses`` (x, y, radius) of a grey uint8 frame.
-
-    Two passes: the radii of :func:`radius_options` over the :data:`COARSE` layouts, then
-    0.85-1.17x the radius the first pass chose over every layout; the best box's edges are
-    then refined.
-    """
+    """Housing boxes (N, 4), fit scores (N,) in [0, 1] and the lenses (N, 3: x, y, radius) the
+    fits used, around candidate ``lenses`` (x, y, radius) of a grey uint8 frame (steps in the
+    module docstring). Every box holds its lens's disc."""
     if not len(lenses):
-        return np.zeros((0, 4)), np.zeros(0), np.zeros(0)
+        return np.zeros((0, 4)), np.zeros(0), np.zeros((0, 3))
     table = integral(gray)
-    x, y, r = (np.asarray(v, np.float64) for v in zip(*lenses))
-    _, coarse = best_layouts(table, x, y, radius_options(r), COARSE)
-    best, chosen = best_layouts(table, x, y, coarse[:, None] * FINE)
+    x, y, r, measured = measure_lenses(table, *(np.asarray(v, np.float64) for v in zip(*lenses)))
+    _, coarse, heads = best_layouts(table, x, y, radius_options(r, measured), COARSE)
+    searched, chosen, _ = best_layouts(table, x, y, coarse[:, None] * FINE, head_variants(heads))
     lens = np.stack([x - chosen, y - chosen, x + chosen, y + chosen], axis=1)
-    # A housing holds its lens: refinement may not move an edge past the lens disc.
-    refined = refine(table, best, chosen)
+    refined = keep_long(refine(table, searched, chosen), searched)
     refined[:, :2] = np.minimum(refined[:, :2], lens[:, :2])
     refined[:, 2:] = np.maximum(refined[:, 2:], lens[:, 2:])
     final = contrast(table, refined, lens, np.maximum(BAND * chosen, 1.0))
-    return refined, np.clip(final, 0.0, 1.0), chosen
+    return refined, np.clip(final, 0.0, 1.0), np.stack([x, y, chosen], axis=1)
