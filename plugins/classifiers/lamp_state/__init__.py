@@ -5,7 +5,11 @@ Beyond the documents (issue 11): Zheng's ab-hist and Lee's hsi-backprojection st
 unchanged, beside it. Features: :mod:`.features`; model: scikit-learn's
 ``HistGradientBoostingClassifier`` stored with skops (explicit trusted types, no pickle; see
 ``tsrkit_plugins.verifiers.persistence``). ``red_yellow`` is a state of its own where the
-training data labels it (DTLD); other labels (arrows, off) are passed over in training.
+training data labels it (DTLD); other labels (arrows, off) are passed over in training. Where
+no training set labels it, a light read red whose housing has its top and middle slots both lit
+(:func:`~.features.two_lit` above ``red_yellow_ratio``) is read red+amber (:func:`red_yellow`).
+The classes are not reweighted: red is the most common state of every set, so a lamp whose
+colour sits between red and amber (orange-red LEDs) reads red.
 ``ab_hist_weight`` mixes ab-hist's normalised scores into the learned probabilities (a late
 fusion, :func:`blend`; measured in ``benchmarks/RESULTS.state.md``).
 """
@@ -26,7 +30,12 @@ from tsrkit.plugin import Classifier, Detector
 from tsrkit.registry import get_registry
 from tsrkit.types import Candidate, Detection, Frame, Sample
 from tsrkit_plugins.classifiers.ab_hist import AbHist
-from tsrkit_plugins.classifiers.lamp_state.features import N_FEATURES, VERSION, lamp_features
+from tsrkit_plugins.classifiers.lamp_state.features import (
+    N_FEATURES,
+    TWO_LIT,
+    VERSION,
+    lamp_features,
+)
 from tsrkit_plugins.verifiers.persistence import estimator_arrays, load_estimator
 
 if TYPE_CHECKING:  # scikit-learn loads when a model is fitted or read, not on import
@@ -92,6 +101,24 @@ def blend(
     return (1 - weight) * table + weight * other
 
 
+def red_yellow(table: np.ndarray, features: np.ndarray, ratio: float) -> np.ndarray:
+    """``table`` (columns: :data:`STATES`) with red and red+amber swapped on the rows read red
+    whose :func:`~.features.two_lit` (column ``TWO_LIT`` of ``features``) exceeds ``ratio``.
+
+    Examples
+    --------
+    >>> features = np.zeros((2, N_FEATURES)); features[:, TWO_LIT] = (0.9, 0.2)
+    >>> red_yellow(np.array([[0.7, 0.2, 0.1, 0.0]] * 2), features, 0.5)
+    array([[0. , 0.2, 0.1, 0.7],
+           [0.7, 0.2, 0.1, 0. ]])
+    """
+    out = table.copy()
+    red, both = STATES.index("red"), STATES.index("red_yellow")
+    rows = (np.argmax(table, axis=1) == red) & (features[:, TWO_LIT] > ratio)
+    out[rows, red], out[rows, both] = table[rows, both], table[rows, red]
+    return out
+
+
 def fit_estimator(
     features: np.ndarray, labels: np.ndarray, params
 ) -> tuple[HistGradientBoostingClassifier, list[str]]:
@@ -103,7 +130,7 @@ def fit_estimator(
         max_iter=params["iterations"],
         max_leaf_nodes=params["leaves"],
         learning_rate=params["learning_rate"],
-        class_weight="balanced",
+        class_weight=None,
         early_stopping=False,
         random_state=params["seed"],
     ).fit(features, np.searchsorted(present, labels))
@@ -146,6 +173,16 @@ class LampState(Classifier):
             help="weight of ab-hist's scores (shipped model, normalised) mixed with the learned "
             "probabilities; 0.5 is the late fusion of benchmarks/RESULTS.state.md",
         ),
+        Param(
+            "red_yellow_ratio",
+            "float",
+            0.5,
+            min=0.0,
+            max=1.0,
+            help="a light read red is read red+amber when its housing's middle slot is lit above "
+            "this share of the brightest slot's height over the bottom one (and so is the top); "
+            "1 switches it off",
+        ),
     )
 
     def __init__(self, **params):
@@ -182,7 +219,8 @@ class LampState(Classifier):
         if not candidates:
             return []
         estimator = self.estimator
-        probability = estimator.predict_proba(lamp_features(frame.image, candidates))
+        features = lamp_features(frame.image, candidates)
+        probability = estimator.predict_proba(features)
         weight = self.params["ab_hist_weight"]
         known = set(self._states)
         if weight > 0:
@@ -193,7 +231,10 @@ class LampState(Classifier):
             other = np.array([[d.state_scores.get(s, 0.0) for s in STATES] for d in found])
         else:
             other = np.zeros((len(candidates), len(STATES)))
-        table = blend(probability, self._states, other, weight)
+        ratio = self.params["red_yellow_ratio"]
+        table = red_yellow(blend(probability, self._states, other, weight), features, ratio)
+        if ratio < 1:
+            known.add("red_yellow")
         out = []
         for candidate, row in zip(candidates, table):
             scores = {s: float(v) for s, v in zip(STATES, row) if s in known}
