@@ -13,6 +13,7 @@ from tsrkit_plugins.classifiers.lamp_state.features import (
     N_LENS,
     TWO_LIT,
     lamp_features,
+    two_lit,
 )
 
 #: BGR of lit lamps as cameras record them (saturated, slightly orange red; amber; blue-green).
@@ -77,13 +78,17 @@ def test_two_lit_tells_red_amber_from_red(white_core):
 
 @pytest.mark.parametrize("white_core", [False, True])
 def test_shipped_model_reads_red_amber_by_position(white_core):
-    # the shipped model never saw red+amber (no open set labels it): the two-lit rule reads it
+    # the shipped model never saw red+amber (no open set labels it): the two-lit rule reads it;
+    # without the rule it is read by one of its two lamps
     image, box = head("red_yellow", white_core)
     classifier = tsrkit.classifier("lamp-state")
     found = classifier.classify(Frame(image, "head"), [Candidate.from_box(box, 1.0)])
     assert found[0].state == "red_yellow"
     off = tsrkit.classifier("lamp-state", red_yellow_ratio=1.0)
-    assert off.classify(Frame(image, "head"), [Candidate.from_box(box, 1.0)])[0].state == "red"
+    assert off.classify(Frame(image, "head"), [Candidate.from_box(box, 1.0)])[0].state in {
+        "red",
+        "yellow",
+    }
 
 
 def save(path, model):
@@ -158,3 +163,14 @@ def test_fusion_with_ab_hist_reads_rendered_heads(state):
     assert found[0].state == state
     assert set(found[0].state_scores) >= {"red", "yellow", "green"}
     assert abs(sum(found[0].state_scores.values()) - 1.0) < 1e-6
+
+
+def test_two_lit_needs_two_lamps_and_a_red_top():
+    # slot centres at rows 6, 18, 30 of 36, averaged over +-2 rows
+    lamps = np.full((1, 36), 0.1)
+    lamps[0, 4:9], lamps[0, 16:21] = 1.0, 0.8  # top and middle lamps, dark housing between
+    glare = np.linspace(1.0, 0.1, 36)[None]  # one lamp's glare fading down the housing
+    red, grey = np.full((1, 36), 0.2), np.zeros((1, 36))
+    assert two_lit(lamps, red)[0] == pytest.approx((0.8 - 0.1) / (1.0 - 0.1))
+    assert two_lit(lamps, grey)[0] == 0.0  # top not red: a backplate or unlit lens
+    assert two_lit(glare, red)[0] == 0.0  # no dark gap between the two slots

@@ -6,8 +6,9 @@ unchanged, beside it. Features: :mod:`.features`; model: scikit-learn's
 ``HistGradientBoostingClassifier`` stored with skops (explicit trusted types, no pickle; see
 ``tsrkit_plugins.verifiers.persistence``). ``red_yellow`` is a state of its own where the
 training data labels it (DTLD); other labels (arrows, off) are passed over in training. Where
-no training set labels it, a light read red whose housing has its top and middle slots both lit
-(:func:`~.features.two_lit` above ``red_yellow_ratio``) is read red+amber (:func:`red_yellow`).
+no training set labels it, a light read red or amber whose housing has its top and middle slots
+both lit, the top one red (:func:`~.features.two_lit` above ``red_yellow_ratio``), is read
+red+amber (:func:`red_yellow`).
 The classes are not reweighted: red is the most common state of every set, so a lamp whose
 colour sits between red and amber (orange-red LEDs) reads red.
 ``ab_hist_weight`` mixes ab-hist's normalised scores into the learned probabilities (a late
@@ -102,20 +103,23 @@ def blend(
 
 
 def red_yellow(table: np.ndarray, features: np.ndarray, ratio: float) -> np.ndarray:
-    """``table`` (columns: :data:`STATES`) with red and red+amber swapped on the rows read red
-    whose :func:`~.features.two_lit` (column ``TWO_LIT`` of ``features``) exceeds ``ratio``.
+    """``table`` (columns: :data:`STATES`) with the top state and red+amber swapped on the rows
+    read red or yellow whose :func:`~.features.two_lit` (column ``TWO_LIT`` of ``features``)
+    exceeds ``ratio``.
 
     Examples
     --------
     >>> features = np.zeros((2, N_FEATURES)); features[:, TWO_LIT] = (0.9, 0.2)
-    >>> red_yellow(np.array([[0.7, 0.2, 0.1, 0.0]] * 2), features, 0.5)
+    >>> red_yellow(np.array([[0.7, 0.2, 0.1, 0.0], [0.2, 0.7, 0.1, 0.0]]), features, 0.5)
     array([[0. , 0.2, 0.1, 0.7],
-           [0.7, 0.2, 0.1, 0. ]])
+           [0.2, 0.7, 0.1, 0. ]])
     """
     out = table.copy()
-    red, both = STATES.index("red"), STATES.index("red_yellow")
-    rows = (np.argmax(table, axis=1) == red) & (features[:, TWO_LIT] > ratio)
-    out[rows, red], out[rows, both] = table[rows, both], table[rows, red]
+    top = np.argmax(table, axis=1)
+    both = STATES.index("red_yellow")
+    read = np.isin(top, [STATES.index("red"), STATES.index("yellow")])
+    rows = np.flatnonzero(read & (features[:, TWO_LIT] > ratio))
+    out[rows, top[rows]], out[rows, both] = table[rows, both], table[rows, top[rows]]
     return out
 
 
@@ -179,9 +183,9 @@ class LampState(Classifier):
             0.5,
             min=0.0,
             max=1.0,
-            help="a light read red is read red+amber when its housing's middle slot is lit above "
-            "this share of the brightest slot's height over the bottom one (and so is the top); "
-            "1 switches it off",
+            help="a light read red or amber is read red+amber when its housing's top slot is red "
+            "and it and the middle slot are lit above this share of the brightest slot's height "
+            "over the bottom one; 1 switches it off",
         ),
     )
 

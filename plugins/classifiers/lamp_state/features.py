@@ -192,25 +192,36 @@ def scaled(values: np.ndarray) -> np.ndarray:
     return (values - low) / np.maximum(values.max(axis=1, keepdims=True) - low, 1e-3)
 
 
-def two_lit(value_slots: np.ndarray) -> np.ndarray:
-    """How far the top and middle slots are both lit above the bottom one, as a share of the
-    brightest slot's height above it: 1 when both are as bright as the brightest, 0 (or below)
-    when either is as dark as the bottom. Red+amber lights both (DTLD's ``red_yellow``)."""
-    top, middle, bottom = value_slots.T
-    return (np.minimum(top, middle) - bottom) / np.maximum(value_slots.max(axis=1) - bottom, 1e-3)
+def two_lit(profile: np.ndarray, redness: np.ndarray, dip: float = 0.7) -> np.ndarray:
+    """How far the top and middle slots of an (N, along) brightness profile are both lit above
+    the bottom one, as a share of the brightest slot's height above it: 1 when both are as
+    bright as the brightest, 0 (or below) when either is as dark as the bottom. Red+amber
+    lights both (DTLD's ``red_yellow``), and its top lamp is red: where the (N, along)
+    ``redness`` (red minus green) at the top slot is not above 0 (a grey backplate or an unlit
+    lens above an amber lamp), the result is 0. Two lamps have dark housing between them:
+    where the profile between the two slot centres stays above ``dip`` of the way from the
+    bottom to the dimmer of the two, one lamp's glare lights both slots and the result is 0."""
+    top, middle, bottom = slots(profile).T
+    lower = np.minimum(top, middle)
+    along = profile.shape[1]
+    gap = profile[:, along // 6 : along // 2 + 1].min(axis=1)
+    both = (lower - bottom) / np.maximum(np.maximum(top, middle) - bottom, 1e-3)
+    two = (gap < bottom + dip * (lower - bottom)) & (slots(redness)[:, 0] > 0)
+    return np.where(two, both, 0.0)
 
 
-def housing_features(hsv: np.ndarray, vertical: np.ndarray) -> np.ndarray:
-    """Lit-position features of upright housing patches in HSV, read in their central
-    :func:`band`."""
+def housing_features(upright: np.ndarray, hsv: np.ndarray, vertical: np.ndarray) -> np.ndarray:
+    """Lit-position features of upright housing patches (BGR ``upright`` and its ``hsv``), read
+    in their central :func:`band`."""
     n = hsv.shape[0]
     value = band(hsv[..., 2].astype(np.float32) / 255)
     colourful = band(hsv[..., 1].astype(np.float32) / 255) * value
     thirds = np.array_split(np.arange(value.shape[1]), 3)
     profile = value.mean(axis=2)
+    bgr = band(upright.astype(np.float32) / 255)
+    redness = (bgr[..., 2] - bgr[..., 1]).mean(axis=2)
     weight = profile**4
     position = weight @ np.linspace(0, 1, weight.shape[1]) / np.maximum(weight.sum(axis=1), 1e-6)
-    value_slots = slots(profile)
     return np.concatenate(
         [
             np.stack([quantiles(value[:, rows].reshape(n, -1), 0.9) for rows in thirds], 1),
@@ -218,9 +229,9 @@ def housing_features(hsv: np.ndarray, vertical: np.ndarray) -> np.ndarray:
             position[:, None],
             vertical[:, None].astype(np.float32),
             np.ones((n, 1), np.float32),
-            scaled(value_slots),
+            scaled(slots(profile)),
             scaled(slots(colourful.mean(axis=2))),
-            two_lit(value_slots)[:, None],
+            two_lit(profile, redness)[:, None],
         ],
         axis=1,
     )
@@ -236,7 +247,7 @@ def lamp_features(image: np.ndarray, candidates: Sequence[Candidate]) -> np.ndar
         boxes = np.array([housings[i] for i in boxed], np.float64)
         upright, vertical = upright_housings(image, boxes)
         hsv = convert(upright, cv2.COLOR_BGR2HSV)
-        rows[boxed, N_LENS:] = housing_features(hsv, vertical)
+        rows[boxed, N_LENS:] = housing_features(upright, hsv, vertical)
         found = lit_lenses(boxes, vertical, hsv)
         for k, i in enumerate(boxed):
             if candidates[i].housing is None:
