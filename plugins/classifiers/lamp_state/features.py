@@ -12,8 +12,8 @@ robust across cameras:
 * **position**: the housing resampled upright (vertical or horizontal head) to
   :data:`HOUSING_SIZE`, the brightness and colourfulness of its top, middle and bottom thirds
   and the lit centroid along its axis (red on top, amber in the middle, green at the bottom in
-  most countries; red+amber lights two thirds at once). Without a housing (a lens box) these are
-  zero and ``has_housing`` is 0.
+  most countries; red+amber lights two thirds at once). Without a housing (a lens box), and for
+  a horizontal head (whose order differs by country), these are zero and ``has_housing`` is 0.
 
 Layout 3 reads the housing in its central band (the middle half across, :func:`band`): the
 corners of a housing box hold sky, visors or a backplate, bright enough to pull the lit lens and
@@ -247,7 +247,10 @@ def lamp_features(image: np.ndarray, candidates: Sequence[Candidate]) -> np.ndar
         boxes = np.array([housings[i] for i in boxed], np.float64)
         upright, vertical = upright_housings(image, boxes)
         hsv = convert(upright, cv2.COLOR_BGR2HSV)
-        rows[boxed, N_LENS:] = housing_features(upright, hsv, vertical)
+        # a horizontal head's order differs by country (red on the left in Europe and the US,
+        # on the right in Japan and in cinTA's Indonesian heads): its lit lens is read, its
+        # position is not
+        rows[boxed, N_LENS:] = housing_features(upright, hsv, vertical) * vertical[:, None]
         found = lit_lenses(boxes, vertical, hsv)
         for k, i in enumerate(boxed):
             if candidates[i].housing is None:
