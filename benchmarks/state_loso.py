@@ -12,7 +12,7 @@ the held-out dataset's own train part (MIT train, KR valid, cinTA valid, DTLD tr
 on its test split. Features are computed once per light. A late fusion (the equal-weight mean
 of lamp-state's LOSO probabilities and ab-hist's normalised scores) is measured beside both;
 ab-hist there is the shipped model, trained on MIT train. lamp-state's red+amber rule
-(``red_yellow_ratio``) applies to all three.
+(``red_yellow_ratio``) and its red prior (``red_prior``) apply to all three.
 
     python benchmarks/state_loso.py
 """
@@ -38,6 +38,7 @@ from tsrkit_plugins.classifiers.lamp_state import (  # noqa: E402
     blend,
     fit_estimator,
     labelled_features,
+    prefer_red,
     red_yellow,
 )
 from tsrkit_plugins.classifiers.lamp_state.features import lamp_features  # noqa: E402
@@ -143,7 +144,7 @@ def main() -> None:
                 np.concatenate([o[1] for o in others]),
                 params,
             )
-            probability = loso.predict_proba(x)
+            probability = prefer_red(loso.predict_proba(x), states, params["red_prior"])
             predicted = read(probability, states, x, params)
             row = {"set": key, "n": len(y), "loso": scores(y, predicted)[:2]}
             if "own" in sets and key.endswith("test"):
@@ -153,7 +154,8 @@ def main() -> None:
                     np.concatenate([o[1] for o in train]),
                     params,
                 )
-                found = read(own.predict_proba(x), own_states, x, params)
+                own_probability = prefer_red(own.predict_proba(x), own_states, params["red_prior"])
+                found = read(own_probability, own_states, x, params)
                 row["in-domain"] = scores(y, found)[:2]
             for name in ("ab-hist", "hsi-backprojection"):
                 found, found_scores = paper(name, dataset)

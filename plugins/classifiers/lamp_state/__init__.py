@@ -9,8 +9,9 @@ training data labels it (DTLD); other labels (arrows, off) are passed over in tr
 no training set labels it, a light read red or amber whose housing has its top and middle slots
 both lit, the top one red (:func:`~.features.two_lit` above ``red_yellow_ratio``), is read
 red+amber (:func:`red_yellow`).
-The classes are not reweighted: red is the most common state of every set, so a lamp whose
-colour sits between red and amber (orange-red LEDs) reads red.
+The classes are not reweighted, and the learned red probability counts ``red_prior`` times
+(:func:`prefer_red`): red is the most common state of every set and the costly one to miss, so
+a lamp whose colour sits between red and amber (orange-red LEDs, white cores) reads red.
 ``ab_hist_weight`` mixes ab-hist's normalised scores into the learned probabilities (a late
 fusion, :func:`blend`; measured in ``benchmarks/RESULTS.state.md``).
 """
@@ -102,6 +103,19 @@ def blend(
     return (1 - weight) * table + weight * other
 
 
+def prefer_red(probability: np.ndarray, states: Sequence[str], factor: float) -> np.ndarray:
+    """``probability`` (columns: ``states``) with its red column times ``factor``, each row
+    renormalised to sum 1.
+
+    Examples
+    --------
+    >>> prefer_red(np.array([[0.4, 0.6]]), ["red", "yellow"], 2.0)
+    array([[0.57142857, 0.42857143]])
+    """
+    out = probability * np.where(np.asarray(states) == "red", factor, 1.0)
+    return out / np.maximum(out.sum(axis=1, keepdims=True), 1e-12)
+
+
 def red_yellow(table: np.ndarray, features: np.ndarray, ratio: float) -> np.ndarray:
     """``table`` (columns: :data:`STATES`) with the top state and red+amber swapped on the rows
     read red or yellow whose :func:`~.features.two_lit` (column ``TWO_LIT`` of ``features``)
@@ -178,6 +192,16 @@ class LampState(Classifier):
             "probabilities; 0.5 is the late fusion of benchmarks/RESULTS.state.md",
         ),
         Param(
+            "red_prior",
+            "float",
+            2.0,
+            min=1.0,
+            max=10.0,
+            help="the learned red probability counts this many times (red is the common and "
+            "the costly state: an ambiguous red/amber reads red); 1 reads the learned "
+            "probabilities as they are",
+        ),
+        Param(
             "red_yellow_ratio",
             "float",
             0.5,
@@ -224,7 +248,9 @@ class LampState(Classifier):
             return []
         estimator = self.estimator
         features = lamp_features(frame.image, candidates)
-        probability = estimator.predict_proba(features)
+        probability = prefer_red(
+            estimator.predict_proba(features), self._states, self.params["red_prior"]
+        )
         weight = self.params["ab_hist_weight"]
         known = set(self._states)
         if weight > 0:
