@@ -11,7 +11,8 @@ train, all VGIS, all KR, all cinTA, DTLD train) and tests on the held-out one; i
 the held-out dataset's own train part (MIT train, KR valid, cinTA valid, DTLD train) and tests
 on its test split. Features are computed once per light. A late fusion (the equal-weight mean
 of lamp-state's LOSO probabilities and ab-hist's normalised scores) is measured beside both;
-ab-hist there is the shipped model, trained on MIT train.
+ab-hist there is the shipped model, trained on MIT train. lamp-state's red+amber rule
+(``red_yellow_ratio``) and its red prior (``red_prior``) apply to all three.
 
     python benchmarks/state_loso.py
 """
@@ -37,6 +38,8 @@ from tsrkit_plugins.classifiers.lamp_state import (  # noqa: E402
     blend,
     fit_estimator,
     labelled_features,
+    prefer_red,
+    red_yellow,
 )
 from tsrkit_plugins.classifiers.lamp_state.features import lamp_features  # noqa: E402
 
@@ -108,6 +111,14 @@ def paper(name: str, dataset: Dataset) -> tuple[list[str], np.ndarray]:
     return out, np.array(rows, np.float64).reshape(-1, len(STATES))
 
 
+def read(probability: np.ndarray, states: list[str], features: np.ndarray, params) -> list[str]:
+    """lamp-state's reading of its learned ``probability`` (columns ``states``), with its
+    red+amber rule (:func:`red_yellow`)."""
+    table = blend(probability, states, np.zeros((len(probability), len(STATES))), 0.0)
+    table = red_yellow(table, features, params["red_yellow_ratio"])
+    return [STATES[i] for i in np.argmax(table, axis=1)]
+
+
 def main() -> None:
     params = get_registry().create("classifier", "lamp-state").params
     data = parts()
@@ -133,8 +144,8 @@ def main() -> None:
                 np.concatenate([o[1] for o in others]),
                 params,
             )
-            probability = loso.predict_proba(x)
-            predicted = [states[i] for i in np.argmax(probability, axis=1)]
+            probability = prefer_red(loso.predict_proba(x), states, params["red_prior"])
+            predicted = read(probability, states, x, params)
             row = {"set": key, "n": len(y), "loso": scores(y, predicted)[:2]}
             if "own" in sets and key.endswith("test"):
                 train = others + [features[(group, "own")]]
@@ -143,14 +154,19 @@ def main() -> None:
                     np.concatenate([o[1] for o in train]),
                     params,
                 )
-                row["in-domain"] = scores(y, [own_states[i] for i in own.predict(x)])[:2]
+                own_probability = prefer_red(own.predict_proba(x), own_states, params["red_prior"])
+                found = read(own_probability, own_states, x, params)
+                row["in-domain"] = scores(y, found)[:2]
             for name in ("ab-hist", "hsi-backprojection"):
                 found, found_scores = paper(name, dataset)
                 row[name] = scores(y, found)[:2]
                 if name == "ab-hist":
                     mixed = blend(probability, states, found_scores, 0.5)
+                    mixed = red_yellow(mixed, x, params["red_yellow_ratio"])
                     row["fused"] = scores(y, [STATES[i] for i in np.argmax(mixed, axis=1)])[:2]
             row["truth"] = dict(Counter(STATES[i] for i in y))
+            pairs = zip((STATES[i] for i in y), predicted)
+            row["loso misread"] = dict(Counter(f"{t}>{p}" for t, p in pairs if t != p))
             rows.append(row)
             print(row, flush=True)
     print()

@@ -8,7 +8,13 @@ import tsrkit
 from tsrkit.models import ModelError, load_model, save_model
 from tsrkit.types import Annotation, Candidate, Frame, Sample
 from tsrkit_plugins.classifiers.lamp_state import STATES, colour_jitter
-from tsrkit_plugins.classifiers.lamp_state.features import N_FEATURES, lamp_features
+from tsrkit_plugins.classifiers.lamp_state.features import (
+    N_FEATURES,
+    N_LENS,
+    TWO_LIT,
+    lamp_features,
+    two_lit,
+)
 
 #: BGR of lit lamps as cameras record them (saturated, slightly orange red; amber; blue-green).
 COLOURS = {"red": (40, 40, 230), "yellow": (20, 170, 250), "green": (170, 230, 40)}
@@ -16,8 +22,8 @@ SLOT = {"red": 0, "yellow": 1, "green": 2}
 
 
 def head(state: str, white_core: bool = False, size: int = 20) -> tuple[np.ndarray, tuple]:
-    """A road-grey image with a dark vertical 3-lamp housing whose ``state`` lamp is lit;
-    returns the image and the housing box."""
+    """A road-grey image with a dark vertical 3-lamp housing whose ``state`` lamp is lit
+    (``red_yellow``: the red and the amber one); returns the image and the housing box."""
     image = np.full((160, 120, 3), (120, 125, 130), np.uint8)
     x0, y0 = 40, 20
     box = (x0, y0, x0 + 2 * size, y0 + 6 * size)
@@ -25,10 +31,11 @@ def head(state: str, white_core: bool = False, size: int = 20) -> tuple[np.ndarr
     for k in range(3):
         centre = (x0 + size, y0 + size + 2 * size * k)
         cv2.circle(image, centre, int(0.75 * size), (45, 45, 45), -1)
-    centre = (x0 + size, y0 + size + 2 * size * SLOT[state])
-    cv2.circle(image, centre, int(0.75 * size), COLOURS[state], -1)
-    if white_core:
-        cv2.circle(image, centre, int(0.5 * size), (250, 250, 250), -1)
+    for lit in state.split("_"):
+        centre = (x0 + size, y0 + size + 2 * size * SLOT[lit])
+        cv2.circle(image, centre, int(0.75 * size), COLOURS[lit], -1)
+        if white_core:
+            cv2.circle(image, centre, int(0.5 * size), (250, 250, 250), -1)
     return cv2.GaussianBlur(image, (3, 3), 0), box
 
 
@@ -48,11 +55,40 @@ def test_features_see_the_lit_position_and_the_rim():
     bottom, _ = head("green", white_core=True)
     a, b = (lamp_features(i, [Candidate.from_box(box, 1.0)])[0] for i in (top, bottom))
     assert a.shape == (N_FEATURES,)
-    position = N_FEATURES - 3  # lit centroid along the housing axis, 0 top .. 1 bottom
+    position = N_LENS + 6  # lit centroid along the housing axis, 0 top .. 1 bottom
     assert a[position] < 0.3 < 0.7 < b[position]
-    assert a[-1] == 1.0  # has_housing
+    assert a[N_LENS + 8] == 1.0  # has_housing
+    # brightness at the slot centres, scaled to the housing's range: the lit slot is 1
+    assert a[N_LENS + 9 : N_LENS + 12].tolist() == [1.0, 0.0, 0.0]
+    assert b[N_LENS + 9 : N_LENS + 12].tolist() == [0.0, 0.0, 1.0]
     lens_box = [Candidate.from_circle(60, 40, 10, 1.0)]
-    assert lamp_features(top, lens_box)[0][-1] == 0.0
+    assert lamp_features(top, lens_box)[0][N_LENS + 8] == 0.0
+
+
+@pytest.mark.parametrize("white_core", [False, True])
+def test_two_lit_tells_red_amber_from_red(white_core):
+    both, box = head("red_yellow", white_core)
+    red, _ = head("red", white_core)
+    amber, _ = head("yellow", white_core)
+    scores = [
+        lamp_features(i, [Candidate.from_box(box, 1.0)])[0, TWO_LIT] for i in (both, red, amber)
+    ]
+    assert scores[0] > 0.8 and scores[1] < 0.1 and scores[2] < 0.1
+
+
+@pytest.mark.parametrize("white_core", [False, True])
+def test_shipped_model_reads_red_amber_by_position(white_core):
+    # the shipped model never saw red+amber (no open set labels it): the two-lit rule reads it;
+    # without the rule it is read by one of its two lamps
+    image, box = head("red_yellow", white_core)
+    classifier = tsrkit.classifier("lamp-state")
+    found = classifier.classify(Frame(image, "head"), [Candidate.from_box(box, 1.0)])
+    assert found[0].state == "red_yellow"
+    off = tsrkit.classifier("lamp-state", red_yellow_ratio=1.0)
+    assert off.classify(Frame(image, "head"), [Candidate.from_box(box, 1.0)])[0].state in {
+        "red",
+        "yellow",
+    }
 
 
 def save(path, model):
@@ -127,3 +163,14 @@ def test_fusion_with_ab_hist_reads_rendered_heads(state):
     assert found[0].state == state
     assert set(found[0].state_scores) >= {"red", "yellow", "green"}
     assert abs(sum(found[0].state_scores.values()) - 1.0) < 1e-6
+
+
+def test_two_lit_needs_two_lamps_and_a_red_top():
+    # slot centres at rows 6, 18, 30 of 36, averaged over +-2 rows
+    lamps = np.full((1, 36), 0.1)
+    lamps[0, 4:9], lamps[0, 16:21] = 1.0, 0.8  # top and middle lamps, dark housing between
+    glare = np.linspace(1.0, 0.1, 36)[None]  # one lamp's glare fading down the housing
+    red, grey = np.full((1, 36), 0.2), np.zeros((1, 36))
+    assert two_lit(lamps, red)[0] == pytest.approx((0.8 - 0.1) / (1.0 - 0.1))
+    assert two_lit(lamps, grey)[0] == 0.0  # top not red: a backplate or unlit lens
+    assert two_lit(glare, red)[0] == 0.0  # no dark gap between the two slots

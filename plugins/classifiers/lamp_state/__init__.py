@@ -5,7 +5,13 @@ Beyond the documents (issue 11): Zheng's ab-hist and Lee's hsi-backprojection st
 unchanged, beside it. Features: :mod:`.features`; model: scikit-learn's
 ``HistGradientBoostingClassifier`` stored with skops (explicit trusted types, no pickle; see
 ``tsrkit_plugins.verifiers.persistence``). ``red_yellow`` is a state of its own where the
-training data labels it (DTLD); other labels (arrows, off) are passed over in training.
+training data labels it (DTLD); other labels (arrows, off) are passed over in training. Where
+no training set labels it, a light read red or amber whose housing has its top and middle slots
+both lit, the top one red (:func:`~.features.two_lit` above ``red_yellow_ratio``), is read
+red+amber (:func:`red_yellow`).
+The classes are not reweighted, and the learned red probability counts ``red_prior`` times
+(:func:`prefer_red`): red is the most common state of every set and the costly one to miss, so
+a lamp whose colour sits between red and amber (orange-red LEDs, white cores) reads red.
 ``ab_hist_weight`` mixes ab-hist's normalised scores into the learned probabilities (a late
 fusion, :func:`blend`; measured in ``benchmarks/RESULTS.state.md``).
 """
@@ -26,7 +32,12 @@ from tsrkit.plugin import Classifier, Detector
 from tsrkit.registry import get_registry
 from tsrkit.types import Candidate, Detection, Frame, Sample
 from tsrkit_plugins.classifiers.ab_hist import AbHist
-from tsrkit_plugins.classifiers.lamp_state.features import N_FEATURES, VERSION, lamp_features
+from tsrkit_plugins.classifiers.lamp_state.features import (
+    N_FEATURES,
+    TWO_LIT,
+    VERSION,
+    lamp_features,
+)
 from tsrkit_plugins.verifiers.persistence import estimator_arrays, load_estimator
 
 if TYPE_CHECKING:  # scikit-learn loads when a model is fitted or read, not on import
@@ -92,6 +103,40 @@ def blend(
     return (1 - weight) * table + weight * other
 
 
+def prefer_red(probability: np.ndarray, states: Sequence[str], factor: float) -> np.ndarray:
+    """``probability`` (columns: ``states``) with its red column times ``factor``, each row
+    renormalised to sum 1.
+
+    Examples
+    --------
+    >>> prefer_red(np.array([[0.4, 0.6]]), ["red", "yellow"], 2.0)
+    array([[0.57142857, 0.42857143]])
+    """
+    out = probability * np.where(np.asarray(states) == "red", factor, 1.0)
+    return out / np.maximum(out.sum(axis=1, keepdims=True), 1e-12)
+
+
+def red_yellow(table: np.ndarray, features: np.ndarray, ratio: float) -> np.ndarray:
+    """``table`` (columns: :data:`STATES`) with the top state and red+amber swapped on the rows
+    read red or yellow whose :func:`~.features.two_lit` (column ``TWO_LIT`` of ``features``)
+    exceeds ``ratio``.
+
+    Examples
+    --------
+    >>> features = np.zeros((2, N_FEATURES)); features[:, TWO_LIT] = (0.9, 0.2)
+    >>> red_yellow(np.array([[0.7, 0.2, 0.1, 0.0], [0.2, 0.7, 0.1, 0.0]]), features, 0.5)
+    array([[0. , 0.2, 0.1, 0.7],
+           [0.2, 0.7, 0.1, 0. ]])
+    """
+    out = table.copy()
+    top = np.argmax(table, axis=1)
+    both = STATES.index("red_yellow")
+    read = np.isin(top, [STATES.index("red"), STATES.index("yellow")])
+    rows = np.flatnonzero(read & (features[:, TWO_LIT] > ratio))
+    out[rows, top[rows]], out[rows, both] = table[rows, both], table[rows, top[rows]]
+    return out
+
+
 def fit_estimator(
     features: np.ndarray, labels: np.ndarray, params
 ) -> tuple[HistGradientBoostingClassifier, list[str]]:
@@ -103,7 +148,7 @@ def fit_estimator(
         max_iter=params["iterations"],
         max_leaf_nodes=params["leaves"],
         learning_rate=params["learning_rate"],
-        class_weight="balanced",
+        class_weight=None,
         early_stopping=False,
         random_state=params["seed"],
     ).fit(features, np.searchsorted(present, labels))
@@ -146,6 +191,26 @@ class LampState(Classifier):
             help="weight of ab-hist's scores (shipped model, normalised) mixed with the learned "
             "probabilities; 0.5 is the late fusion of benchmarks/RESULTS.state.md",
         ),
+        Param(
+            "red_prior",
+            "float",
+            2.0,
+            min=1.0,
+            max=10.0,
+            help="the learned red probability counts this many times (red is the common and "
+            "the costly state: an ambiguous red/amber reads red); 1 reads the learned "
+            "probabilities as they are",
+        ),
+        Param(
+            "red_yellow_ratio",
+            "float",
+            0.5,
+            min=0.0,
+            max=1.0,
+            help="a light read red or amber is read red+amber when its housing's top slot is red "
+            "and it and the middle slot are lit above this share of the brightest slot's height "
+            "over the bottom one; 1 switches it off",
+        ),
     )
 
     def __init__(self, **params):
@@ -182,7 +247,10 @@ class LampState(Classifier):
         if not candidates:
             return []
         estimator = self.estimator
-        probability = estimator.predict_proba(lamp_features(frame.image, candidates))
+        features = lamp_features(frame.image, candidates)
+        probability = prefer_red(
+            estimator.predict_proba(features), self._states, self.params["red_prior"]
+        )
         weight = self.params["ab_hist_weight"]
         known = set(self._states)
         if weight > 0:
@@ -193,7 +261,10 @@ class LampState(Classifier):
             other = np.array([[d.state_scores.get(s, 0.0) for s in STATES] for d in found])
         else:
             other = np.zeros((len(candidates), len(STATES)))
-        table = blend(probability, self._states, other, weight)
+        ratio = self.params["red_yellow_ratio"]
+        table = red_yellow(blend(probability, self._states, other, weight), features, ratio)
+        if ratio < 1:
+            known.add("red_yellow")
         out = []
         for candidate, row in zip(candidates, table):
             scores = {s: float(v) for s, v in zip(STATES, row) if s in known}

@@ -12,8 +12,14 @@ robust across cameras:
 * **position**: the housing resampled upright (vertical or horizontal head) to
   :data:`HOUSING_SIZE`, the brightness and colourfulness of its top, middle and bottom thirds
   and the lit centroid along its axis (red on top, amber in the middle, green at the bottom in
-  most countries; red+amber lights two thirds at once). Without a housing (a lens box) these are
-  zero and ``has_housing`` is 0.
+  most countries; red+amber lights two thirds at once). Without a housing (a lens box), and for
+  a horizontal head (whose order differs by country), these are zero and ``has_housing`` is 0.
+
+Layout 3 reads the housing in its central band (the middle half across, :func:`band`): the
+corners of a housing box hold sky, visors or a backplate, bright enough to pull the lit lens and
+the lit centroid off the lamp. It adds the brightness and colourfulness at the three lens slots'
+centres, each scaled to the housing's own range (0 the darkest slot, 1 the brightest), and
+:func:`two_lit`, how much the top and middle slots are both lit above the bottom one (red+amber).
 
 Layout 2 left out what differs by camera rather than by state (mean value and saturation of the
 disk, its red/green chromaticity, the hue histogram of the whole housing): across cameras they
@@ -39,7 +45,7 @@ HOUSING_SIZE = (12, 36)
 #: Long / short side ratio from which a box without a fitted housing is read as a housing.
 ELONGATION = 1.5
 #: Feature layout version: a model trained on another layout is refused.
-VERSION = 2
+VERSION = 3
 
 
 def _lens_masks() -> tuple[np.ndarray, np.ndarray]:
@@ -51,8 +57,11 @@ def _lens_masks() -> tuple[np.ndarray, np.ndarray]:
 
 DISK, RIM = _lens_masks()
 N_HUE = len(HUE_EDGES) - 1
-#: Number of features: 2 x lens hue, 4 Lab, the over-exposed share, 9 position.
-N_FEATURES = 2 * N_HUE + 4 + 1 + 9
+#: Number of features: 2 x lens hue, 4 Lab, the over-exposed share, 16 position (the last one
+#: :func:`two_lit`).
+N_FEATURES = 2 * N_HUE + 4 + 1 + 16
+#: Column of :func:`two_lit` (0 without a housing).
+TWO_LIT = N_FEATURES - 1
 #: Number of lens (colour) features, the first columns.
 N_LENS = 2 * N_HUE + 5
 
@@ -146,9 +155,10 @@ def lit_lenses(
 ) -> list[Candidate]:
     """The lit lens of each upright housing patch, in image coordinates: the window of
     ``2 * lens_fraction`` short sides along the axis with the highest mean saturation x
-    value^2 (the rule of ``tsrkit_plugins.classifiers.regions.find_lens``, on the patch)."""
+    value^2 over the central :func:`band` (the rule of
+    ``tsrkit_plugins.classifiers.regions.find_lens``, on the patch)."""
     value = hsv[..., 2].astype(np.float32) / 255
-    lit = (hsv[..., 1].astype(np.float32) / 255 * value * value).mean(axis=2)
+    lit = band(hsv[..., 1].astype(np.float32) / 255 * value * value).mean(axis=2)
     across, along = HOUSING_SIZE
     window = max(1, int(round(2 * lens_fraction * across)))
     kernel = np.ones(window, np.float32)
@@ -161,13 +171,56 @@ def lit_lenses(
     return [Candidate.from_circle(*v, 1.0) for v in zip(cx, cy, radius)]
 
 
-def housing_features(hsv: np.ndarray, vertical: np.ndarray) -> np.ndarray:
-    """Lit-position features of upright housing patches in HSV."""
+def band(upright: np.ndarray) -> np.ndarray:
+    """The middle half across of an (N, along, across) stack of upright housings."""
+    across = upright.shape[2]
+    return upright[:, :, across // 4 : across - across // 4]
+
+
+def slots(profile: np.ndarray) -> np.ndarray:
+    """The (N, 3) mean of an (N, along) profile around the centres of the top, middle and bottom
+    lens slots (at 1/6, 1/2 and 5/6 of the length, +-1/18 of it)."""
+    along = profile.shape[1]
+    half = max(1, along // 18)
+    centres = (2 * np.arange(3) + 1) * along // 6
+    return np.stack([profile[:, c - half : c + half + 1].mean(axis=1) for c in centres], axis=1)
+
+
+def scaled(values: np.ndarray) -> np.ndarray:
+    """Each row of ``values`` scaled to its own range: 0 at its minimum, 1 at its maximum."""
+    low = values.min(axis=1, keepdims=True)
+    return (values - low) / np.maximum(values.max(axis=1, keepdims=True) - low, 1e-3)
+
+
+def two_lit(profile: np.ndarray, redness: np.ndarray, dip: float = 0.7) -> np.ndarray:
+    """How far the top and middle slots of an (N, along) brightness profile are both lit above
+    the bottom one, as a share of the brightest slot's height above it: 1 when both are as
+    bright as the brightest, 0 (or below) when either is as dark as the bottom. Red+amber
+    lights both (DTLD's ``red_yellow``), and its top lamp is red: where the (N, along)
+    ``redness`` (red minus green) at the top slot is not above 0 (a grey backplate or an unlit
+    lens above an amber lamp), the result is 0. Two lamps have dark housing between them:
+    where the profile between the two slot centres stays above ``dip`` of the way from the
+    bottom to the dimmer of the two, one lamp's glare lights both slots and the result is 0."""
+    top, middle, bottom = slots(profile).T
+    lower = np.minimum(top, middle)
+    along = profile.shape[1]
+    gap = profile[:, along // 6 : along // 2 + 1].min(axis=1)
+    both = (lower - bottom) / np.maximum(np.maximum(top, middle) - bottom, 1e-3)
+    two = (gap < bottom + dip * (lower - bottom)) & (slots(redness)[:, 0] > 0)
+    return np.where(two, both, 0.0)
+
+
+def housing_features(upright: np.ndarray, hsv: np.ndarray, vertical: np.ndarray) -> np.ndarray:
+    """Lit-position features of upright housing patches (BGR ``upright`` and its ``hsv``), read
+    in their central :func:`band`."""
     n = hsv.shape[0]
-    value = hsv[..., 2].astype(np.float32) / 255
-    colourful = hsv[..., 1].astype(np.float32) / 255 * value
+    value = band(hsv[..., 2].astype(np.float32) / 255)
+    colourful = band(hsv[..., 1].astype(np.float32) / 255) * value
     thirds = np.array_split(np.arange(value.shape[1]), 3)
-    weight = value.max(axis=2) ** 4
+    profile = value.mean(axis=2)
+    bgr = band(upright.astype(np.float32) / 255)
+    redness = (bgr[..., 2] - bgr[..., 1]).mean(axis=2)
+    weight = profile**4
     position = weight @ np.linspace(0, 1, weight.shape[1]) / np.maximum(weight.sum(axis=1), 1e-6)
     return np.concatenate(
         [
@@ -176,6 +229,9 @@ def housing_features(hsv: np.ndarray, vertical: np.ndarray) -> np.ndarray:
             position[:, None],
             vertical[:, None].astype(np.float32),
             np.ones((n, 1), np.float32),
+            scaled(slots(profile)),
+            scaled(slots(colourful.mean(axis=2))),
+            two_lit(profile, redness)[:, None],
         ],
         axis=1,
     )
@@ -191,7 +247,10 @@ def lamp_features(image: np.ndarray, candidates: Sequence[Candidate]) -> np.ndar
         boxes = np.array([housings[i] for i in boxed], np.float64)
         upright, vertical = upright_housings(image, boxes)
         hsv = convert(upright, cv2.COLOR_BGR2HSV)
-        rows[boxed, N_LENS:] = housing_features(hsv, vertical)
+        # a horizontal head's order differs by country (red on the left in Europe and the US,
+        # on the right in Japan and in cinTA's Indonesian heads): its lit lens is read, its
+        # position is not
+        rows[boxed, N_LENS:] = housing_features(upright, hsv, vertical) * vertical[:, None]
         found = lit_lenses(boxes, vertical, hsv)
         for k, i in enumerate(boxed):
             if candidates[i].housing is None:
