@@ -69,7 +69,7 @@ SETS = (
     RealSet("DTLD", "dtld_fridtjofs", "train", "test", "housing", False),
 )
 LABELS = [bin_label(lo, hi) for lo, hi in SIZE_BINS]
-THRESHOLDS = (0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9)
+THRESHOLDS = (0.1, 0.2, 0.25, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9)
 
 
 class Memo(Detector):
@@ -226,7 +226,11 @@ def main() -> None:
     parser.add_argument("--threshold", default="0.5", help="verifier threshold of the tables")
     args = parser.parse_args()
     if args.tables:
-        print(markdown(json.loads(Path(args.tables).read_text()), args.threshold))
+        results = json.loads(Path(args.tables).read_text())
+        measured = next(iter(results["folds"].values()))["loso"]["by_threshold"]
+        if args.threshold not in measured:
+            parser.error(f"--threshold {args.threshold}: this run has {', '.join(measured)}")
+        print(markdown(results, args.threshold))
         return
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
