@@ -41,6 +41,7 @@ from tsrkit.plugin import Detector, Verifier  # noqa: E402
 from tsrkit.registry import get_registry  # noqa: E402
 from tsrkit.training import train  # noqa: E402
 from tsrkit.types import Dataset, Sample  # noqa: E402
+from tsrkit_plugins.verifiers.learned import passes  # noqa: E402
 from tsrkit_plugins.verifiers.mining import no_light_frames  # noqa: E402
 
 cv2.setNumThreads(1)
@@ -68,7 +69,7 @@ SETS = (
     RealSet("DTLD", "dtld_fridtjofs", "train", "test", "housing", False),
 )
 LABELS = [bin_label(lo, hi) for lo, hi in SIZE_BINS]
-THRESHOLDS = (0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9)
+THRESHOLDS = (0.1, 0.2, 0.25, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9)
 
 
 class Memo(Detector):
@@ -111,9 +112,10 @@ def no_light_dataset(count: int) -> Dataset:
     return Dataset("synthetic-no-light", samples, info={"box": "housing"})
 
 
-def evaluate(dataset, detector, verifier, box, thresholds=(0.0,)):
+def evaluate(dataset, detector, verifier, box, thresholds=(0.0,), relative=0.0):
     """One run (verifier threshold 0); Zheng figures and the share of lights some kept box
-    overlaps at IoU >= 0.5 (``iou50_recall``, the set's ``box``) recomputed at every threshold."""
+    overlaps at IoU >= 0.5 (``iou50_recall``, the set's ``box``) recomputed at every threshold
+    (with the verifier's ``relative`` gate: :func:`passes`)."""
     run = run_benchmark(dataset, detector, verifier=verifier, cache=False, box=box)
     ap = run.report["iou50"]["ap"]
     pairs = list(run.pairs())
@@ -121,7 +123,8 @@ def evaluate(dataset, detector, verifier, box, thresholds=(0.0,)):
     for t in thresholds:
         scores, box_hits = [], []
         for sample, record in pairs:
-            kept = [d for d in record.detections if d.score >= t]
+            keep = passes([d.score for d in record.detections], t, relative)
+            kept = [d for d, k in zip(record.detections, keep) if k]
             truth = [a.bbox for a in sample.annotations]
             scores.append(score_frame([(d.x, d.y) for d in kept], truth))
             if truth:
@@ -160,8 +163,9 @@ def markdown(results: dict, threshold: str = "0.5") -> str:
         f"Candidates: {' + '.join(results['detector'])} "
         f"({' '.join(results['params']) or 'defaults'})"
         f"{', housing: ' + results['housing'] if results['housing'] else ''}; verifier threshold "
-        f"{threshold}. FP/frame: detections outside every ground-truth circle (exhaustive sets "
-        "only); no-light: synthetic 1280x720 scenes without a lit light.",
+        f"{threshold}, relative {results.get('relative', 0.0)}. FP/frame: detections outside "
+        "every ground-truth circle (exhaustive sets only); no-light: synthetic 1280x720 "
+        "scenes without a lit light.",
         "",
         "| test set | pipeline | AP50 (box) | recall IoU.5 | recall | hit | precision | FP/frame "
         "| no-light FP/frame |",
@@ -222,7 +226,11 @@ def main() -> None:
     parser.add_argument("--threshold", default="0.5", help="verifier threshold of the tables")
     args = parser.parse_args()
     if args.tables:
-        print(markdown(json.loads(Path(args.tables).read_text()), args.threshold))
+        results = json.loads(Path(args.tables).read_text())
+        measured = next(iter(results["folds"].values()))["loso"]["by_threshold"]
+        if args.threshold not in measured:
+            parser.error(f"--threshold {args.threshold}: this run has {', '.join(measured)}")
+        print(markdown(results, args.threshold))
         return
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -231,6 +239,7 @@ def main() -> None:
     names = args.detector or ["lab-frst"]
     ver_params = {k[9:]: v for k, v in assigned.items() if k.startswith("verifier.")}
     ver_params["after"] = args.housing or ""
+    relative = float(ver_params.pop("relative", 0.0))  # applied to the records, like thresholds
     members = [
         reg.create(
             "detector",
@@ -246,7 +255,12 @@ def main() -> None:
     tests = {s.key: open_datasets([f"{s.name}:{s.test}"]) for s in SETS}
     nolight = no_light_dataset(args.no_light)
     started = time.perf_counter()
-    results: dict = {"detector": names, "params": args.param, "housing": args.housing}
+    results: dict = {
+        "detector": names,
+        "params": args.param,
+        "housing": args.housing,
+        "relative": relative,
+    }
 
     if args.paper_from:
         results["paper"] = json.loads(Path(args.paper_from).read_text())["paper"]
@@ -284,8 +298,8 @@ def main() -> None:
                 },
             )
             chain = Chain([verifier])  # the verifier runs its `after` stage (housing) itself
-            ap, rows, pairs = evaluate(tests[s.key], detector, chain, s.box, THRESHOLDS)
-            _, nl, _ = evaluate(nolight, detector, chain, "housing", THRESHOLDS)
+            ap, rows, pairs = evaluate(tests[s.key], detector, chain, s.box, THRESHOLDS, relative)
+            _, nl, _ = evaluate(nolight, detector, chain, "housing", THRESHOLDS, relative)
             folds.setdefault(s.key, {})[mode] = {
                 "train": refs,
                 "fit_seconds": round(fit_s, 1),

@@ -205,6 +205,24 @@ def test_prior_blends_the_detectors_score_with_the_probability(trained):
     assert alone and {c.score for c in alone} <= {0.5, 1.0}
 
 
+def test_relative_drops_what_scores_below_a_share_of_the_frames_best(trained):
+    frame = tiny_dataset(1).samples[0].load()
+    candidates = get_registry().create("detector", "gray-tophat").detect(frame)
+    candidates = get_registry().create("verifier", "housing").verify(frame, candidates)
+    own = [1.0, 0.4]  # prior 1: the score is the detector's own
+    candidates = [dataclasses.replace(c, score=s) for c, s in zip(candidates, own)]
+    assert len(candidates) == 2
+
+    def scores(**params):
+        verifier = make(model=str(trained[0]), prior=1.0, **params)
+        return [c.score for c in verifier.verify(frame, candidates)]
+
+    assert scores(threshold=0.0) == [1.0, 0.4]
+    assert scores(threshold=0.0, relative=0.5) == [1.0]
+    assert scores(threshold=0.0, relative=0.4) == [1.0, 0.4]
+    assert scores(threshold=0.5, relative=0.1) == [1.0]
+
+
 def test_corrupt_foreign_or_mismatched_models_are_one_clear_error(trained, tmp_path):
     npz, meta = model_paths(trained[0])
     frame = Frame(lamp_scene(), "x")
