@@ -19,10 +19,11 @@ from tsrkit_plugins.classifiers.lamp_state.features import (
     N_HUE,
     N_LENS,
     RIM,
-    housing_features,
+    band,
     housing_of,
     lit_lenses,
     quantiles,
+    scaled,
 )
 
 
@@ -78,6 +79,48 @@ def _lens_features(image, lenses):
     ).reshape(n, -1)
 
 
+def _slots(profile):
+    along = profile.shape[1]
+    half = max(1, along // 18)
+    centres = (2 * np.arange(3) + 1) * along // 6
+    return np.stack([profile[:, c - half : c + half + 1].mean(axis=1) for c in centres], axis=1)
+
+
+def _two_lit(profile, redness, dip=0.7):
+    top, middle, bottom = _slots(profile).T
+    lower = np.minimum(top, middle)
+    along = profile.shape[1]
+    gap = profile[:, along // 6 : along // 2 + 1].min(axis=1)
+    both = (lower - bottom) / np.maximum(np.maximum(top, middle) - bottom, 1e-3)
+    two = (gap < bottom + dip * (lower - bottom)) & (_slots(redness)[:, 0] > 0)
+    return np.where(two, both, 0.0)
+
+
+def _housing_features(upright, hsv, vertical):
+    n = hsv.shape[0]
+    value = band(hsv[..., 2].astype(np.float32) / 255)
+    colourful = band(hsv[..., 1].astype(np.float32) / 255) * value
+    thirds = np.array_split(np.arange(value.shape[1]), 3)
+    profile = value.mean(axis=2)
+    bgr = band(upright.astype(np.float32) / 255)
+    redness = (bgr[..., 2] - bgr[..., 1]).mean(axis=2)
+    weight = profile**4
+    position = weight @ np.linspace(0, 1, weight.shape[1]) / np.maximum(weight.sum(axis=1), 1e-6)
+    return np.concatenate(
+        [
+            np.stack([quantiles(value[:, rows].reshape(n, -1), 0.9) for rows in thirds], 1),
+            np.stack([quantiles(colourful[:, rows].reshape(n, -1), 0.9) for rows in thirds], 1),
+            position[:, None],
+            vertical[:, None].astype(np.float32),
+            np.ones((n, 1), np.float32),
+            scaled(_slots(profile)),
+            scaled(_slots(colourful.mean(axis=2))),
+            _two_lit(profile, redness)[:, None],
+        ],
+        axis=1,
+    )
+
+
 def _upright_housings(image, boxes):
     vertical = (boxes[:, 3] - boxes[:, 1]) >= (boxes[:, 2] - boxes[:, 0])
     out = _patches(image, boxes, HOUSING_SIZE)
@@ -97,7 +140,7 @@ def lamp_features(image, candidates):
         boxes = np.array([housings[i] for i in boxed], np.float64)
         upright, vertical = _upright_housings(image, boxes)
         hsv = _convert(upright, cv2.COLOR_BGR2HSV)
-        rows[boxed, N_LENS:] = housing_features(upright, hsv, vertical) * vertical[:, None]
+        rows[boxed, N_LENS:] = _housing_features(upright, hsv, vertical) * vertical[:, None]
         found = lit_lenses(boxes, vertical, hsv)
         for k, i in enumerate(boxed):
             if candidates[i].housing is None:

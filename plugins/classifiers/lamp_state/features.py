@@ -222,7 +222,7 @@ def slots(profile: np.ndarray) -> np.ndarray:
     along = profile.shape[1]
     half = max(1, along // 18)
     centres = (2 * np.arange(3) + 1) * along // 6
-    return np.stack([profile[:, c - half : c + half + 1].mean(axis=1) for c in centres], axis=1)
+    return profile[:, centres[:, None] + np.arange(-half, half + 1)].mean(axis=2)
 
 
 def scaled(values: np.ndarray) -> np.ndarray:
@@ -253,18 +253,19 @@ def housing_features(upright: np.ndarray, hsv: np.ndarray, vertical: np.ndarray)
     """Lit-position features of upright housing patches (BGR ``upright`` and its ``hsv``), read
     in their central :func:`band`."""
     n = hsv.shape[0]
-    value = band(hsv[..., 2].astype(np.float32) / 255)
-    colourful = band(hsv[..., 1].astype(np.float32) / 255) * value
-    thirds = np.array_split(np.arange(value.shape[1]), 3)
+    value = band(hsv[..., 2]).astype(np.float32) / 255
+    colourful = band(hsv[..., 1]).astype(np.float32) / 255 * value
     profile = value.mean(axis=2)
-    bgr = band(upright.astype(np.float32) / 255)
-    redness = (bgr[..., 2] - bgr[..., 1]).mean(axis=2)
+    bgr = band(upright[..., 1:]).astype(np.float32) / 255
+    redness = (bgr[..., 1] - bgr[..., 0]).mean(axis=2)
+    # the 0.9 quantile of value and colourfulness over each third of the length (HOUSING_SIZE's
+    # length is a multiple of 3), one partition for all six
+    thirds = quantiles(np.stack([value, colourful], axis=1).reshape(2 * n * 3, -1), 0.9)
     weight = profile**4
     position = weight @ np.linspace(0, 1, weight.shape[1]) / np.maximum(weight.sum(axis=1), 1e-6)
     return np.concatenate(
         [
-            np.stack([quantiles(value[:, rows].reshape(n, -1), 0.9) for rows in thirds], 1),
-            np.stack([quantiles(colourful[:, rows].reshape(n, -1), 0.9) for rows in thirds], 1),
+            thirds.reshape(n, 6),
             position[:, None],
             vertical[:, None].astype(np.float32),
             np.ones((n, 1), np.float32),
@@ -290,10 +291,13 @@ def lamp_features(image: np.ndarray, candidates: Sequence[Candidate]) -> np.ndar
         # on the right in Japan and in cinTA's Indonesian heads): its lit lens is read, its
         # position is not
         rows[boxed, N_LENS:] = housing_features(upright, hsv, vertical) * vertical[:, None]
-        found = lit_lenses(boxes, vertical, hsv)
-        for k, i in enumerate(boxed):
-            if candidates[i].housing is None:
-                lenses[i] = found[k]
+        # a box read as a housing has its lit lens found in it (a fitted housing's candidate
+        # is its lens)
+        unfitted = [k for k, i in enumerate(boxed) if candidates[i].housing is None]
+        if unfitted:
+            found = lit_lenses(boxes[unfitted], vertical[unfitted], hsv[unfitted])
+            for k, lens in zip(unfitted, found):
+                lenses[boxed[k]] = lens
     if lenses:
         rows[:, :N_LENS] = lens_features(image, lenses)
     return np.nan_to_num(rows)
