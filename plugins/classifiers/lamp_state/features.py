@@ -56,8 +56,11 @@ def _lens_masks() -> tuple[np.ndarray, np.ndarray]:
 
 
 DISK, RIM = _lens_masks()
-#: The pixels of :data:`DISK` and :data:`RIM`, as flat indices into a patch (row-major order).
-DISK_AT, RIM_AT = np.flatnonzero(DISK), np.flatnonzero(RIM)
+#: The pixels of :data:`DISK`, then those of :data:`RIM`, as flat indices into a lens patch
+#: (row-major order), and which of the two each is (0: disk, 1: rim).
+LENS_AT = np.concatenate([np.flatnonzero(DISK), np.flatnonzero(RIM)])
+N_DISK = int(DISK.sum())
+LENS_PART = (np.arange(len(LENS_AT)) >= N_DISK).astype(np.intp)
 N_HUE = len(HUE_EDGES) - 1
 #: Number of features: 2 x lens hue, 4 Lab, the over-exposed share, 16 position (the last one
 #: :func:`two_lit`).
@@ -95,21 +98,17 @@ def quantiles(values: np.ndarray, q: float) -> np.ndarray:
 HUE_BIN = np.digitize(np.arange(256), HUE_EDGES) - 1
 
 
-def hue_histograms(pixels: Sequence[np.ndarray]) -> list[np.ndarray]:
-    """Per patch, the share of saturation x value weight per :data:`HUE_EDGES` bin of each
-    (N, K, 3) stack of HSV ``pixels`` (K pixels of each of N patches, a mask's): one
-    (N, :data:`N_HUE`) table per stack, all from one weighted ``np.bincount`` (each bin sums
-    its pixels in the stack's order)."""
-    n = pixels[0].shape[0]
-    offset = N_HUE * np.arange(n)[:, None]
-    bins = [HUE_BIN.take(p[..., 0]) + offset + k * n * N_HUE for k, p in enumerate(pixels)]
-    weights = [p[..., 1].astype(np.float32) * p[..., 2] / 65025.0 for p in pixels]
-    hist = np.bincount(
-        np.concatenate(bins, axis=None),
-        weights=np.concatenate(weights, axis=None),
-        minlength=len(pixels) * n * N_HUE,
-    ).reshape(len(pixels), n, N_HUE)
-    return list(hist / np.maximum(hist.sum(axis=2, keepdims=True), 1e-6))
+def hue_histograms(pixels: np.ndarray, part: np.ndarray, parts: int) -> np.ndarray:
+    """Per patch of an (N, K, 3) stack of HSV ``pixels`` and per region (``part`` (K,) gives
+    each pixel's, 0 to ``parts`` - 1), the share of saturation x value weight per
+    :data:`HUE_EDGES` bin, (N, parts, :data:`N_HUE`), from one weighted ``np.bincount`` (each
+    bin sums its pixels in the stack's order)."""
+    n = len(pixels)
+    cells = HUE_BIN.take(pixels[..., 0]) + N_HUE * (parts * np.arange(n)[:, None] + part)
+    weight = pixels[..., 1].astype(np.float32) * pixels[..., 2] / 65025.0
+    hist = np.bincount(cells.ravel(), weights=weight.ravel(), minlength=n * parts * N_HUE)
+    hist = hist.reshape(n, parts, N_HUE)
+    return hist / np.maximum(hist.sum(axis=2, keepdims=True), 1e-6)
 
 
 def pixel_bounds(boxes: np.ndarray, width: int, height: int) -> np.ndarray:
@@ -153,15 +152,14 @@ def lens_features(image: np.ndarray, lenses: Sequence[Candidate]) -> np.ndarray:
     x, y = np.array([c.x for c in lenses]), np.array([c.y for c in lenses])
     stack = patches(image, np.stack([x - r, y - r, x + r, y + r], axis=1), (LENS_PATCH,) * 2)
     n = len(lenses)
-    hsv = convert(stack, cv2.COLOR_BGR2HSV).reshape(n, -1, 3)
-    lab = convert(stack, cv2.COLOR_BGR2LAB).reshape(n, -1, 3)
-    disk, rim = hsv.take(DISK_AT, axis=1), hsv.take(RIM_AT, axis=1)
-    disk_lab, rim_lab = lab.take(DISK_AT, axis=1), lab.take(RIM_AT, axis=1)
+    hsv = convert(stack, cv2.COLOR_BGR2HSV).reshape(n, -1, 3).take(LENS_AT, axis=1)
+    lab = convert(stack, cv2.COLOR_BGR2LAB).reshape(n, -1, 3).take(LENS_AT, axis=1)
+    disk_hsv = hsv[:, :N_DISK]
     # CIELab a and b around 0: small integers, exact in float64
-    disk_ab = disk_lab[..., 1:].astype(np.float64) - 128
-    rim_ab = rim_lab[..., 1:].astype(np.float64) - 128
-    value = disk[..., 2].astype(np.float32)
+    ab = lab[..., 1:].astype(np.float64) - 128
+    value = disk_hsv[..., 2].astype(np.float32)
     bright = value >= quantiles(value, 0.7)[:, None]
+    rim_lab = lab[:, N_DISK:]
     chroma = chroma_table().take((rim_lab[..., 1].astype(np.intp) << 8) | rim_lab[..., 2])
     vivid = chroma >= quantiles(chroma, 0.7)[:, None]
 
@@ -170,12 +168,12 @@ def lens_features(image: np.ndarray, lenses: Sequence[Candidate]) -> np.ndarray:
         total = np.matmul(mask[:, None, :].astype(np.float64), values)[:, 0]
         return total / np.maximum(mask.sum(axis=1), 1)[:, None]
 
-    over = (value > 230) & (disk[..., 1] < 80)
+    over = (value > 230) & (disk_hsv[..., 1] < 80)
     return np.concatenate(
         [
-            *hue_histograms((disk, rim)),
-            masked_mean(disk_ab, bright) / 128,
-            masked_mean(rim_ab, vivid) / 128,
+            hue_histograms(hsv, LENS_PART, 2).reshape(n, -1),
+            masked_mean(ab[:, :N_DISK], bright) / 128,
+            masked_mean(ab[:, N_DISK:], vivid) / 128,
             over.mean(axis=1, keepdims=True),
         ],
         axis=1,
