@@ -63,8 +63,8 @@ class Forest:
         if (binary and estimator.n_trees_per_iteration_ != 1) or any(
             tree.nodes["is_categorical"].any() for tree in trees
         ):
-            kind = "binary classifiers" if binary else "classifiers"
-            raise ModelError(f"model {where}: reads {kind} without categorical splits only")
+            kind = "the verifier reads binary classifiers" if binary else "reads classifiers"
+            raise ModelError(f"model {where}: {kind} without categorical splits only")
         nodes = np.concatenate([tree.nodes for tree in trees])
         sizes = np.array([len(tree.nodes) for tree in trees])
         offset = np.repeat(np.cumsum(sizes) - sizes, sizes)
