@@ -9,7 +9,8 @@ The leaf values are summed tree after tree onto the baseline, in scikit-learn's 
 probability is the same ``scipy.special.expit``, so the probabilities equal scikit-learn's to
 the bit (``tests/test_verifier_forest.py``). The trees are read from the estimator's
 ``_predictors`` and ``_baseline_prediction`` (scikit-learn's own arrays; that test would catch
-a change of them).
+a change of them). A multiclass classifier (one tree per class per iteration, ``lamp-state``'s)
+is read too: :meth:`Forest.raw` gives each class's sum, as scikit-learn's ``_raw_predict``.
 """
 
 from __future__ import annotations
@@ -27,16 +28,17 @@ if TYPE_CHECKING:  # scikit-learn loads when a model is fitted or read, not on i
 
 @dataclass(frozen=True)
 class Forest:
-    """The trees of a fitted binary classifier as flat node arrays.
+    """The trees of a fitted classifier as flat node arrays.
 
     ``roots`` (T,) index each tree's root in the node arrays, deepest tree first, and
     ``depths`` (T,) are those trees' depths (at a step of the descent, only the trees still
     deeper take part); ``order`` (T,) gives the place of each of scikit-learn's trees in that
     list. ``children`` (nodes x 2, flat) hold each node's left and right child (a leaf is its
-    own child on both sides); ``value`` is a leaf's raw value.
+    own child on both sides); ``value`` is a leaf's raw value. ``baseline`` (K,) holds each
+    class's starting value (K = 1: a binary classifier).
     """
 
-    baseline: float
+    baseline: np.ndarray
     roots: np.ndarray
     depths: np.ndarray
     order: np.ndarray
@@ -47,22 +49,22 @@ class Forest:
     value: np.ndarray
 
     @classmethod
-    def of(cls, estimator: HistGradientBoostingClassifier, where: str) -> Forest:
-        """The trees of ``estimator`` (read from ``where``).
+    def of(
+        cls, estimator: HistGradientBoostingClassifier, where: str, binary: bool = True
+    ) -> Forest:
+        """The trees of ``estimator`` (read from ``where``); ``binary``: refuse a multiclass one.
 
         Raises
         ------
         ModelError
-            Not one tree per iteration (binary), or a categorical split.
+            Not one tree per iteration (binary) where ``binary``, or a categorical split.
         """
         trees = [tree for iteration in estimator._predictors for tree in iteration]
-        if estimator.n_trees_per_iteration_ != 1 or any(
+        if (binary and estimator.n_trees_per_iteration_ != 1) or any(
             tree.nodes["is_categorical"].any() for tree in trees
         ):
-            raise ModelError(
-                f"model {where}: the verifier reads binary classifiers without categorical "
-                "splits only"
-            )
+            kind = "the verifier reads binary classifiers" if binary else "reads classifiers"
+            raise ModelError(f"model {where}: {kind} without categorical splits only")
         nodes = np.concatenate([tree.nodes for tree in trees])
         sizes = np.array([len(tree.nodes) for tree in trees])
         offset = np.repeat(np.cumsum(sizes) - sizes, sizes)
@@ -77,7 +79,7 @@ class Forest:
         depths = np.array([tree.nodes["depth"].max() for tree in trees])
         deepest = np.argsort(-depths, kind="stable")
         return cls(
-            baseline=float(estimator._baseline_prediction.ravel()[0]),
+            baseline=np.asarray(estimator._baseline_prediction, np.float64).ravel(),
             roots=(np.cumsum(sizes) - sizes)[deepest],
             depths=depths[deepest],
             order=np.argsort(deepest),
@@ -90,9 +92,14 @@ class Forest:
 
     def probability(self, features: np.ndarray) -> np.ndarray:
         """The probability of the positive class for each row of ``features`` (float64, as
-        scikit-learn converts them)."""
+        scikit-learn converts them), of a binary classifier."""
         from scipy.special import expit
 
+        return expit(self.raw(features)[:, 0])
+
+    def raw(self, features: np.ndarray) -> np.ndarray:
+        """The (rows, K) raw predictions of ``features``: each class's baseline plus its trees'
+        leaf values, summed iteration after iteration as scikit-learn does."""
         x = np.asarray(features, np.float64)
         rows, columns = x.shape
         flat = x.ravel()
@@ -107,6 +114,7 @@ class Forest:
             if missing:
                 right &= ~(np.isnan(value) & self.nan_left.take(at))
             node[:active] = self.children.take(2 * at + right)
+        k = len(self.baseline)
         leaves = self.value.take(node).reshape(len(self.roots), rows)[self.order]
-        start = np.zeros((1, rows)) + self.baseline
-        return expit(np.cumsum(np.vstack([start, leaves]), axis=0)[-1])
+        start = np.zeros((1, k, rows)) + self.baseline[None, :, None]
+        return np.cumsum(np.concatenate([start, leaves.reshape(-1, k, rows)]), axis=0)[-1].T

@@ -14,6 +14,10 @@ The classes are not reweighted, and the learned red probability counts ``red_pri
 a lamp whose colour sits between red and amber (orange-red LEDs, white cores) reads red.
 ``ab_hist_weight`` mixes ab-hist's normalised scores into the learned probabilities (a late
 fusion, :func:`blend`; measured in ``benchmarks/RESULTS.state.md``).
+The model's trees are evaluated for all of a frame's candidates in one pass
+(``tsrkit_plugins.verifiers.forest``) and turned into probabilities by the estimator's own
+loss: scikit-learn's ``predict_proba`` to the bit, without its per-tree calls
+(``tests/test_lamp_state_oracle.py``).
 """
 
 from __future__ import annotations
@@ -38,6 +42,7 @@ from tsrkit_plugins.classifiers.lamp_state.features import (
     VERSION,
     lamp_features,
 )
+from tsrkit_plugins.verifiers.forest import Forest
 from tsrkit_plugins.verifiers.persistence import estimator_arrays, load_estimator
 
 if TYPE_CHECKING:  # scikit-learn loads when a model is fitted or read, not on import
@@ -216,6 +221,7 @@ class LampState(Classifier):
     def __init__(self, **params):
         super().__init__(**params)
         self._estimator: HistGradientBoostingClassifier | None = None
+        self._forest: Forest | None = None
         self._states: tuple[str, ...] = ()
         self._ab_hist: Classifier | None = None
 
@@ -226,7 +232,7 @@ class LampState(Classifier):
         Raises
         ------
         tsrkit.models.ModelError
-            A missing, corrupt or foreign model, or one of another feature layout.
+            A missing, corrupt or foreign model, or one of another feature layout or count.
         """
         if self._estimator is None:
             where = str(self.params["model"] or DEFAULT_MODEL)
@@ -239,18 +245,34 @@ class LampState(Classifier):
             states = model.info.get("states")
             if not isinstance(states, list) or not set(states) <= set(STATES):
                 raise ModelError(f"model {where}: 'states' must be a list of {STATES}")
-            self._estimator = load_estimator(model, where, classes=list(range(len(states))))
-            self._states = tuple(states)
+            estimator = load_estimator(model, where, classes=list(range(len(states))))
+            if estimator.n_features_in_ != N_FEATURES:
+                raise ModelError(
+                    f"model {where}: {estimator.n_features_in_} features, this lamp-state "
+                    f"reads {N_FEATURES}; retrain it (tsrkit train lamp-state)"
+                )
+            self._estimator, self._states = estimator, tuple(states)
         return self._estimator
+
+    @property
+    def forest(self) -> Forest:
+        """The estimator's trees as flat arrays, for one-pass prediction."""
+        if self._forest is None:
+            where = str(self.params["model"] or DEFAULT_MODEL)
+            self._forest = Forest.of(self.estimator, where, binary=False)
+        return self._forest
+
+    def probability(self, features: np.ndarray) -> np.ndarray:
+        """The estimator's ``predict_proba`` of ``features``, to the bit: one pass over its
+        trees (:attr:`forest`), the sums turned into probabilities by the estimator's own
+        loss."""
+        return self.estimator._loss.predict_proba(self.forest.raw(features))
 
     def classify(self, frame: Frame, candidates: Sequence[Candidate]) -> list[Detection]:
         if not candidates:
             return []
-        estimator = self.estimator
         features = lamp_features(frame.image, candidates)
-        probability = prefer_red(
-            estimator.predict_proba(features), self._states, self.params["red_prior"]
-        )
+        probability = prefer_red(self.probability(features), self._states, self.params["red_prior"])
         weight = self.params["ab_hist_weight"]
         known = set(self._states)
         if weight > 0:
@@ -265,11 +287,13 @@ class LampState(Classifier):
         table = red_yellow(blend(probability, self._states, other, weight), features, ratio)
         if ratio < 1:
             known.add("red_yellow")
-        out = []
-        for candidate, row in zip(candidates, table):
-            scores = {s: float(v) for s, v in zip(STATES, row) if s in known}
-            out.append(Detection(candidate, STATES[int(np.argmax(row))], scores))
-        return out
+        columns = [k for k, s in enumerate(STATES) if s in known]
+        names = [STATES[k] for k in columns]
+        best = [STATES[k] for k in np.argmax(table, axis=1).tolist()]
+        return [
+            Detection(candidate, state, dict(zip(names, row)))
+            for candidate, state, row in zip(candidates, best, table[:, columns].tolist())
+        ]
 
     def fit(self, samples: Iterable[Sample], *, detector: Detector | None = None) -> Model:
         """Learn the states of the annotated lights of ``samples`` and of ``copies``

@@ -28,12 +28,12 @@ cost accuracy (leave-one-dataset-out, ``benchmarks/RESULTS.state.md``).
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 
 import cv2
 import numpy as np
 
-from tsrkit.geometry import clip_box
 from tsrkit.types import Candidate
 
 #: OpenCV hue (0-180) bin edges: reds split off at both ends, orange, amber, yellow, greens, blues.
@@ -56,6 +56,11 @@ def _lens_masks() -> tuple[np.ndarray, np.ndarray]:
 
 
 DISK, RIM = _lens_masks()
+#: The pixels of :data:`DISK`, then those of :data:`RIM`, as flat indices into a lens patch
+#: (row-major order), and which of the two each is (0: disk, 1: rim).
+LENS_AT = np.concatenate([np.flatnonzero(DISK), np.flatnonzero(RIM)])
+N_DISK = int(DISK.sum())
+LENS_PART = (np.arange(len(LENS_AT)) >= N_DISK).astype(np.intp)
 N_HUE = len(HUE_EDGES) - 1
 #: Number of features: 2 x lens hue, 4 Lab, the over-exposed share, 16 position (the last one
 #: :func:`two_lit`).
@@ -64,6 +69,14 @@ N_FEATURES = 2 * N_HUE + 4 + 1 + 16
 TWO_LIT = N_FEATURES - 1
 #: Number of lens (colour) features, the first columns.
 N_LENS = 2 * N_HUE + 5
+
+
+@functools.lru_cache(maxsize=1)
+def chroma_table() -> np.ndarray:
+    """CIELab chroma, ``np.hypot(a, b)`` around 0 in float64, of every 8-bit OpenCV (a, b)
+    pair, indexed ``256 a + b`` (looked up: the same values as computed pixel by pixel)."""
+    a, b = np.divmod(np.arange(65536), 256)
+    return np.hypot(a - 128.0, b - 128.0)
 
 
 def housing_of(candidate: Candidate) -> tuple[float, float, float, float] | None:
@@ -81,33 +94,56 @@ def quantiles(values: np.ndarray, q: float) -> np.ndarray:
     return np.partition(values, k, axis=1)[:, k]
 
 
-def hue_histograms(hsv: np.ndarray, mask: np.ndarray) -> np.ndarray:
-    """Per patch of an (N, H, W, 3) HSV stack, the share of saturation x value weight per
-    :data:`HUE_EDGES` bin over the (H, W) or (N, H, W) ``mask``."""
-    n = hsv.shape[0]
-    mask = np.broadcast_to(mask, hsv.shape[:3])
-    bins = np.digitize(hsv[..., 0], HUE_EDGES) - 1 + N_HUE * np.arange(n)[:, None, None]
-    weight = hsv[..., 1].astype(np.float32) * hsv[..., 2] / 65025.0
-    hist = np.bincount(bins[mask], weights=weight[mask], minlength=n * N_HUE)
-    hist = hist[: n * N_HUE].reshape(n, N_HUE)
-    return hist / np.maximum(hist.sum(axis=1, keepdims=True), 1e-6)
+#: The :data:`HUE_EDGES` bin of every 8-bit OpenCV hue (``np.digitize``'s, looked up).
+HUE_BIN = np.digitize(np.arange(256), HUE_EDGES) - 1
 
 
-def patches(image: np.ndarray, boxes: np.ndarray, size: tuple[int, int]) -> np.ndarray:
+def hue_histograms(pixels: np.ndarray, part: np.ndarray, parts: int) -> np.ndarray:
+    """Per patch of an (N, K, 3) stack of HSV ``pixels`` and per region (``part`` (K,) gives
+    each pixel's, 0 to ``parts`` - 1), the share of saturation x value weight per
+    :data:`HUE_EDGES` bin, (N, parts, :data:`N_HUE`), from one weighted ``np.bincount`` (each
+    bin sums its pixels in the stack's order)."""
+    n = len(pixels)
+    cells = HUE_BIN.take(pixels[..., 0]) + N_HUE * (parts * np.arange(n)[:, None] + part)
+    weight = pixels[..., 1].astype(np.float32) * pixels[..., 2] / 65025.0
+    hist = np.bincount(cells.ravel(), weights=weight.ravel(), minlength=n * parts * N_HUE)
+    hist = hist.reshape(n, parts, N_HUE)
+    return hist / np.maximum(hist.sum(axis=2, keepdims=True), 1e-6)
+
+
+def pixel_bounds(boxes: np.ndarray, width: int, height: int) -> np.ndarray:
+    """Integer pixel bounds (N, 4) of float ``boxes`` inside a ``width`` x ``height`` image,
+    end exclusive (:func:`tsrkit.geometry.clip_box`, for all boxes at once)."""
+    low = np.maximum(np.floor(boxes[:, :2]), 0)
+    high = np.minimum(np.ceil(boxes[:, 2:]), (width, height))
+    return np.concatenate([low, high], axis=1).astype(np.int64)
+
+
+def patches(
+    image: np.ndarray, boxes: np.ndarray, size: tuple[int, int], turned: np.ndarray | None = None
+) -> np.ndarray:
     """The (N, height, width, 3) stack of ``boxes`` resampled to ``size`` = (width, height);
-    a box wholly outside the image gives a black patch."""
+    a box wholly outside the image gives a black patch. A box where ``turned`` is set is
+    resampled to (height, width) and transposed."""
     out = np.zeros((len(boxes), size[1], size[0], 3), np.uint8)
-    for i, box in enumerate(boxes):
-        x0, y0, x1, y1 = clip_box(box, image.shape[1], image.shape[0])
+    turned = np.zeros(len(boxes), bool) if turned is None else turned
+    bounds = pixel_bounds(boxes, image.shape[1], image.shape[0]).tolist()
+    for i, ((x0, y0, x1, y1), turn) in enumerate(zip(bounds, turned.tolist())):
         if x1 > x0 and y1 > y0:
-            out[i] = cv2.resize(image[y0:y1, x0:x1], size, interpolation=cv2.INTER_AREA)
+            crop = image[y0:y1, x0:x1]
+            if turn:
+                out[i] = cv2.resize(crop, size[::-1], interpolation=cv2.INTER_AREA).transpose(
+                    1, 0, 2
+                )
+            else:
+                out[i] = cv2.resize(crop, size, interpolation=cv2.INTER_AREA)
     return out
 
 
 def convert(stack: np.ndarray, code: int) -> np.ndarray:
-    """One OpenCV colour conversion over a whole (N, H, W, 3) stack."""
-    n, h, w, _ = stack.shape
-    return cv2.cvtColor(stack.reshape(n * h, w, 3), code).reshape(n, h, w, 3)
+    """One OpenCV colour conversion over a whole (N, H, W, 3) stack (as one row of pixels:
+    OpenCV's per-row overhead dominates a tall stack of small patches)."""
+    return cv2.cvtColor(stack.reshape(1, -1, 3), code).reshape(stack.shape)
 
 
 def lens_features(image: np.ndarray, lenses: Sequence[Candidate]) -> np.ndarray:
@@ -116,23 +152,28 @@ def lens_features(image: np.ndarray, lenses: Sequence[Candidate]) -> np.ndarray:
     x, y = np.array([c.x for c in lenses]), np.array([c.y for c in lenses])
     stack = patches(image, np.stack([x - r, y - r, x + r, y + r], axis=1), (LENS_PATCH,) * 2)
     n = len(lenses)
-    hsv = convert(stack, cv2.COLOR_BGR2HSV)
-    lab = convert(stack, cv2.COLOR_BGR2LAB).astype(np.float32) - (0, 128, 128)
-    value = hsv[..., 2][:, DISK].astype(np.float32)
+    hsv = convert(stack, cv2.COLOR_BGR2HSV).reshape(n, -1, 3).take(LENS_AT, axis=1)
+    lab = convert(stack, cv2.COLOR_BGR2LAB).reshape(n, -1, 3).take(LENS_AT, axis=1)
+    disk_hsv = hsv[:, :N_DISK]
+    # CIELab a and b around 0: small integers, exact in float64
+    ab = lab[..., 1:].astype(np.float64) - 128
+    value = disk_hsv[..., 2].astype(np.float32)
     bright = value >= quantiles(value, 0.7)[:, None]
-    chroma = np.hypot(lab[..., 1], lab[..., 2])[:, RIM]
+    rim_lab = lab[:, N_DISK:]
+    chroma = chroma_table().take((rim_lab[..., 1].astype(np.intp) << 8) | rim_lab[..., 2])
     vivid = chroma >= quantiles(chroma, 0.7)[:, None]
 
     def masked_mean(values: np.ndarray, mask: np.ndarray) -> np.ndarray:
-        return (values * mask[..., None]).sum(axis=1) / np.maximum(mask.sum(axis=1), 1)[:, None]
+        # one matrix product per lens; integer sums, exact in any order
+        total = np.matmul(mask[:, None, :].astype(np.float64), values)[:, 0]
+        return total / np.maximum(mask.sum(axis=1), 1)[:, None]
 
-    over = (value > 230) & (hsv[..., 1][:, DISK] < 80)
+    over = (value > 230) & (disk_hsv[..., 1] < 80)
     return np.concatenate(
         [
-            hue_histograms(hsv, DISK),
-            hue_histograms(hsv, RIM),
-            masked_mean(lab[:, DISK, 1:], bright) / 128,
-            masked_mean(lab[:, RIM, 1:], vivid) / 128,
+            hue_histograms(hsv, LENS_PART, 2).reshape(n, -1),
+            masked_mean(ab[:, :N_DISK], bright) / 128,
+            masked_mean(ab[:, N_DISK:], vivid) / 128,
             over.mean(axis=1, keepdims=True),
         ],
         axis=1,
@@ -143,11 +184,7 @@ def upright_housings(image: np.ndarray, boxes: np.ndarray) -> tuple[np.ndarray, 
     """The housings resampled to :data:`HOUSING_SIZE`, long axis vertical (horizontal heads
     transposed), and whether each was vertical."""
     vertical = (boxes[:, 3] - boxes[:, 1]) >= (boxes[:, 2] - boxes[:, 0])
-    out = patches(image, boxes, HOUSING_SIZE)
-    wide = np.flatnonzero(~vertical)
-    if len(wide):
-        out[wide] = patches(image, boxes[wide], HOUSING_SIZE[::-1]).transpose(0, 2, 1, 3)
-    return out, vertical
+    return patches(image, boxes, HOUSING_SIZE, turned=~vertical), vertical
 
 
 def lit_lenses(
@@ -183,7 +220,7 @@ def slots(profile: np.ndarray) -> np.ndarray:
     along = profile.shape[1]
     half = max(1, along // 18)
     centres = (2 * np.arange(3) + 1) * along // 6
-    return np.stack([profile[:, c - half : c + half + 1].mean(axis=1) for c in centres], axis=1)
+    return profile[:, centres[:, None] + np.arange(-half, half + 1)].mean(axis=2)
 
 
 def scaled(values: np.ndarray) -> np.ndarray:
@@ -214,18 +251,19 @@ def housing_features(upright: np.ndarray, hsv: np.ndarray, vertical: np.ndarray)
     """Lit-position features of upright housing patches (BGR ``upright`` and its ``hsv``), read
     in their central :func:`band`."""
     n = hsv.shape[0]
-    value = band(hsv[..., 2].astype(np.float32) / 255)
-    colourful = band(hsv[..., 1].astype(np.float32) / 255) * value
-    thirds = np.array_split(np.arange(value.shape[1]), 3)
+    value = band(hsv[..., 2]).astype(np.float32) / 255
+    colourful = band(hsv[..., 1]).astype(np.float32) / 255 * value
     profile = value.mean(axis=2)
-    bgr = band(upright.astype(np.float32) / 255)
-    redness = (bgr[..., 2] - bgr[..., 1]).mean(axis=2)
+    bgr = band(upright[..., 1:]).astype(np.float32) / 255
+    redness = (bgr[..., 1] - bgr[..., 0]).mean(axis=2)
+    # the 0.9 quantile of value and colourfulness over each third of the length (HOUSING_SIZE's
+    # length is a multiple of 3), one partition for all six
+    thirds = quantiles(np.stack([value, colourful], axis=1).reshape(2 * n * 3, -1), 0.9)
     weight = profile**4
     position = weight @ np.linspace(0, 1, weight.shape[1]) / np.maximum(weight.sum(axis=1), 1e-6)
     return np.concatenate(
         [
-            np.stack([quantiles(value[:, rows].reshape(n, -1), 0.9) for rows in thirds], 1),
-            np.stack([quantiles(colourful[:, rows].reshape(n, -1), 0.9) for rows in thirds], 1),
+            thirds.reshape(n, 6),
             position[:, None],
             vertical[:, None].astype(np.float32),
             np.ones((n, 1), np.float32),
@@ -251,10 +289,13 @@ def lamp_features(image: np.ndarray, candidates: Sequence[Candidate]) -> np.ndar
         # on the right in Japan and in cinTA's Indonesian heads): its lit lens is read, its
         # position is not
         rows[boxed, N_LENS:] = housing_features(upright, hsv, vertical) * vertical[:, None]
-        found = lit_lenses(boxes, vertical, hsv)
-        for k, i in enumerate(boxed):
-            if candidates[i].housing is None:
-                lenses[i] = found[k]
+        # a box read as a housing has its lit lens found in it (a fitted housing's candidate
+        # is its lens)
+        unfitted = [k for k, i in enumerate(boxed) if candidates[i].housing is None]
+        if unfitted:
+            found = lit_lenses(boxes[unfitted], vertical[unfitted], hsv[unfitted])
+            for k, lens in zip(unfitted, found):
+                lenses[boxed[k]] = lens
     if lenses:
         rows[:, :N_LENS] = lens_features(image, lenses)
     return np.nan_to_num(rows)

@@ -1,0 +1,177 @@
+"""lamp-state as the plugin computed it before it was batched (one ``clip_box`` per crop, every
+housing resampled upright and again transposed when wide, a colour conversion over a tall
+stack, ``np.digitize`` hue bins, scikit-learn's ``predict_proba``): the oracle the faster
+classifier must match exactly. The feature functions the speed-up left alone are imported."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+from tsrkit.geometry import clip_box
+from tsrkit_plugins.classifiers.lamp_state import STATES, blend, prefer_red, red_yellow
+from tsrkit_plugins.classifiers.lamp_state.features import (
+    DISK,
+    HOUSING_SIZE,
+    HUE_EDGES,
+    LENS_PATCH,
+    N_FEATURES,
+    N_HUE,
+    N_LENS,
+    RIM,
+    band,
+    housing_of,
+    lit_lenses,
+    quantiles,
+    scaled,
+)
+
+
+def _patches(image, boxes, size):
+    out = np.zeros((len(boxes), size[1], size[0], 3), np.uint8)
+    for i, box in enumerate(boxes):
+        x0, y0, x1, y1 = clip_box(box, image.shape[1], image.shape[0])
+        if x1 > x0 and y1 > y0:
+            out[i] = cv2.resize(image[y0:y1, x0:x1], size, interpolation=cv2.INTER_AREA)
+    return out
+
+
+def _convert(stack, code):
+    n, h, w, _ = stack.shape
+    return cv2.cvtColor(stack.reshape(n * h, w, 3), code).reshape(n, h, w, 3)
+
+
+def _hue_histograms(hsv, mask):
+    n = hsv.shape[0]
+    mask = np.broadcast_to(mask, hsv.shape[:3])
+    bins = np.digitize(hsv[..., 0], HUE_EDGES) - 1 + N_HUE * np.arange(n)[:, None, None]
+    weight = hsv[..., 1].astype(np.float32) * hsv[..., 2] / 65025.0
+    hist = np.bincount(bins[mask], weights=weight[mask], minlength=n * N_HUE)
+    hist = hist[: n * N_HUE].reshape(n, N_HUE)
+    return hist / np.maximum(hist.sum(axis=1, keepdims=True), 1e-6)
+
+
+def _lens_features(image, lenses):
+    r = np.array([max(c.radius, 0.5) * 1.3 for c in lenses])
+    x, y = np.array([c.x for c in lenses]), np.array([c.y for c in lenses])
+    stack = _patches(image, np.stack([x - r, y - r, x + r, y + r], axis=1), (LENS_PATCH,) * 2)
+    n = len(lenses)
+    hsv = _convert(stack, cv2.COLOR_BGR2HSV)
+    lab = _convert(stack, cv2.COLOR_BGR2LAB).astype(np.float32) - (0, 128, 128)
+    value = hsv[..., 2][:, DISK].astype(np.float32)
+    bright = value >= quantiles(value, 0.7)[:, None]
+    chroma = np.hypot(lab[..., 1], lab[..., 2])[:, RIM]
+    vivid = chroma >= quantiles(chroma, 0.7)[:, None]
+
+    def masked_mean(values, mask):
+        return (values * mask[..., None]).sum(axis=1) / np.maximum(mask.sum(axis=1), 1)[:, None]
+
+    over = (value > 230) & (hsv[..., 1][:, DISK] < 80)
+    return np.concatenate(
+        [
+            _hue_histograms(hsv, DISK),
+            _hue_histograms(hsv, RIM),
+            masked_mean(lab[:, DISK, 1:], bright) / 128,
+            masked_mean(lab[:, RIM, 1:], vivid) / 128,
+            over.mean(axis=1, keepdims=True),
+        ],
+        axis=1,
+    ).reshape(n, -1)
+
+
+def _slots(profile):
+    along = profile.shape[1]
+    half = max(1, along // 18)
+    centres = (2 * np.arange(3) + 1) * along // 6
+    return np.stack([profile[:, c - half : c + half + 1].mean(axis=1) for c in centres], axis=1)
+
+
+def _two_lit(profile, redness, dip=0.7):
+    top, middle, bottom = _slots(profile).T
+    lower = np.minimum(top, middle)
+    along = profile.shape[1]
+    gap = profile[:, along // 6 : along // 2 + 1].min(axis=1)
+    both = (lower - bottom) / np.maximum(np.maximum(top, middle) - bottom, 1e-3)
+    two = (gap < bottom + dip * (lower - bottom)) & (_slots(redness)[:, 0] > 0)
+    return np.where(two, both, 0.0)
+
+
+def _housing_features(upright, hsv, vertical):
+    n = hsv.shape[0]
+    value = band(hsv[..., 2].astype(np.float32) / 255)
+    colourful = band(hsv[..., 1].astype(np.float32) / 255) * value
+    thirds = np.array_split(np.arange(value.shape[1]), 3)
+    profile = value.mean(axis=2)
+    bgr = band(upright.astype(np.float32) / 255)
+    redness = (bgr[..., 2] - bgr[..., 1]).mean(axis=2)
+    weight = profile**4
+    position = weight @ np.linspace(0, 1, weight.shape[1]) / np.maximum(weight.sum(axis=1), 1e-6)
+    return np.concatenate(
+        [
+            np.stack([quantiles(value[:, rows].reshape(n, -1), 0.9) for rows in thirds], 1),
+            np.stack([quantiles(colourful[:, rows].reshape(n, -1), 0.9) for rows in thirds], 1),
+            position[:, None],
+            vertical[:, None].astype(np.float32),
+            np.ones((n, 1), np.float32),
+            scaled(_slots(profile)),
+            scaled(_slots(colourful.mean(axis=2))),
+            _two_lit(profile, redness)[:, None],
+        ],
+        axis=1,
+    )
+
+
+def _upright_housings(image, boxes):
+    vertical = (boxes[:, 3] - boxes[:, 1]) >= (boxes[:, 2] - boxes[:, 0])
+    out = _patches(image, boxes, HOUSING_SIZE)
+    wide = np.flatnonzero(~vertical)
+    if len(wide):
+        out[wide] = _patches(image, boxes[wide], HOUSING_SIZE[::-1]).transpose(0, 2, 1, 3)
+    return out, vertical
+
+
+def lamp_features(image, candidates):
+    """The (N, N_FEATURES) features of ``candidates``, computed the old way."""
+    rows = np.zeros((len(candidates), N_FEATURES), np.float32)
+    housings = [housing_of(c) for c in candidates]
+    boxed = [i for i, h in enumerate(housings) if h is not None]
+    lenses = list(candidates)
+    if boxed:
+        boxes = np.array([housings[i] for i in boxed], np.float64)
+        upright, vertical = _upright_housings(image, boxes)
+        hsv = _convert(upright, cv2.COLOR_BGR2HSV)
+        rows[boxed, N_LENS:] = _housing_features(upright, hsv, vertical) * vertical[:, None]
+        found = lit_lenses(boxes, vertical, hsv)
+        for k, i in enumerate(boxed):
+            if candidates[i].housing is None:
+                lenses[i] = found[k]
+    if lenses:
+        rows[:, :N_LENS] = _lens_features(image, lenses)
+    return np.nan_to_num(rows)
+
+
+def classify(classifier, frame, candidates):
+    """``(state, state_scores)`` of each candidate as ``classifier`` (a lamp-state) read them
+    before: the old features, scikit-learn's ``predict_proba``, then the same fusion."""
+    estimator = classifier.estimator
+    features = lamp_features(frame.image, candidates)
+    states = classifier._states
+    probability = prefer_red(
+        estimator.predict_proba(features), states, classifier.params["red_prior"]
+    )
+    weight = classifier.params["ab_hist_weight"]
+    known = set(states)
+    other = np.zeros((len(candidates), len(STATES)))
+    if weight > 0:
+        found = classifier._ab_hist.classify(frame, candidates)
+        known |= {s for d in found for s in d.state_scores}
+        other = np.array([[d.state_scores.get(s, 0.0) for s in STATES] for d in found])
+    ratio = classifier.params["red_yellow_ratio"]
+    table = red_yellow(blend(probability, states, other, weight), features, ratio)
+    if ratio < 1:
+        known.add("red_yellow")
+    out = []
+    for row in table:
+        scores = {s: float(v) for s, v in zip(STATES, row) if s in known}
+        out.append((STATES[int(np.argmax(row))], scores))
+    return out
