@@ -3,7 +3,8 @@
 Candidates are 50 circles of radius 2-20 px at random places of synthetic 1280x720 road scenes
 (half of them given a 1:3 housing box, as a housing stage would); the verifier (its housing
 stage, features, shipped model) runs on each frame, then the recommended preset's state
-classifier (``--classifier``, ab-hist) on all 50 candidates (the worst case: none rejected).
+classifier (``--classifier``, lamp-state) on all 50 candidates as the housing stage left them
+(the worst case: none rejected).
 Medians over frames and repeats are reported, wall clock and process CPU time, with the
 stages timed one by one beside them: the housing stage, the features, the model's prediction
 (one pass over its trees, and scikit-learn's ``predict_proba`` for comparison) and the state.
@@ -28,6 +29,7 @@ from functools import partial  # noqa: E402
 import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
+from tsrkit.params import load_config  # noqa: E402
 from tsrkit.registry import get_registry  # noqa: E402
 from tsrkit.synth import SynthOptions, render_frame  # noqa: E402
 from tsrkit.types import Candidate, Frame  # noqa: E402
@@ -61,7 +63,11 @@ def main() -> None:
     parser.add_argument("--frames", type=int, default=20)
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--candidates", type=int, default=50)
-    parser.add_argument("--classifier", default="ab-hist", help="state classifier timed after")
+    parser.add_argument(
+        "--classifier",
+        default=load_config("recommended")["classifier"]["name"],
+        help="state classifier timed after (default: the recommended preset's)",
+    )
     args = parser.parse_args()
     verifier = get_registry().create("verifier", "verifier", {"threshold": 0.5})
     housing = get_registry().create("verifier", "housing")
@@ -73,7 +79,7 @@ def main() -> None:
     sets = [candidates(rng, args.candidates) for _ in frames]
     classifier = get_registry().create("classifier", args.classifier)
     verifier.verify(frames[0], sets[0])  # load the models once
-    classifier.classify(frames[0], sets[0])
+    classifier.classify(frames[0], housing.verify(frames[0], sets[0]))
     times: dict[str, list[tuple[float, float]]] = {}
     cpu_start = time.process_time()
     for _ in range(args.repeats):
@@ -82,7 +88,7 @@ def main() -> None:
             features = candidate_features(frame.image, housed)
             stages = {
                 "verifier (housing + features + model)": partial(verifier.verify, frame, cands),
-                f"{args.classifier} on all candidates": partial(classifier.classify, frame, cands),
+                f"{args.classifier} on all candidates": partial(classifier.classify, frame, housed),
                 "  housing stage": partial(housing.verify, frame, cands),
                 "  features": partial(candidate_features, frame.image, housed),
                 "  model (one pass over the trees)": partial(verifier.forest.probability, features),
