@@ -208,13 +208,12 @@ def lens_features(image: np.ndarray, lenses: Sequence[Candidate]) -> np.ndarray:
     ).reshape(n, -1)
 
 
-def upright_housings(image: np.ndarray, boxes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The housings resampled to :data:`HOUSING_SIZE`, long axis vertical (horizontal heads
-    transposed), and whether each was vertical. Only their central :func:`band` is read: the
+def upright_housings(image: np.ndarray, boxes: np.ndarray, vertical: np.ndarray) -> np.ndarray:
+    """The housings resampled to :data:`HOUSING_SIZE`, long axis vertical (those not
+    ``vertical``, horizontal heads, transposed). Only their central :func:`band` is read: the
     columns past it are left black (a quarter less source resampled)."""
-    vertical = (boxes[:, 3] - boxes[:, 1]) >= (boxes[:, 2] - boxes[:, 0])
     across = HOUSING_SIZE[0]
-    return patches(image, boxes, HOUSING_SIZE, ~vertical, across - across // 4), vertical
+    return patches(image, boxes, HOUSING_SIZE, ~vertical, across - across // 4)
 
 
 def lit_lenses(
@@ -313,19 +312,25 @@ def lamp_features(image: np.ndarray, candidates: Sequence[Candidate]) -> np.ndar
     lenses = list(candidates)
     if boxed:
         boxes = np.array([housings[i] for i in boxed], np.float64)
-        upright, vertical = upright_housings(image, boxes)
-        hsv = convert(upright, cv2.COLOR_BGR2HSV)
+        vertical = (boxes[:, 3] - boxes[:, 1]) >= (boxes[:, 2] - boxes[:, 0])
+        fitted = np.array([candidates[i].housing is not None for i in boxed])
         # a horizontal head's order differs by country (red on the left in Europe and the US,
-        # on the right in Japan and in cinTA's Indonesian heads): its lit lens is read, its
-        # position is not
-        rows[boxed, N_LENS:] = housing_features(upright, hsv, vertical) * vertical[:, None]
-        # a box read as a housing has its lit lens found in it (a fitted housing's candidate
-        # is its lens)
-        unfitted = [k for k, i in enumerate(boxed) if candidates[i].housing is None]
-        if unfitted:
-            found = lit_lenses(boxes[unfitted], vertical[unfitted], hsv[unfitted])
-            for k, lens in zip(unfitted, found):
-                lenses[boxed[k]] = lens
+        # on the right in Japan and in cinTA's Indonesian heads): its position is not read (its
+        # features stay 0), only its lit lens, found in it when the box is read as a housing (a
+        # fitted housing's candidate is its lens): a fitted horizontal housing is not resampled
+        read = np.flatnonzero(vertical | ~fitted)
+        if len(read):
+            upright = upright_housings(image, boxes[read], vertical[read])
+            hsv = convert(upright, cv2.COLOR_BGR2HSV)
+            tall = vertical[read]
+            if tall.any():
+                at = [boxed[k] for k in read[tall]]
+                rows[at, N_LENS:] = housing_features(upright[tall], hsv[tall], tall[tall])
+            unfitted = ~fitted[read]
+            if unfitted.any():
+                found = lit_lenses(boxes[read[unfitted]], tall[unfitted], hsv[unfitted])
+                for k, lens in zip(read[unfitted].tolist(), found):
+                    lenses[boxed[k]] = lens
     if lenses:
         rows[:, :N_LENS] = lens_features(image, lenses)
     return np.nan_to_num(rows)
