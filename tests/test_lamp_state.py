@@ -12,6 +12,7 @@ from tsrkit_plugins.classifiers.lamp_state.features import (
     N_FEATURES,
     N_LENS,
     TWO_LIT,
+    area_resample,
     lamp_features,
     two_lit,
 )
@@ -174,3 +175,22 @@ def test_two_lit_needs_two_lamps_and_a_red_top():
     assert two_lit(lamps, red)[0] == pytest.approx((0.8 - 0.1) / (1.0 - 0.1))
     assert two_lit(lamps, grey)[0] == 0.0  # top not red: a backplate or unlit lens
     assert two_lit(glare, red)[0] == 0.0  # no dark gap between the two slots
+
+
+@pytest.mark.parametrize(
+    ("size", "first", "axis"), [((12, 36), 9, 1), ((36, 12), 9, 0), ((16, 16), 16, 1)]
+)
+def test_area_resample_equals_opencv_whole_resampling(size, first, axis):
+    """The wanted rows or columns (a housing's first 9 across, its band and a bit) equal those
+    of OpenCV's whole resampling, bit for bit, at every length of the cut side up to a frame's
+    width (integer and fractional scales, enlarging and shrinking) and other sides short,
+    long, fractional and integer multiples of the output."""
+    rng = np.random.default_rng(3)
+    image = rng.integers(0, 256, (1281, 1281, 3), np.uint8)
+    for length in range(1, 1281):
+        for other in (1, 35, 36, 72, int(rng.integers(37, 300))):
+            shape = (length, other) if axis == 0 else (other, length)
+            crop = image[: shape[0], : shape[1]]
+            whole = cv2.resize(crop, size, interpolation=cv2.INTER_AREA)
+            wanted = whole[:first] if axis == 0 else whole[:, :first]
+            assert np.array_equal(area_resample(crop, size, first, axis), wanted), shape

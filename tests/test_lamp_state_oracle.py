@@ -18,7 +18,7 @@ from tsrkit.models import Model, ModelError, save_model
 from tsrkit.registry import get_registry
 from tsrkit.synth import SynthOptions, render_frame
 from tsrkit.types import Candidate, Frame
-from tsrkit_plugins.classifiers.lamp_state.features import lamp_features
+from tsrkit_plugins.classifiers.lamp_state.features import housing_of, lamp_features
 from tsrkit_plugins.verifiers.forest import Forest
 from tsrkit_plugins.verifiers.persistence import estimator_arrays
 
@@ -43,8 +43,8 @@ def housed(rng, width, height, n=30):
 def frames(shared_datasets):
     """Two frames of each real detection set (lens and housing boxes) and two synthetic
     1280x720 scenes, each with candidates: its annotated boxes (read as housings when
-    elongated), the housing stage's fit around their centres, and random lenses with and
-    without housings."""
+    elongated), the housing stage's fit around their centres, random lenses with and
+    without housings and random tall and wide boxes read as housings."""
     rng = np.random.default_rng(7)
     stage = get_registry().create("verifier", "housing")
     out = []
@@ -63,7 +63,11 @@ def frames(shared_datasets):
             Candidate.from_circle(x, y, r, 1.0)
             for x, y, r in rng.uniform((-10, -10, 0.6), (w + 10, h + 10, 20), (20, 3))
         ]
-        out.append((frame, boxes + stage.verify(frame, lenses) + housed(rng, w, h)))
+        # boxes without a fitted housing, read as housings (tall and wide), their lit lens found
+        read_as_housings = [Candidate.from_box(c.housing, 1.0) for c in housed(rng, w, h, 10)]
+        out.append(
+            (frame, boxes + stage.verify(frame, lenses) + housed(rng, w, h) + read_as_housings)
+        )
     return out
 
 
@@ -86,6 +90,21 @@ def test_features_equal_the_oracle(real):
         expected = oracle.lamp_features(frame.image, candidates)
         assert np.array_equal(lamp_features(frame.image, candidates), expected)
         assert np.array_equal(lamp_features(frame.image, candidates[3:4]), expected[3:4])
+        # fitted horizontal housings alone (none resampled) and boxes read as housings alone
+        for kind in (fitted_wide, unfitted):
+            some = [c for c in candidates if kind(c)]
+            assert some
+            expected = oracle.lamp_features(frame.image, some)
+            assert np.array_equal(lamp_features(frame.image, some), expected)
+
+
+def fitted_wide(candidate):
+    box = candidate.housing
+    return box is not None and box[2] - box[0] > box[3] - box[1]
+
+
+def unfitted(candidate):
+    return candidate.housing is None and housing_of(candidate) is not None
 
 
 @pytest.mark.parametrize("params", PARAMS, ids=str)

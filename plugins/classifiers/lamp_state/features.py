@@ -119,24 +119,52 @@ def pixel_bounds(boxes: np.ndarray, width: int, height: int) -> np.ndarray:
     return np.concatenate([low, high], axis=1).astype(np.int64)
 
 
+def area_resample(crop: np.ndarray, size: tuple[int, int], first: int, axis: int) -> np.ndarray:
+    """The first ``first`` rows (``axis`` 0) or columns (``axis`` 1) of ``crop`` resampled to
+    ``size`` = (width, height) by OpenCV's area rule (``cv2.INTER_AREA``), the same to the bit.
+
+    When both sides shrink (OpenCV's area decimation), each output row or column is summed from
+    its own source cells, with weights set by its index times the scale factor alone (clamped
+    only at the far edge): the crop is cut two source pixels past the wanted ones and resampled
+    with the whole crop's scale factors (``fx``, ``fy``: the quotients OpenCV takes of the
+    sizes), so less source is read for the same values (``tests/test_lamp_state.py`` compares
+    them with whole resamplings at every crop length up to a frame's width).
+    """
+    height, width = crop.shape[:2]
+    if width < size[0] or height < size[1]:  # enlarging: OpenCV's area rule is then linear
+        whole = cv2.resize(crop, size, interpolation=cv2.INTER_AREA)
+        return whole[:first] if axis == 0 else whole[:, :first]
+    fx, fy = size[0] / width, size[1] / height
+    if axis == 0:
+        cut = crop[: first * height // size[1] + 2]
+        return cv2.resize(cut, None, fx=fx, fy=fy, interpolation=cv2.INTER_AREA)[:first]
+    cut = crop[:, : first * width // size[0] + 2]
+    return cv2.resize(cut, None, fx=fx, fy=fy, interpolation=cv2.INTER_AREA)[:, :first]
+
+
 def patches(
-    image: np.ndarray, boxes: np.ndarray, size: tuple[int, int], turned: np.ndarray | None = None
+    image: np.ndarray,
+    boxes: np.ndarray,
+    size: tuple[int, int],
+    turned: np.ndarray | None = None,
+    first: int | None = None,
 ) -> np.ndarray:
     """The (N, height, width, 3) stack of ``boxes`` resampled to ``size`` = (width, height);
     a box wholly outside the image gives a black patch. A box where ``turned`` is set is
-    resampled to (height, width) and transposed."""
+    resampled to (height, width) and transposed. With ``first``, only the first ``first``
+    columns of each patch are resampled (:func:`area_resample`), the others left black."""
     out = np.zeros((len(boxes), size[1], size[0], 3), np.uint8)
     turned = np.zeros(len(boxes), bool) if turned is None else turned
+    first = size[0] if first is None else first
     bounds = pixel_bounds(boxes, image.shape[1], image.shape[0]).tolist()
     for i, ((x0, y0, x1, y1), turn) in enumerate(zip(bounds, turned.tolist())):
         if x1 > x0 and y1 > y0:
             crop = image[y0:y1, x0:x1]
             if turn:
-                out[i] = cv2.resize(crop, size[::-1], interpolation=cv2.INTER_AREA).transpose(
-                    1, 0, 2
-                )
+                upright = area_resample(crop, size[::-1], first, 0).transpose(1, 0, 2)
             else:
-                out[i] = cv2.resize(crop, size, interpolation=cv2.INTER_AREA)
+                upright = area_resample(crop, size, first, 1)
+            out[i, :, :first] = upright
     return out
 
 
@@ -180,11 +208,12 @@ def lens_features(image: np.ndarray, lenses: Sequence[Candidate]) -> np.ndarray:
     ).reshape(n, -1)
 
 
-def upright_housings(image: np.ndarray, boxes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The housings resampled to :data:`HOUSING_SIZE`, long axis vertical (horizontal heads
-    transposed), and whether each was vertical."""
-    vertical = (boxes[:, 3] - boxes[:, 1]) >= (boxes[:, 2] - boxes[:, 0])
-    return patches(image, boxes, HOUSING_SIZE, turned=~vertical), vertical
+def upright_housings(image: np.ndarray, boxes: np.ndarray, vertical: np.ndarray) -> np.ndarray:
+    """The housings resampled to :data:`HOUSING_SIZE`, long axis vertical (those not
+    ``vertical``, horizontal heads, transposed). Only their central :func:`band` is read: the
+    columns past it are left black (a quarter less source resampled)."""
+    across = HOUSING_SIZE[0]
+    return patches(image, boxes, HOUSING_SIZE, ~vertical, across - across // 4)
 
 
 def lit_lenses(
@@ -283,19 +312,25 @@ def lamp_features(image: np.ndarray, candidates: Sequence[Candidate]) -> np.ndar
     lenses = list(candidates)
     if boxed:
         boxes = np.array([housings[i] for i in boxed], np.float64)
-        upright, vertical = upright_housings(image, boxes)
-        hsv = convert(upright, cv2.COLOR_BGR2HSV)
+        vertical = (boxes[:, 3] - boxes[:, 1]) >= (boxes[:, 2] - boxes[:, 0])
+        fitted = np.array([candidates[i].housing is not None for i in boxed])
         # a horizontal head's order differs by country (red on the left in Europe and the US,
-        # on the right in Japan and in cinTA's Indonesian heads): its lit lens is read, its
-        # position is not
-        rows[boxed, N_LENS:] = housing_features(upright, hsv, vertical) * vertical[:, None]
-        # a box read as a housing has its lit lens found in it (a fitted housing's candidate
-        # is its lens)
-        unfitted = [k for k, i in enumerate(boxed) if candidates[i].housing is None]
-        if unfitted:
-            found = lit_lenses(boxes[unfitted], vertical[unfitted], hsv[unfitted])
-            for k, lens in zip(unfitted, found):
-                lenses[boxed[k]] = lens
+        # on the right in Japan and in cinTA's Indonesian heads): its position is not read (its
+        # features stay 0), only its lit lens, found in it when the box is read as a housing (a
+        # fitted housing's candidate is its lens): a fitted horizontal housing is not resampled
+        read = np.flatnonzero(vertical | ~fitted)
+        if len(read):
+            upright = upright_housings(image, boxes[read], vertical[read])
+            hsv = convert(upright, cv2.COLOR_BGR2HSV)
+            tall = vertical[read]
+            if tall.any():
+                at = [boxed[k] for k in read[tall]]
+                rows[at, N_LENS:] = housing_features(upright[tall], hsv[tall], tall[tall])
+            unfitted = ~fitted[read]
+            if unfitted.any():
+                found = lit_lenses(boxes[read[unfitted]], tall[unfitted], hsv[unfitted])
+                for k, lens in zip(read[unfitted].tolist(), found):
+                    lenses[boxed[k]] = lens
     if lenses:
         rows[:, :N_LENS] = lens_features(image, lenses)
     return np.nan_to_num(rows)
