@@ -32,7 +32,8 @@ sizes a member was built for). Two keys belong to the union, not to the member:
 ``scale_top=T`` first keeps only the upper ``T`` share of its rows (where the lights are),
 e.g. ``lab-frst top=15 scale=2 scale_top=0.6``. Centres map back with the pixel-centre
 convention ``x = (x' + 0.5) / s - 0.5`` (``s`` the exact per-axis factor), radii as
-``r' / s``. The same detector may then appear twice, at two scales.
+``r' / s``. The same detector may then appear twice, at two scales. Frame metadata passes
+unchanged (a member reading ``focal_px`` would see the unscaled focal length).
 """
 
 from __future__ import annotations
@@ -42,7 +43,7 @@ from dataclasses import replace
 import cv2
 import numpy as np
 
-from tsrkit.geometry import circle_box
+from tsrkit.geometry import Box, circle_box
 from tsrkit.hookspecs import hookimpl
 from tsrkit.params import Param, ParamError, parse_assignments, validate
 from tsrkit.plugin import Detector
@@ -53,8 +54,8 @@ DEFAULT_MEMBERS = "lab-frst top=15; conspicuity n_top=15; adaboost-hsv max_boxes
 
 #: The union's own keys in a member's assignments (not passed to the member).
 SCALE_PARAMS = (
-    Param("scale", "float", 1.0, min=0.25, max=4.0, help="run the member on the frame resized by"),
-    Param("scale_top", "float", 1.0, min=0.01, max=1.0, help="... cut to its upper share first"),
+    Param("scale", "float", 1.0, min=0.25, max=4.0, help="resize factor of the member's frame"),
+    Param("scale_top", "float", 1.0, min=0.01, max=1.0, help="upper share of rows it searches"),
 )
 
 
@@ -96,7 +97,7 @@ def split_scaling(values: dict[str, str], owner: str) -> tuple[dict[str, str], f
     ParamError
         A ``scale`` or ``scale_top`` outside its range or not a number.
     """
-    own = {k: v for k, v in values.items() if k not in ("scale", "scale_top")}
+    own = {k: v for k, v in values.items() if k not in {p.name for p in SCALE_PARAMS}}
     scaling = validate(SCALE_PARAMS, {k: v for k, v in values.items() if k not in own}, owner)
     return own, scaling["scale"], scaling["scale_top"]
 
@@ -105,25 +106,23 @@ def map_back(c: Candidate, sx: float, sy: float) -> Candidate:
     """A candidate found on a frame resized by ``(sx, sy)``, in the original frame's pixels:
     ``x = (x' + 0.5) / sx - 0.5`` (pixel centres stay centres), radius ``r' / sx``."""
 
-    def box(b):
-        return (
-            None
-            if b is None
-            else (
-                (b[0] + 0.5) / sx - 0.5,
-                (b[1] + 0.5) / sy - 0.5,
-                (b[2] + 0.5) / sx - 0.5,
-                (b[3] + 0.5) / sy - 0.5,
-            )
-        )
-
     return replace(
         c,
         x=(c.x + 0.5) / sx - 0.5,
         y=(c.y + 0.5) / sy - 0.5,
         radius=c.radius / sx,
-        bbox=box(c.bbox),
-        housing=box(c.housing),
+        bbox=_map_box(c.bbox, sx, sy),
+        housing=None if c.housing is None else _map_box(c.housing, sx, sy),
+    )
+
+
+def _map_box(b: Box, sx: float, sy: float) -> Box:
+    """:func:`map_back`'s convention applied to each edge of the box ``b``."""
+    return (
+        (b[0] + 0.5) / sx - 0.5,
+        (b[1] + 0.5) / sy - 0.5,
+        (b[2] + 0.5) / sx - 0.5,
+        (b[3] + 0.5) / sy - 0.5,
     )
 
 
