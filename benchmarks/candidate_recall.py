@@ -10,6 +10,9 @@ The union's figures merge the members' cached candidates with the plugin's own
 :func:`tsrkit_plugins.detectors.union.merge` (the members are not run twice).
 
 Run: python benchmarks/candidate_recall.py [--out benchmarks/out/candidate_recall]
+     python benchmarks/candidate_recall.py --quick --extra "lab-frst top=15 scale=2"
+       (only the union's members, each --extra member alone, the union with it added and, for
+       an extra whose detector is already a member, the union with that member replaced)
      python benchmarks/candidate_recall.py --tables benchmarks/out/candidate_recall/results.json
 """
 
@@ -31,9 +34,13 @@ import numpy as np  # noqa: E402
 
 from tsrkit.datasets import open_datasets  # noqa: E402
 from tsrkit.eval.matching import centre_hits  # noqa: E402
-from tsrkit.registry import get_registry  # noqa: E402
 from tsrkit.types import Candidate, Sample  # noqa: E402
-from tsrkit_plugins.detectors.union import DEFAULT_MEMBERS, merge, parse_members  # noqa: E402
+from tsrkit_plugins.detectors.union import (  # noqa: E402
+    DEFAULT_MEMBERS,
+    create_member,
+    merge,
+    parse_members,
+)
 
 cv2.setNumThreads(1)
 
@@ -78,7 +85,7 @@ def recall_by_size(
 
 def run_detector(name: str, params: dict, samples: Sequence[Sample]):
     """Candidates of every sample and the median ms per frame."""
-    detector = get_registry().create("detector", name.split()[0], params)
+    detector = create_member(name, params)
     found, times = [], []
     for sample in samples:
         frame = sample.load()
@@ -92,11 +99,28 @@ def detector_key(name: str, params: dict) -> str:
     return " ".join([name] + [f"{k}={v}" for k, v in params.items()])
 
 
-def measure() -> dict:
+def union_variants(members: list, extras: list) -> list[tuple[str, list]]:
+    """The unions to score: the default one, with gray-tophat, and with each extra member added
+    (and replacing the member of the same detector, when there is one)."""
+    variants = [
+        ("union", members),
+        ("union + gray-tophat", members + [("gray-tophat", {"n_top": "15"})]),
+    ]
+    for name, values in extras:
+        label = detector_key(name, values)
+        variants.append((f"union + {label}", members + [(name, values)]))
+        if any(n == name for n, _ in members):
+            swapped = [(name, values) if n == name else (n, v) for n, v in members]
+            variants.append((f"union, {name} -> {label}", swapped))
+    return variants
+
+
+def measure(extras: list, quick: bool) -> dict:
     members = parse_members(DEFAULT_MEMBERS)
-    configs = [(name, {}) for name in ("lab-frst", "conspicuity", "gray-tophat")]
-    configs += [("adaboost-hsv", {}), ("tl-recognizer", {})]
-    configs += [(n, v) for n, v in members if v] + [("gray-tophat", {"n_top": "15"})]
+    configs = [] if quick else [(name, {}) for name in ("lab-frst", "conspicuity", "gray-tophat")]
+    configs += [] if quick else [("adaboost-hsv", {}), ("tl-recognizer", {})]
+    configs += [(n, v) for n, v in members if v or quick] + [("gray-tophat", {"n_top": "15"})]
+    configs += extras
     results: dict = {"members": DEFAULT_MEMBERS, "sets": {}}
     for key, ref in SETS.items():
         samples = list(open_datasets([ref]).samples)
@@ -112,10 +136,7 @@ def measure() -> dict:
                 "ms": round(ms, 1),
             }
             print(key, label, rows[label]["recall"]["all"], round(ms, 1), flush=True)
-        for union_name, member_list in (
-            ("union", members),
-            ("union + gray-tophat", members + [("gray-tophat", {"n_top": "15"})]),
-        ):
+        for union_name, member_list in union_variants(members, extras):
             parts = [cached[detector_key(n, v)] for n, v in member_list]
             merged = [merge(list(lists), 1.0, 3.0) for lists in zip(*(p[0] for p in parts))]
             rows[union_name] = {
@@ -157,13 +178,24 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", default="benchmarks/out/candidate_recall")
     parser.add_argument("--tables", metavar="RESULTS_JSON", help="only print the tables")
+    parser.add_argument(
+        "--extra",
+        action="append",
+        default=[],
+        metavar="MEMBER",
+        help="a further union member, e.g. 'lab-frst top=15 scale=2' (repeatable)",
+    )
+    parser.add_argument(
+        "--quick", action="store_true", help="skip the detectors at their paper defaults"
+    )
     args = parser.parse_args()
     if args.tables:
         print(markdown(json.loads(Path(args.tables).read_text())))
         return
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    results = measure()
+    extras = [member for text in args.extra for member in parse_members(text)]
+    results = measure(extras, args.quick)
     (out / "results.json").write_text(json.dumps(results, indent=1))
     print(markdown(results))
 

@@ -7,7 +7,13 @@ from tsrkit.params import ParamError
 from tsrkit.registry import get_registry
 from tsrkit.synth.heads import background, render_head
 from tsrkit.types import Candidate, Frame
-from tsrkit_plugins.detectors.union import merge, parse_members, rank_scores
+from tsrkit_plugins.detectors.union import (
+    ScaledMember,
+    map_back,
+    merge,
+    parse_members,
+    rank_scores,
+)
 
 
 def test_members_parse_with_their_own_parameters():
@@ -79,3 +85,72 @@ def test_union_finds_what_each_member_finds_on_a_rendered_head():
     for member in members:  # what a member finds near the lit lens, the union finds too
         if any(np.hypot(c.x - x, c.y - y) < 6 for c in member):
             assert any(np.hypot(c.x - x, c.y - y) < 12 for c in found)
+
+
+def test_a_member_may_come_twice_at_two_scales_but_not_twice_at_one():
+    assert parse_members("lab-frst; lab-frst scale=2") == [
+        ("lab-frst", {}),
+        ("lab-frst", {"scale": "2"}),
+    ]
+    with pytest.raises(ParamError, match="same scale"):
+        parse_members("lab-frst scale=2; lab-frst top=3 scale=2")
+
+
+@pytest.mark.parametrize("value", ["scale=0", "scale=9", "scale=two", "scale_top=0"])
+def test_a_bad_scale_is_one_clear_error(value):
+    with pytest.raises(ParamError, match="scale"):
+        get_registry().create("detector", "union", {"members": f"lab-frst {value}"})
+
+
+def test_map_back_uses_the_pixel_centre_convention():
+    # at scale 2 the original pixel 0 covers resized pixels 0 and 1: its centre is 0.5 there
+    c = map_back(Candidate.from_circle(0.5, 20.5, 3.0, 1.0), 2.0, 2.0)
+    assert (c.x, c.y, c.radius) == (0.0, 10.0, 1.5)
+    assert c.bbox == (-1.5, 8.5, 1.5, 11.5)  # (b + 0.5) / 2 - 0.5 per edge of (-2.5, 17.5, ...)
+
+
+class Centroid:
+    """A stand-in member: one candidate at the brightness-weighted centroid of the frame."""
+
+    def detect(self, frame):
+        weight = frame.image.astype(float).sum(axis=2)
+        rows, cols = np.indices(weight.shape)
+        x, y = (cols * weight).sum() / weight.sum(), (rows * weight).sum() / weight.sum()
+        return [Candidate.from_circle(x, y, 1.0, 1.0)]
+
+
+@pytest.mark.parametrize("scale, tol", [(2.0, 1e-6), (3.0, 1e-6), (1.5, 2e-3)])
+def test_an_upscaled_members_centres_map_back_exactly(scale, tol):
+    # a 2 px lamp drawn with sub-pixel precision on black: bilinear resizing by a whole factor
+    # keeps its brightness-weighted centroid, so the mapped-back centre equals the original
+    # one (a fractional factor's interpolation weights move it by about 1e-3 px)
+    image = np.zeros((60, 80, 3), np.uint8)
+    render_head(image, (40.3, 20.6), 2, 3, 0)
+    frame = Frame(image.astype(np.float32), "lamp")  # float: no rounding after resizing
+    (expected,) = Centroid().detect(frame)
+    (found,) = ScaledMember(Centroid(), scale, 1.0).detect(frame)
+    assert found.x == pytest.approx(expected.x, abs=tol)
+    assert found.y == pytest.approx(expected.y, abs=tol)
+    assert found.radius == pytest.approx(1.0 / scale)
+
+
+def test_scale_top_searches_only_the_upper_rows():
+    image = np.zeros((100, 80, 3), np.uint8)
+    image[70:74, 30:34] = 255  # a lamp at rows 70-73, below the upper 60 rows
+    image[10:14, 50:54] = 255  # and one at rows 10-13
+    (found,) = ScaledMember(Centroid(), 2.0, 0.6).detect(Frame(image, "two lamps"))
+    assert (found.x, found.y) == pytest.approx((51.5, 11.5))
+
+
+def test_an_upscaled_member_finds_a_small_lamp_its_full_scale_twin_misses():
+    image = background(240, 320, seed=3)
+    head = render_head(image, (160.3, 80.6), 2, 3, 0)  # lens radius 2 px
+    frame = Frame(image, "small head")
+    x, y = head.lens[:2]
+
+    def nearest(members):
+        found = get_registry().create("detector", "union", {"members": members}).detect(frame)
+        return min(np.hypot(c.x - x, c.y - y) for c in found)
+
+    assert nearest("conspicuity n_top=15") > 5
+    assert nearest("conspicuity n_top=15 scale=2") < 1

@@ -24,22 +24,39 @@ parameters, and merges their candidates:
 
 Members are written ``NAME [KEY=VALUE ...]; NAME ...``, e.g.
 ``lab-frst top=15; conspicuity n_top=15``; values are checked by each member's own schema.
+
+**Upscaled members** (multi-resolution, after Mascetti et al. 2016, 4.2, who run extraction
+and pruning on a resized frame; here the frame is enlarged so that 2-3 px lenses reach the
+sizes a member was built for). Two keys belong to the union, not to the member:
+``scale=S`` runs the member on the frame resized by ``S`` (``cv2.INTER_LINEAR``) and
+``scale_top=T`` first keeps only the upper ``T`` share of its rows (where the lights are),
+e.g. ``lab-frst top=15 scale=2 scale_top=0.6``. Centres map back with the pixel-centre
+convention ``x = (x' + 0.5) / s - 0.5`` (``s`` the exact per-axis factor), radii as
+``r' / s``. The same detector may then appear twice, at two scales. Frame metadata passes
+unchanged (a member reading ``focal_px`` would see the unscaled focal length).
 """
 
 from __future__ import annotations
 
 from dataclasses import replace
 
+import cv2
 import numpy as np
 
-from tsrkit.geometry import circle_box
+from tsrkit.geometry import Box, circle_box
 from tsrkit.hookspecs import hookimpl
-from tsrkit.params import Param, ParamError, parse_assignments
+from tsrkit.params import Param, ParamError, parse_assignments, validate
 from tsrkit.plugin import Detector
 from tsrkit.registry import get_registry
 from tsrkit.types import Candidate, Frame
 
 DEFAULT_MEMBERS = "lab-frst top=15; conspicuity n_top=15; adaboost-hsv max_boxes=10; tl-recognizer"
+
+#: The union's own keys in a member's assignments (not passed to the member).
+SCALE_PARAMS = (
+    Param("scale", "float", 1.0, min=0.25, max=4.0, help="resize factor of the member's frame"),
+    Param("scale_top", "float", 1.0, min=0.01, max=1.0, help="upper share of rows it searches"),
+)
 
 
 def parse_members(text: str) -> list[tuple[str, dict[str, str]]]:
@@ -58,12 +75,81 @@ def parse_members(text: str) -> list[tuple[str, dict[str, str]]]:
         name, assignments = words[0], words[1:]
         if name == Union.name:
             raise ParamError("union: a member cannot be 'union' itself")
-        if any(name == seen for seen, _ in members):
-            raise ParamError(f"union: member {name!r} given twice")
-        members.append((name, parse_assignments(assignments)))
+        values = parse_assignments(assignments)
+        if any((name, _scaling(values)) == (seen, _scaling(v)) for seen, v in members):
+            raise ParamError(f"union: member {name!r} given twice at the same scale")
+        members.append((name, values))
     if not members:
         raise ParamError(f"union: no member detector in {text!r}")
     return members
+
+
+def _scaling(values: dict[str, str]) -> tuple[str, str]:
+    """A member's ``scale`` and ``scale_top`` as written (``1`` when not given)."""
+    return values.get("scale", "1"), values.get("scale_top", "1")
+
+
+def split_scaling(values: dict[str, str], owner: str) -> tuple[dict[str, str], float, float]:
+    """A member's own values, and the union's checked ``scale`` and ``scale_top``.
+
+    Raises
+    ------
+    ParamError
+        A ``scale`` or ``scale_top`` outside its range or not a number.
+    """
+    own = {k: v for k, v in values.items() if k not in {p.name for p in SCALE_PARAMS}}
+    scaling = validate(SCALE_PARAMS, {k: v for k, v in values.items() if k not in own}, owner)
+    return own, scaling["scale"], scaling["scale_top"]
+
+
+def map_back(c: Candidate, sx: float, sy: float) -> Candidate:
+    """A candidate found on a frame resized by ``(sx, sy)``, in the original frame's pixels:
+    ``x = (x' + 0.5) / sx - 0.5`` (pixel centres stay centres), radius ``r' / sx``."""
+
+    return replace(
+        c,
+        x=(c.x + 0.5) / sx - 0.5,
+        y=(c.y + 0.5) / sy - 0.5,
+        radius=c.radius / sx,
+        bbox=_map_box(c.bbox, sx, sy),
+        housing=None if c.housing is None else _map_box(c.housing, sx, sy),
+    )
+
+
+def _map_box(b: Box, sx: float, sy: float) -> Box:
+    """:func:`map_back`'s convention applied to each edge of the box ``b``."""
+    return (
+        (b[0] + 0.5) / sx - 0.5,
+        (b[1] + 0.5) / sy - 0.5,
+        (b[2] + 0.5) / sx - 0.5,
+        (b[3] + 0.5) / sy - 0.5,
+    )
+
+
+class ScaledMember:
+    """A member detector run on the upper ``top`` share of the frame, resized by ``scale``
+    (Mascetti et al. 2016, 4.2's multi-resolution, here to enlarge small lenses)."""
+
+    def __init__(self, detector: Detector, scale: float, top: float):
+        self.detector, self.scale, self.top = detector, scale, top
+
+    def detect(self, frame: Frame) -> list[Candidate]:
+        """The member's candidates on the resized region, in ``frame``'s pixels."""
+        image = frame.image[: max(1, int(round(frame.height * self.top)))]
+        h, w = image.shape[:2]
+        size = (max(1, int(round(w * self.scale))), max(1, int(round(h * self.scale))))
+        if size == (w, h):
+            return self.detector.detect(replace(frame, image=image))
+        resized = cv2.resize(image, size, interpolation=cv2.INTER_LINEAR)
+        found = self.detector.detect(replace(frame, image=resized))
+        return [map_back(c, size[0] / w, size[1] / h) for c in found]
+
+
+def create_member(name: str, values: dict[str, str]) -> ScaledMember:
+    """The registered detector ``name`` with its own ``values``, run at the union's ``scale``
+    and ``scale_top`` given among them."""
+    own, scale, top = split_scaling(values, f"union member {name!r}")
+    return ScaledMember(get_registry().create("detector", name, own), scale, top)
 
 
 def rank_scores(count: int) -> np.ndarray:
@@ -147,11 +233,7 @@ class Union(Detector):
 
     def __init__(self, **params):
         super().__init__(**params)
-        registry = get_registry()
-        self.members = [
-            registry.create("detector", name, values)
-            for name, values in parse_members(self.params["members"])
-        ]
+        self.members = [create_member(n, v) for n, v in parse_members(self.params["members"])]
 
     def detect(self, frame: Frame) -> list[Candidate]:
         """Every member's candidates, merged; scores in [0, 1]."""
