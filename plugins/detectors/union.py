@@ -203,7 +203,8 @@ class Union(Detector):
             "members",
             "str",
             DEFAULT_MEMBERS,
-            help="member detectors with their parameters: 'NAME KEY=VALUE ...; NAME ...'",
+            help="member detectors with their parameters: 'NAME KEY=VALUE ...; NAME ...'; "
+            "scale=S (and scale_top=T) runs a member on the frame's top T upscaled by S",
         ),
         Param(
             "merge",
