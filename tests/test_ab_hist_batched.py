@@ -8,9 +8,9 @@ import cv2
 import numpy as np
 import pytest
 from oracles.ab_hist_oracle import lens_areas, lens_scores
+from oracles.frames import annotated_frames
 from oracles.lamps import training_set
 
-from tsrkit.datasets import open_dataset
 from tsrkit.registry import get_registry
 from tsrkit.synth import SynthOptions, render_frame
 from tsrkit.types import Candidate, Frame
@@ -22,20 +22,6 @@ PARAMS = [
     {"smooth": 0, "min_chroma": 0},
     {"smooth": 1.3, "min_chroma": 25.5, "red_prior": False},
 ]
-
-
-def frames(shared_datasets):
-    """Two frames of each real detection set (lens and housing boxes) and two synthetic
-    1280x720 scenes, each with its annotated boxes as candidates."""
-    out = []
-    for name in ("roboflow_cinta_v2_id", "dtld_fridtjofs", "roboflow_traffic_light_kr"):
-        samples = list(open_dataset(shared_datasets / name, format="normalized"))
-        for sample in samples[:2]:
-            boxes = [Candidate.from_box(a.bbox, 1.0) for a in sample.annotations]
-            out.append((sample.load().image, boxes))
-    for seed in (3, 4):
-        out.append((render_frame(seed, 7, 1280, 720, SynthOptions())[0], []))
-    return out
 
 
 def circles(rng, width, height, n=40):
@@ -51,7 +37,7 @@ def test_batched_scores_equal_the_lens_by_lens_oracle(shared_datasets, params):
     classifier = get_registry().create("classifier", "ab-hist", params)
     rng = np.random.default_rng(11)
     checked = 0
-    for image, boxes in frames(shared_datasets):
+    for image, boxes in annotated_frames(shared_datasets):
         candidates = boxes + circles(rng, image.shape[1], image.shape[0])
         found = classifier.classify(Frame(image, "t"), candidates)
         assert [d.candidate for d in found] == candidates

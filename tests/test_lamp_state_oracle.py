@@ -9,14 +9,13 @@ import dataclasses
 import numpy as np
 import pytest
 from oracles import lamp_state_oracle as oracle
+from oracles.frames import annotated_frames
 from oracles.lamps import training_set
 from threadpoolctl import threadpool_limits
 
 import tsrkit
-from tsrkit.datasets import open_dataset
 from tsrkit.models import Model, ModelError, save_model
 from tsrkit.registry import get_registry
-from tsrkit.synth import SynthOptions, render_frame
 from tsrkit.types import Candidate, Frame
 from tsrkit_plugins.classifiers.lamp_state.features import housing_of, lamp_features
 from tsrkit_plugins.verifiers.forest import Forest
@@ -48,14 +47,7 @@ def frames(shared_datasets):
     rng = np.random.default_rng(7)
     stage = get_registry().create("verifier", "housing")
     out = []
-    images = []
-    for name in ("roboflow_cinta_v2_id", "dtld_fridtjofs", "roboflow_traffic_light_kr"):
-        data = list(open_dataset(shared_datasets / name, format="normalized"))
-        for sample in data[:2]:
-            boxes = [Candidate.from_box(a.bbox, 1.0) for a in sample.annotations]
-            images.append((sample.load().image, boxes))
-    images += [(render_frame(seed, 7, 1280, 720, SynthOptions())[0], []) for seed in (3, 4)]
-    for image, boxes in images:
+    for image, boxes in annotated_frames(shared_datasets):
         frame = Frame(image, "t")
         h, w = image.shape[:2]
         lenses = [Candidate.from_circle(c.x, c.y, max(c.radius / 3, 1.0), 1.0) for c in boxes]
