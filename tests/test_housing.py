@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import tsrkit
-from tsrkit.geometry import iou_matrix
+from tsrkit.geometry import circle_box, iou_matrix
 from tsrkit.pipeline import Pipeline
 from tsrkit.registry import get_registry
 from tsrkit.synth.heads import LAMP_COLOURS, background, render_head
@@ -39,7 +39,7 @@ def test_fit_without_a_lens_radius_searches_the_scale():
     assert np.mean(np.array(ious) >= 0.8) >= 0.9
 
 
-def test_stage_keeps_the_lens_adds_the_housing_and_drops_duplicates():
+def test_stage_adds_the_housing_and_drops_duplicates():
     image = background(200, 300)
     head = render_head(image, (150, 100), 8)
     lens = Candidate.from_circle(150, 100, 8, 0.9)
@@ -52,11 +52,26 @@ def test_stage_keeps_the_lens_adds_the_housing_and_drops_duplicates():
     weighed = weigh.verify(Frame(image, "x"), [lens, sky])
     assert [c.score for c in weighed] == [c.score * c.housing_score for c in out]  # x fit
     best = out[0]
-    assert (best.x, best.y, best.radius, best.bbox) == (lens.x, lens.y, lens.radius, lens.bbox)
+    assert best.score == lens.score and best.state == lens.state
     assert iou_matrix([head.housing], [best.housing])[0, 0] >= 0.8
     assert best.housing_score > out[1].housing_score
     strict = get_registry().create("verifier", "housing", {"min_score": 0.5})
     assert [c.score for c in strict.verify(Frame(image, "x"), [lens, sky])] == [0.9]
+
+
+@pytest.mark.parametrize("given", [3.0, 8.0, 40.0])
+def test_stage_gives_each_candidate_the_lens_its_housing_was_fitted_around(given):
+    # a detector's lens may be a blob five times the lamp (union's largest radius) or a point
+    # (FRST): the record's lens becomes the lit lens measured for the fit, inside its housing
+    image = background(200, 300)
+    render_head(image, (150, 100), 8)
+    stage = get_registry().create("verifier", "housing")
+    (out,) = stage.verify(Frame(image, "x"), [Candidate.from_circle(151, 99, given, 0.9)])
+    assert np.hypot(out.x - 150, out.y - 100) <= 0.3 * 8  # the measurement's grid: s / 2
+    assert 6.0 <= out.radius <= 10.5
+    assert out.bbox == circle_box(out.x, out.y, out.radius)
+    x0, y0, x1, y1 = out.housing
+    assert x0 <= out.bbox[0] and y0 <= out.bbox[1] and out.bbox[2] <= x1 and out.bbox[3] <= y1
 
 
 def test_records_report_the_housing_as_bbox(tmp_path):
