@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import tsrkit
-from tsrkit.geometry import circle_box, iou_matrix
+from tsrkit.geometry import iou_matrix
 from tsrkit.pipeline import Pipeline
 from tsrkit.registry import get_registry
 from tsrkit.synth.heads import LAMP_COLOURS, background, render_head
@@ -52,7 +52,7 @@ def test_stage_adds_the_housing_and_drops_duplicates():
     weighed = weigh.verify(Frame(image, "x"), [lens, sky])
     assert [c.score for c in weighed] == [c.score * c.housing_score for c in out]  # x fit
     best = out[0]
-    assert best.score == lens.score and best.state == lens.state
+    assert (best.x, best.y, best.radius, best.score) == (lens.x, lens.y, lens.radius, lens.score)
     assert iou_matrix([head.housing], [best.housing])[0, 0] >= 0.8
     assert best.housing_score > out[1].housing_score
     strict = get_registry().create("verifier", "housing", {"min_score": 0.5})
@@ -60,18 +60,20 @@ def test_stage_adds_the_housing_and_drops_duplicates():
 
 
 @pytest.mark.parametrize("given", [3.0, 8.0, 40.0])
-def test_stage_gives_each_candidate_the_lens_its_housing_was_fitted_around(given):
+def test_the_lens_box_becomes_the_lens_the_housing_was_fitted_around(given):
     # a detector's lens may be a blob five times the lamp (union's largest radius) or a point
-    # (FRST): the record's lens becomes the lit lens measured for the fit, inside its housing
+    # (FRST): the candidate keeps its circle, and its lens box becomes the lit lens measured
+    # for the fit, inside its housing
     image = background(200, 300)
     render_head(image, (150, 100), 8)
     stage = get_registry().create("verifier", "housing")
     (out,) = stage.verify(Frame(image, "x"), [Candidate.from_circle(151, 99, given, 0.9)])
-    assert np.hypot(out.x - 150, out.y - 100) <= 0.3 * 8  # the measurement's grid: s / 2
-    assert 6.0 <= out.radius <= 10.5
-    assert out.bbox == circle_box(out.x, out.y, out.radius)
-    x0, y0, x1, y1 = out.housing
-    assert x0 <= out.bbox[0] and y0 <= out.bbox[1] and out.bbox[2] <= x1 and out.bbox[3] <= y1
+    assert (out.x, out.y, out.radius) == (151.0, 99.0, given)
+    x0, y0, x1, y1 = out.lens_bbox
+    assert np.hypot((x0 + x1) / 2 - 150, (y0 + y1) / 2 - 100) <= 0.3 * 8  # grid: s / 2
+    assert 6.0 <= (x1 - x0) / 2 <= 10.5 and x1 - x0 == pytest.approx(y1 - y0)
+    hx0, hy0, hx1, hy1 = out.housing
+    assert hx0 <= x0 and hy0 <= y0 and x1 <= hx1 and y1 <= hy1
 
 
 def test_records_report_the_housing_as_bbox(tmp_path):

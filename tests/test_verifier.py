@@ -329,6 +329,6 @@ def test_the_verifier_runs_its_housing_stage_and_its_model_must_match_it():
     frame = Frame(lamp_scene(), "lamp")
     kept = make(threshold=0.0).verify(frame, [Candidate.from_circle(80, 30, 6, 1.0)])
     x0, y0, x1, y1 = kept[0].housing  # the housing stage ran first (after=housing)
-    assert (x1 - x0) < (y1 - y0) and (kept[0].x, kept[0].y) == (80.0, 30.0)  # on the lamp
+    assert (x1 - x0) < (y1 - y0) and (kept[0].x, kept[0].y, kept[0].radius) == (80.0, 30.0, 6.0)
     with pytest.raises(ModelError, match="trained after the stage 'housing'"):
         make(after="").verify(frame, [Candidate.from_circle(80, 30, 6, 1.0)])

@@ -30,7 +30,8 @@ class DetectionRecord:
     """One reported object as written to disk.
 
     ``bbox`` is the housing once a verifier fitted one, else the lens box; ``lens_bbox`` is
-    always the lens box. ``x``, ``y`` and ``radius`` are the lens circle.
+    always the lens box (the lit lens the housing was fitted around, once a housing stage
+    ran). ``x``, ``y`` and ``radius`` are the detector's lens circle.
     """
 
     x: float

@@ -39,7 +39,7 @@ class Candidate:
         A state the detector itself can tell (e.g. TL-recognizer's colour filters), else None.
     housing : tuple of float or None
         The signal housing around the lens, ``(x_min, y_min, x_max, y_max)``, once a housing
-        stage has fitted one; ``bbox`` stays the lens box.
+        stage has fitted one; ``bbox`` stays a lens box (that stage's measured lit lens).
     housing_score : float or None
         How well that housing fits, in [0, 1].
     distance_m : float or None
@@ -59,7 +59,7 @@ class Candidate:
 
     @property
     def lens_bbox(self) -> Box:
-        """The lens box (what the detector found)."""
+        """The lens box: the detector's, or the lit lens a housing stage fitted around."""
         return self.bbox
 
     @property

@@ -1,17 +1,20 @@
 """``housing``: a verifier stage that fits the signal housing around every candidate's lens.
 
-Works after any detector (``-V housing``): each candidate gains ``housing`` and
-``housing_score`` (:mod:`.fit`, from the lit lens measured near the candidate, :mod:`.lens`),
-and its lens (``x``, ``y``, ``radius``, ``lens_bbox`` in records) becomes the lens that housing
-was fitted around, which the housing holds (a detector's own lens may be a 40-70 px blob or
-off the lamp: on KR test, whose boxes are lenses, the union's best candidate meets a lens box
-at IoU >= 0.5 for 0.39 of the lights, the fitted lens for 0.61), so records, COCO
-output and IoU metrics evaluate housing boxes on datasets that box housings (``--eval-box
-housing``). Candidates whose housings overlap a better-scored one's are the same light and are
-dropped (``nms_iou``); ``min_score`` drops poor fits; ``rescore`` weighs each candidate's
-score by its fit, for pipelines without a verifier (housing AP50 of the ``union`` candidates:
-cinTA test 0.28 -> 0.35; after the preset's verifier it lowers held-out recall at its threshold
-and leaves held-out AP50 unchanged, so it is off by default: ``benchmarks/RESULTS.housing.md``).
+Works after any detector (``-V housing``): each candidate keeps its lens circle (``x``, ``y``,
+``radius``: where and at what scale the detector found it, which the verifier's features and
+Zheng's centre rule read) and gains ``housing`` and ``housing_score`` (:mod:`.fit`, from the lit
+lens measured near the candidate, :mod:`.lens`); its lens box (``bbox``, ``lens_bbox`` in
+records) becomes the box of the lit lens the housing was fitted around, which the housing holds.
+A detector's own lens may be a blob several times the lamp (``union`` keeps the largest radius
+of its members; ``adaboost-hsv`` boxes whole sky regions) or a point (FRST): on KR test, whose
+boxes are lenses, the union's best candidate meets a lens box at IoU >= 0.5 for 0.39 of the
+lights, the fitted lens for 0.61. Records, COCO output and IoU metrics evaluate the housing
+on datasets that box housings and that lens box on lens-boxed ones (``--eval-box``).
+Candidates whose housings overlap a better-scored one's are the same light and are dropped
+(``nms_iou``); ``min_score`` drops poor fits; ``rescore`` weighs each candidate's score by its
+fit, for pipelines without a verifier (housing AP50 of the ``union`` candidates: cinTA test
+0.28 -> 0.35; after the preset's verifier it lowers held-out recall at its threshold and leaves
+held-out AP50 unchanged, so it is off by default: ``benchmarks/RESULTS.housing.md``).
 ``margin`` widens every housing to a dataset's box convention (:mod:`.margin`: learn it from a
 training split).
 """
@@ -97,9 +100,6 @@ class Housing(Verifier):
         fitted = [
             replace(
                 c,
-                x=x,
-                y=y,
-                radius=radius,
                 bbox=circle_box(x, y, radius),
                 housing=tuple(box),
                 housing_score=fit,
