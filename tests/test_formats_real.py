@@ -41,7 +41,7 @@ def test_registry_maps_kr_left_arrow_to_green(shared_datasets):
     ds = open_dataset("roboflow_traffic_light_kr")
     left = [a for s in ds for a in s.annotations if a.attributes["label"] == "left"]
     assert len(left) == 21 and {a.state for a in left} == {"green"}
-    assert ds.info["box"] == "housing" and ds.info["licence"] == "CC BY 4.0"
+    assert ds.info["box"] == "lens" and ds.info["licence"] == "CC BY 4.0"
     assert Counter(s.split for s in ds) == {"valid": 25, "test": 13}
 
 
