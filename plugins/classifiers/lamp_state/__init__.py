@@ -8,7 +8,8 @@ unchanged, beside it. Features: :mod:`.features`; model: scikit-learn's
 training data labels it (DTLD); other labels (arrows, off) are passed over in training. Where
 no training set labels it, a light read red or amber whose housing has its top and middle slots
 both lit, the top one red (:func:`~.features.two_lit` above ``red_yellow_ratio``), is read
-red+amber (:func:`red_yellow`).
+red+amber (:func:`red_yellow`); a box taller than wide but too square to be read as a housing is
+read so too (:func:`~.features.red_amber_rows`).
 The classes are not reweighted, and the learned red probability counts ``red_prior`` times
 (:func:`prefer_red`): red is the most common state of every set and the costly one to miss, so
 a lamp whose colour sits between red and amber (orange-red LEDs, white cores) reads red.
@@ -41,6 +42,7 @@ from tsrkit_plugins.classifiers.lamp_state.features import (
     TWO_LIT,
     VERSION,
     lamp_features,
+    red_amber_rows,
 )
 from tsrkit_plugins.verifiers.forest import Forest
 from tsrkit_plugins.verifiers.persistence import estimator_arrays, load_estimator
@@ -284,7 +286,8 @@ class LampState(Classifier):
         else:
             other = np.zeros((len(candidates), len(STATES)))
         ratio = self.params["red_yellow_ratio"]
-        table = red_yellow(blend(probability, self._states, other, weight), features, ratio)
+        rule = red_amber_rows(frame.image, candidates, features)
+        table = red_yellow(blend(probability, self._states, other, weight), rule, ratio)
         if ratio < 1:
             known.add("red_yellow")
         columns = [k for k, s in enumerate(STATES) if s in known]
