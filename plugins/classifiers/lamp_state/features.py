@@ -359,9 +359,10 @@ def red_amber_rows(
     """
     square = []
     for i, candidate in enumerate(candidates):
-        x0, y0, x1, y1 = candidate.bbox
-        if housing_of(candidate) is None and y1 - y0 > x1 - x0 > 0:
-            square.append(i)
+        if candidate.housing is None:  # most of a pipeline's candidates have a fitted housing
+            x0, y0, x1, y1 = candidate.bbox
+            if y1 - y0 > x1 - x0 > 0 and housing_of(candidate) is None:
+                square.append(i)
     if not square:
         return rows
     out = rows.copy()
