@@ -214,9 +214,9 @@ class LampState(Classifier):
             0.5,
             min=0.0,
             max=1.0,
-            help="a light read red or amber is read red+amber when its housing's top slot is red "
-            "and it and the middle slot are lit above this share of the brightest slot's height "
-            "over the bottom one; 1 switches it off",
+            help="a light read red or amber is read red+amber when its housing's (or its box's, "
+            "if taller than wide) top slot is red and it and the middle slot are lit above this "
+            "share of the brightest slot's height over the bottom one; 1 switches it off",
         ),
     )
 
