@@ -12,7 +12,8 @@ the held-out dataset's own train part (MIT train, KR valid, cinTA valid, DTLD tr
 on its test split. Features are computed once per light. A late fusion (the equal-weight mean
 of lamp-state's LOSO probabilities and ab-hist's normalised scores) is measured beside both;
 ab-hist there is the shipped model, trained on MIT train. lamp-state's red+amber rule
-(``red_yellow_ratio``) and its red prior (``red_prior``) apply to all three.
+(``red_yellow_ratio``, on housings and on boxes taller than wide too square to be read as
+housings, as its ``classify`` reads them) and its red prior (``red_prior``) apply to all three.
 
     python benchmarks/state_loso.py
 """
@@ -41,7 +42,10 @@ from tsrkit_plugins.classifiers.lamp_state import (  # noqa: E402
     prefer_red,
     red_yellow,
 )
-from tsrkit_plugins.classifiers.lamp_state.features import lamp_features  # noqa: E402
+from tsrkit_plugins.classifiers.lamp_state.features import (  # noqa: E402
+    lamp_features,
+    red_amber_rows,
+)
 
 
 def deduplicated(dataset: Dataset, lighting: str) -> Dataset:
@@ -102,20 +106,37 @@ def paper(name: str, dataset: Dataset) -> tuple[list[str], np.ndarray]:
     classifier = get_registry().create("classifier", name)
     out, rows = [], []
     for sample in dataset:
-        wanted = [a for a in sample.annotations if a.state in STATES]
-        if wanted:
-            frame = sample.load()
-            found = classifier.classify(frame, [Candidate.from_box(a.bbox, 1.0) for a in wanted])
+        boxes = wanted_boxes(sample)
+        if boxes:
+            found = classifier.classify(sample.load(), boxes)
             out += [d.state for d in found]
             rows += [[d.state_scores.get(s, 0.0) for s in STATES] for d in found]
     return out, np.array(rows, np.float64).reshape(-1, len(STATES))
 
 
-def read(probability: np.ndarray, states: list[str], features: np.ndarray, params) -> list[str]:
+def wanted_boxes(sample) -> list[Candidate]:
+    """The annotated lights of ``sample`` whose state is in :data:`STATES`, as candidates."""
+    return [Candidate.from_box(a.bbox, 1.0) for a in sample.annotations if a.state in STATES]
+
+
+def rule_rows(dataset: Dataset, features: np.ndarray) -> np.ndarray:
+    """The ``features`` of the lights of ``dataset`` (in order, no copies) as lamp-state's
+    red+amber rule reads them (:func:`red_amber_rows`: squarer boxes' two lamps too)."""
+    out, start = [], 0
+    for sample in dataset:
+        boxes = wanted_boxes(sample)
+        if boxes:
+            rows = features[start : start + len(boxes)]
+            out.append(red_amber_rows(sample.load().image, boxes, rows))
+            start += len(boxes)
+    return np.concatenate(out)
+
+
+def read(probability: np.ndarray, states: list[str], rule: np.ndarray, params) -> list[str]:
     """lamp-state's reading of its learned ``probability`` (columns ``states``), with its
-    red+amber rule (:func:`red_yellow`)."""
+    red+amber rule (:func:`red_yellow`) on the ``rule`` rows (:func:`rule_rows`)."""
     table = blend(probability, states, np.zeros((len(probability), len(STATES))), 0.0)
-    table = red_yellow(table, features, params["red_yellow_ratio"])
+    table = red_yellow(table, rule, params["red_yellow_ratio"])
     return [STATES[i] for i in np.argmax(table, axis=1)]
 
 
@@ -138,6 +159,7 @@ def main() -> None:
             if key in ("train", "own"):
                 continue
             x, y = features[(group, key)]
+            rule = rule_rows(dataset, x)
             others = [features[(g, "train")] for g in data if g != group]
             loso, states = fit_estimator(
                 np.concatenate([o[0] for o in others]),
@@ -145,7 +167,7 @@ def main() -> None:
                 params,
             )
             probability = prefer_red(loso.predict_proba(x), states, params["red_prior"])
-            predicted = read(probability, states, x, params)
+            predicted = read(probability, states, rule, params)
             row = {"set": key, "n": len(y), "loso": scores(y, predicted)[:2]}
             if "own" in sets and key.endswith("test"):
                 train = others + [features[(group, "own")]]
@@ -155,14 +177,14 @@ def main() -> None:
                     params,
                 )
                 own_probability = prefer_red(own.predict_proba(x), own_states, params["red_prior"])
-                found = read(own_probability, own_states, x, params)
+                found = read(own_probability, own_states, rule, params)
                 row["in-domain"] = scores(y, found)[:2]
             for name in ("ab-hist", "hsi-backprojection"):
                 found, found_scores = paper(name, dataset)
                 row[name] = scores(y, found)[:2]
                 if name == "ab-hist":
                     mixed = blend(probability, states, found_scores, 0.5)
-                    mixed = red_yellow(mixed, x, params["red_yellow_ratio"])
+                    mixed = red_yellow(mixed, rule, params["red_yellow_ratio"])
                     row["fused"] = scores(y, [STATES[i] for i in np.argmax(mixed, axis=1)])[:2]
             row["truth"] = dict(Counter(STATES[i] for i in y))
             pairs = zip((STATES[i] for i in y), predicted)

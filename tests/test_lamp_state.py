@@ -14,6 +14,7 @@ from tsrkit_plugins.classifiers.lamp_state.features import (
     TWO_LIT,
     area_resample,
     lamp_features,
+    red_amber_rows,
     two_lit,
 )
 
@@ -90,6 +91,34 @@ def test_shipped_model_reads_red_amber_by_position(white_core):
         "red",
         "yellow",
     }
+
+
+@pytest.mark.parametrize("white_core", [False, True])
+def test_red_amber_in_a_box_too_square_for_a_housing(white_core):
+    # DTLD-like: the 40x120 head inside an 81x120 box (elongation 1.48, below ELONGATION): the
+    # model reads no position there, the red+amber rule reads its band (the middle half across)
+    both, (x0, y0, x1, y1) = head("red_yellow", white_core)
+    red, _ = head("red", white_core)
+    square = [Candidate.from_box((x0 - 20.5, y0, x1 + 20.5, y1), 1.0)]
+    rows = [lamp_features(i, square) for i in (both, red)]
+    assert rows[0][0, N_LENS + 8] == 0.0 and rows[0][0, TWO_LIT] == 0.0  # not read as a housing
+    rule = [red_amber_rows(i, square, r)[0] for i, r in zip((both, red), rows)]
+    assert rule[0][TWO_LIT] > 0.8 and rule[1][TWO_LIT] < 0.1
+    assert np.array_equal(np.delete(rule[0], TWO_LIT), np.delete(rows[0][0], TWO_LIT))
+    classifier = tsrkit.classifier("lamp-state")
+    assert classifier.classify(Frame(both, "both"), square)[0].state == "red_yellow"
+    assert classifier.classify(Frame(red, "red"), square)[0].state == "red"
+
+
+def test_red_amber_rule_leaves_housings_lenses_and_wide_boxes_alone():
+    both, (x0, y0, x1, y1) = head("red_yellow")
+    candidates = [
+        Candidate.from_box((x0, y0, x1, y1), 1.0),  # read as a housing: its own two_lit
+        Candidate.from_circle(x0 + 20, y0 + 40, 15, 1.0),  # a lens: square box
+        Candidate.from_box((x0 - 40, y0, x1 + 40, y1), 1.0),  # wider than tall
+    ]
+    rows = lamp_features(both, candidates)
+    assert red_amber_rows(both, candidates, rows) is rows
 
 
 def save(path, model):

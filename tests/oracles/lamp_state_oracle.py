@@ -23,6 +23,7 @@ from tsrkit_plugins.classifiers.lamp_state.features import (
     housing_of,
     lit_lenses,
     quantiles,
+    red_amber_rows,
     scaled,
 )
 
@@ -167,7 +168,8 @@ def classify(classifier, frame, candidates):
         known |= {s for d in found for s in d.state_scores}
         other = np.array([[d.state_scores.get(s, 0.0) for s in STATES] for d in found])
     ratio = classifier.params["red_yellow_ratio"]
-    table = red_yellow(blend(probability, states, other, weight), features, ratio)
+    rule = red_amber_rows(frame.image, candidates, features)  # the rule's reading, shared
+    table = red_yellow(blend(probability, states, other, weight), rule, ratio)
     if ratio < 1:
         known.add("red_yellow")
     out = []

@@ -8,7 +8,8 @@ unchanged, beside it. Features: :mod:`.features`; model: scikit-learn's
 training data labels it (DTLD); other labels (arrows, off) are passed over in training. Where
 no training set labels it, a light read red or amber whose housing has its top and middle slots
 both lit, the top one red (:func:`~.features.two_lit` above ``red_yellow_ratio``), is read
-red+amber (:func:`red_yellow`).
+red+amber (:func:`red_yellow`); a box taller than wide but too square to be read as a housing is
+read so too (:func:`~.features.red_amber_rows`).
 The classes are not reweighted, and the learned red probability counts ``red_prior`` times
 (:func:`prefer_red`): red is the most common state of every set and the costly one to miss, so
 a lamp whose colour sits between red and amber (orange-red LEDs, white cores) reads red.
@@ -41,6 +42,7 @@ from tsrkit_plugins.classifiers.lamp_state.features import (
     TWO_LIT,
     VERSION,
     lamp_features,
+    red_amber_rows,
 )
 from tsrkit_plugins.verifiers.forest import Forest
 from tsrkit_plugins.verifiers.persistence import estimator_arrays, load_estimator
@@ -212,9 +214,9 @@ class LampState(Classifier):
             0.5,
             min=0.0,
             max=1.0,
-            help="a light read red or amber is read red+amber when its housing's top slot is red "
-            "and it and the middle slot are lit above this share of the brightest slot's height "
-            "over the bottom one; 1 switches it off",
+            help="a light read red or amber is read red+amber when its housing's (or its box's, "
+            "if taller than wide) top slot is red and it and the middle slot are lit above this "
+            "share of the brightest slot's height over the bottom one; 1 switches it off",
         ),
     )
 
@@ -284,7 +286,8 @@ class LampState(Classifier):
         else:
             other = np.zeros((len(candidates), len(STATES)))
         ratio = self.params["red_yellow_ratio"]
-        table = red_yellow(blend(probability, self._states, other, weight), features, ratio)
+        rule = red_amber_rows(frame.image, candidates, features)
+        table = red_yellow(blend(probability, self._states, other, weight), rule, ratio)
         if ratio < 1:
             known.add("red_yellow")
         columns = [k for k, s in enumerate(STATES) if s in known]

@@ -276,15 +276,23 @@ def two_lit(profile: np.ndarray, redness: np.ndarray, dip: float = 0.7) -> np.nd
     return np.where(two, both, 0.0)
 
 
+def band_profiles(
+    upright: np.ndarray, hsv: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The central :func:`band` of upright housing patches (BGR ``upright`` and its ``hsv``):
+    its value and colourfulness (saturation x value), (N, along, band width), and their
+    profiles along the axis, brightness and redness (red minus green), (N, along)."""
+    value = band(hsv[..., 2]).astype(np.float32) / 255
+    colourful = band(hsv[..., 1]).astype(np.float32) / 255 * value
+    bgr = band(upright[..., 1:]).astype(np.float32) / 255
+    return value, colourful, value.mean(axis=2), (bgr[..., 1] - bgr[..., 0]).mean(axis=2)
+
+
 def housing_features(upright: np.ndarray, hsv: np.ndarray, vertical: np.ndarray) -> np.ndarray:
     """Lit-position features of upright housing patches (BGR ``upright`` and its ``hsv``), read
     in their central :func:`band`."""
     n = hsv.shape[0]
-    value = band(hsv[..., 2]).astype(np.float32) / 255
-    colourful = band(hsv[..., 1]).astype(np.float32) / 255 * value
-    profile = value.mean(axis=2)
-    bgr = band(upright[..., 1:]).astype(np.float32) / 255
-    redness = (bgr[..., 1] - bgr[..., 0]).mean(axis=2)
+    value, colourful, profile, redness = band_profiles(upright, hsv)
     # the 0.9 quantile of value and colourfulness over each third of the length (HOUSING_SIZE's
     # length is a multiple of 3), one partition for all six
     thirds = quantiles(np.stack([value, colourful], axis=1).reshape(2 * n * 3, -1), 0.9)
@@ -334,3 +342,32 @@ def lamp_features(image: np.ndarray, candidates: Sequence[Candidate]) -> np.ndar
     if lenses:
         rows[:, :N_LENS] = lens_features(image, lenses)
     return np.nan_to_num(rows)
+
+
+def red_amber_rows(
+    image: np.ndarray, candidates: Sequence[Candidate], rows: np.ndarray
+) -> np.ndarray:
+    """The feature ``rows`` of ``candidates`` as the red+amber rule reads them: ``rows``, or a
+    copy whose :data:`TWO_LIT` column also holds :func:`two_lit` of each box taller than wide
+    but too square to be read as a housing (no fitted housing, elongation below
+    :data:`ELONGATION`), read upright in its central :func:`band`.
+
+    Such a box gives the model no position (DTLD's housing boxes around a backplate are often
+    1.2-1.5 times as tall as wide, as are KR's lens boxes), but two lamps lit with a dark gap
+    between them and a red top one are not one lamp's lens: the rule reads them there too. A
+    lens candidate's box (square) is not read.
+    """
+    square = []
+    for i, candidate in enumerate(candidates):
+        if candidate.housing is None:  # most of a pipeline's candidates have a fitted housing
+            x0, y0, x1, y1 = candidate.bbox
+            if y1 - y0 > x1 - x0 > 0 and housing_of(candidate) is None:
+                square.append(i)
+    if not square:
+        return rows
+    out = rows.copy()
+    boxes = np.array([candidates[i].bbox for i in square], np.float64)
+    upright = upright_housings(image, boxes, np.ones(len(square), bool))
+    _, _, profile, redness = band_profiles(upright, convert(upright, cv2.COLOR_BGR2HSV))
+    out[square, TWO_LIT] = two_lit(profile, redness)
+    return out
