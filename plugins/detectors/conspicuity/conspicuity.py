@@ -24,11 +24,15 @@ Reading choices (the thesis leaves them open or prints them ambiguously):
 Speed: every window sum is an exact integer sum of entries of one row-prefix table per
 channel (rows of equal half-width merged into one look-up in its column integral; the plan of
 each window is computed once per radius and executed by the numba kernel in
-``conspicuity_kernel.py``, one image row at a time), the full lightness disk is assembled from
-its four quarters, saturation disks are shared between radii, the sums run in 16 bits when
-every lightness window is small enough to be exact there (:func:`narrow_sums`: int16 lightness,
-uint16 saturation in bands of rows), and the root of Eq. 3.1 is taken once after the maximum
-of Eq. 3.2 (the root is monotonic, so the arg-max is unchanged).
+``conspicuity_kernel.py``, one image row at a time). Lightness entries that several windows of
+a radius use (the quarters' centre column and centre row, the quadrant boxes' corners, the
+axes) are read once per pixel in the pass that combines them, and only the quarters'
+staircases go through row buffers; the full lightness disk is assembled from its four
+quarters, saturation disks are shared between radii, the sums run in 16 bits when every
+lightness window is small enough to be exact there (:func:`narrow_sums`: int16 lightness,
+uint16 saturation in bands of rows), L and S come from one compiled pass (``colour.py``), and
+the root of Eq. 3.1 is taken once after the maximum of Eq. 3.2 (the root is monotonic, so the
+arg-max is unchanged).
 ``tests/oracles/conspicuity_oracle.py`` is the direct reference these are tested against.
 """
 
@@ -46,9 +50,12 @@ from tsrkit.hookspecs import hookimpl
 from tsrkit.params import Param, ParamError
 from tsrkit.plugin import Detector
 from tsrkit.types import Candidate, Frame
+from tsrkit_plugins.detectors.conspicuity.colour import lightness_and_saturation
 from tsrkit_plugins.detectors.conspicuity.conspicuity_kernel import (
     BAND_PIXELS,
+    INTEGRAL,
     NARROW_PIXELS,
+    PREFIX,
     best_products,
     flat_offsets,
     positive_ends,
@@ -98,18 +105,14 @@ def mirror(channel: np.ndarray, pad: int) -> np.ndarray:
     return cv2.copyMakeBorder(channel, pad, pad, pad, pad, cv2.BORDER_REFLECT_101)
 
 
-def compile_terms(
-    runs: Sequence[tuple[int, int, int]], columns: Sequence[tuple[int, int, int, int]] = ()
-):
-    """Plan a window sum: ``sign * prefix(dy, dc)`` over ``runs`` = (dy, dc, sign) plus, over
-    ``columns`` = (top, bottom, dc, sign), ``sign`` times the prefix at column offset ``dc``
-    summed over rows ``top..bottom``.
+def compile_terms(runs: Sequence[tuple[int, int, int]]):
+    """Plan a window sum: ``sign * prefix(dy, dc)`` over ``runs`` = (dy, dc, sign).
 
     Runs sharing ``dc`` and ``sign`` on consecutive rows are merged into one column look-up
     (two array operations instead of one per row). Returns ``(on_integral, dy, dc, sign)``
     terms, positive ones first.
     """
-    merged = list(columns)
+    merged = []
     terms = []
     ordered = sorted(runs, key=lambda t: (t[1], t[2], t[0]))
     start = 0
@@ -159,38 +162,68 @@ def disk_bands(radius: int, limit: int | None) -> tuple[tuple[int, int], ...]:
 
 
 @cache
-def quarter_plan(radius: int, quadrant: tuple[int, int]):
-    """Plan of quadrant ``k`` of A1, axes included (numerator of Eq. 3.7).
+def stair_plan(radius: int, quadrant: tuple[int, int]):
+    """Plan of the staircase of quadrant ``k`` of A1: the far-edge prefixes of its rows
+    ``1..radius`` away from the centre row, the part of the quarter (numerator of Eq. 3.7) that
+    no other window shares.
 
-    Every row run of the quarter starts (or ends) on the centre column, so that edge is one
-    column look-up; the other edge follows the disk's staircase.
+    The staircase follows the disk's edge (rows of equal half-width merged into one column
+    look-up); the centre-column edge of those rows (one column look-up) and the centre row are
+    single entries of :func:`corner_terms` and :data:`SHARED_TERMS`, read once per pixel for
+    the quarters, boxes and axes together (``conspicuity_kernel._light_windows``).
     """
     vertical, horizontal = quadrant
     w = half_widths(radius)
-    rows = (-radius, 0) if vertical < 0 else (0, radius)
     if horizontal > 0:
-        runs = [(vertical * dy, w[dy] + 1, 1) for dy in range(radius + 1)]
-        return compile_terms(runs, [(rows[0], rows[1], 0, -1)])
-    runs = [(vertical * dy, -w[dy], -1) for dy in range(radius + 1)]
-    return compile_terms(runs, [(rows[0], rows[1], 1, 1)])
+        return compile_terms([(vertical * dy, w[dy] + 1, 1) for dy in range(1, radius + 1)])
+    return compile_terms([(vertical * dy, -w[dy], -1) for dy in range(1, radius + 1)])
+
+
+#: The single lightness entries every radius shares, as kernel terms (plane, dy, dc): the row
+#: prefix left of the centre and right of it, and the column integrals at the centre row and
+#: the row above it, left and right of the centre column.
+SHARED_TERMS = (
+    (PREFIX, 0, 0),
+    (PREFIX, 0, 1),
+    (INTEGRAL, 0, 0),
+    (INTEGRAL, 0, 1),
+    (INTEGRAL, -1, 0),
+    (INTEGRAL, -1, 1),
+)
 
 
 @cache
-def box_plan(half_side: int, quadrant: tuple[int, int]):
-    """Plan of quadrant ``k`` of the bounding box of side ``half_side + 1`` (A1 + A2)."""
-    vertical, horizontal = quadrant
-    top, bottom = (-half_side, 0) if vertical < 0 else (0, half_side)
-    left, right = (-half_side, 0) if horizontal < 0 else (0, half_side)
-    return compile_terms((), [(top, bottom, right + 1, 1), (top, bottom, left, -1)])
+def corner_terms(radius: int, half_side: int) -> tuple[tuple[int, int, int], ...]:
+    """The single lightness entries of radius ``radius`` (plane, dy, dc), read once per pixel
+    and shared by its windows (``conspicuity_kernel._light_windows``).
 
-
-@cache
-def axes_plan(radius: int):
-    """Plan of minus the centre column ``|dy| <= radius`` and the two centre-row runs
-    ``0 <= +-dx <= radius`` (the parts the four quarters share)."""
-    return compile_terms(
-        [(0, radius + 1, -1), (0, 0, 1), (0, 1, -1), (0, -radius, 1)],
-        [(-radius, radius, 1, -1), (-radius, radius, 0, 1)],
+    With ``r = radius`` and ``s = half_side`` (``r + m``): the centre row's prefix right and
+    left of the disk; the column integrals above and below the disk's centre-column run (these
+    close the four quarters with :data:`SHARED_TERMS` and :func:`stair_plan`, and with the
+    centre row give the axes term, minus the centre column and the two centre-row runs the
+    quarters share); then the corners of the four quadrant boxes of A1 + A2, up-right,
+    up-left, down-left, down-right (Eq. 3.8), three or four each beside the shared ones.
+    """
+    r, s = radius, half_side
+    return (
+        (PREFIX, 0, r + 1),
+        (PREFIX, 0, -r),
+        (INTEGRAL, -r - 1, 0),
+        (INTEGRAL, -r - 1, 1),
+        (INTEGRAL, r, 0),
+        (INTEGRAL, r, 1),
+        (INTEGRAL, 0, s + 1),
+        (INTEGRAL, -s - 1, s + 1),
+        (INTEGRAL, -s - 1, 0),
+        (INTEGRAL, -s - 1, 1),
+        (INTEGRAL, 0, -s),
+        (INTEGRAL, -s - 1, -s),
+        (INTEGRAL, s, 1),
+        (INTEGRAL, s, -s),
+        (INTEGRAL, -1, -s),
+        (INTEGRAL, s, s + 1),
+        (INTEGRAL, -1, s + 1),
+        (INTEGRAL, s, 0),
     )
 
 
@@ -213,6 +246,7 @@ class KernelPlan:
     light_terms: np.ndarray
     light_starts: np.ndarray
     light_mids: np.ndarray
+    corners: np.ndarray
     sat_terms: np.ndarray
     sat_starts: np.ndarray
     sat_mids: np.ndarray
@@ -237,16 +271,13 @@ def concatenated(plans: Sequence[list]) -> tuple[np.ndarray, np.ndarray]:
 def kernel_plan(radii: tuple[int, ...], margin: int) -> KernelPlan:
     """The windows of Eq. 3.3-3.11 for the radius set RAD and margin ``m``.
 
-    Per radius: the four quarters of A1, the four quadrant boxes of A1 + A2 (half-side
-    ``r + m``) and the shared axes on lightness; the saturation disks of radius ``r`` and ``2 r``
+    Per radius: the staircases of the four quarters of A1 and the single entries that close
+    them, the quadrant boxes of A1 + A2 (half-side ``r + m``) and the axes term on lightness;
+    the saturation disks of radius ``r`` and ``2 r``
     are planned once per distinct radius (the annulus A3 is their difference), as bands of at
     most :data:`conspicuity_kernel.BAND_PIXELS` pixels with :func:`narrow_sums`.
     """
-    light = []
-    for r in radii:
-        light += [kernel_terms(quarter_plan(r, q)) for q in QUADRANTS]
-        light += [kernel_terms(box_plan(r + margin, q)) for q in QUADRANTS]
-        light.append(kernel_terms(axes_plan(r)))
+    light = [kernel_terms(stair_plan(r, q)) for r in radii for q in QUADRANTS]
     sat_radii = sorted(set(radii) | {2 * r for r in radii})
     limit = BAND_PIXELS if narrow_sums(radii, margin) else None
     bands = [disk_bands(r, limit) for r in sat_radii]
@@ -268,6 +299,7 @@ def kernel_plan(radii: tuple[int, ...], margin: int) -> KernelPlan:
         light_terms,
         light_starts,
         positive_ends(light_terms, light_starts),
+        np.array([corner_terms(r, r + margin) for r in radii], np.int32),
         sat_terms,
         sat_starts,
         positive_ends(sat_terms, sat_starts),
@@ -384,12 +416,14 @@ def channel_tables(
     image: np.ndarray, radii: Sequence[int], margin: int
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """Prefix tables of the mirrored lightness and saturation (int16 and uint16 with
-    :func:`narrow_sums`, int32 otherwise), with the padding they need."""
+    :func:`narrow_sums`, int32 otherwise), with the padding they need. The channels are those
+    of :func:`lightness` and :func:`saturation`, converted in one pass (``colour.py``)."""
     pad = max(2 * max(radii), max(radii) + margin)
     narrow = narrow_sums(radii, margin)
+    light, sat = lightness_and_saturation(image)
     return (
-        prefix_tables(mirror(lightness(image), pad), np.int16 if narrow else np.int32),
-        prefix_tables(mirror(saturation(image), pad), np.uint16 if narrow else np.int32),
+        prefix_tables(mirror(light, pad), np.int16 if narrow else np.int32),
+        prefix_tables(mirror(sat, pad), np.uint16 if narrow else np.int32),
         pad,
     )
 
@@ -419,6 +453,8 @@ def products_on_runs(
         flat_offsets(plan.light_terms, light_tables.shape),
         plan.light_starts,
         plan.light_mids,
+        flat_offsets(np.array(SHARED_TERMS), light_tables.shape),
+        flat_offsets(plan.corners.reshape(-1, 3), light_tables.shape).reshape(len(radii), -1),
         flat_offsets(plan.sat_terms, sat_tables.shape),
         plan.sat_starts,
         plan.sat_mids,
