@@ -119,8 +119,25 @@ def window_sum(flat, offsets, first, mid, last, base, count, out):
     tables' integer type) wrap, so the grouping does not change the result.
     """
     target = out[:count]
-    target[:] = 0
     p, q = first, mid
+    if mid - p >= 4:
+        a, b = _source(flat, offsets, p, base, count), _source(flat, offsets, p + 1, base, count)
+        c, d = (
+            _source(flat, offsets, p + 2, base, count),
+            _source(flat, offsets, p + 3, base, count),
+        )
+        for x in range(count):
+            target[x] = (a[x] + b[x]) + (c[x] + d[x])
+        p += 4
+    elif mid - p >= 2 and last - q >= 2:
+        a, b = _source(flat, offsets, p, base, count), _source(flat, offsets, p + 1, base, count)
+        c, d = _source(flat, offsets, q, base, count), _source(flat, offsets, q + 1, base, count)
+        for x in range(count):
+            target[x] = (a[x] + b[x]) - (c[x] + d[x])
+        p += 2
+        q += 2
+    else:
+        target[:] = 0
     while mid - p >= 4:
         a, b = _source(flat, offsets, p, base, count), _source(flat, offsets, p + 1, base, count)
         c, d = (
