@@ -139,9 +139,28 @@ def peak_mask(wcm: np.ndarray, h_peak: float) -> np.ndarray:
     return np.greater(wcm, h_peak).view(np.uint8)
 
 
-def denoise(mask: np.ndarray) -> np.ndarray:
-    """Eq. 3.15: morphological opening with the radius-1 disk."""
-    return cv2.morphologyEx(mask, cv2.MORPH_OPEN, DISK_1)
+def peak_region(mask: np.ndarray) -> tuple[slice, slice]:
+    """The bounding rectangle of the set pixels of ``mask`` widened by one pixel on each side
+    (clipped to the image), as row and column slices (empty when nothing is set)."""
+    x, y, w, h = cv2.boundingRect(mask)
+    if w == 0:
+        return slice(0, 0), slice(0, 0)
+    return slice(max(y - 1, 0), y + h + 1), slice(max(x - 1, 0), x + w + 1)
+
+
+def denoise(mask: np.ndarray, region: tuple[slice, slice] | None = None) -> np.ndarray:
+    """Eq. 3.15: morphological opening with the radius-1 disk.
+
+    Only ``region`` (:func:`peak_region` of ``mask``, found when not given) is opened, the rest
+    is 0: outside the set pixels' rectangle the opening is 0, and its one-pixel frame of zeros
+    (or the image border, handled alike) gives the pixels inside the same neighbours.
+    """
+    rows, cols = peak_region(mask) if region is None else region
+    opened = np.zeros_like(mask)
+    if rows.stop > rows.start:
+        part = np.ascontiguousarray(mask[rows, cols])
+        opened[rows, cols] = cv2.morphologyEx(part, cv2.MORPH_OPEN, DISK_1)
+    return opened
 
 
 @dataclass(frozen=True)
@@ -293,11 +312,17 @@ def too_many(new_count: int, found_count: int, n_pi: int) -> bool:
 
 
 def clear_found(
-    wcm: np.ndarray, raw_peaks: np.ndarray, centres: np.ndarray, radius: np.ndarray
+    wcm: np.ndarray,
+    raw_peaks: np.ndarray,
+    centres: np.ndarray,
+    radius: np.ndarray,
+    region: tuple[slice, slice] | None = None,
 ) -> None:
     """Steps 3.1-3.2: zero the raw peak pixels and the new candidate disks in the working map
-    (the disks drawn with value 0 straight into it)."""
-    np.putmask(wcm, raw_peaks, 0)
+    (the disks drawn with value 0 straight into it); ``region`` (:func:`peak_region`), when
+    given, holds every raw peak pixel."""
+    rows, cols = (slice(None), slice(None)) if region is None else region
+    np.putmask(wcm[rows, cols], raw_peaks[rows, cols], 0)
     for (row, col), r in zip(np.rint(centres).astype(int), radius):
         cv2.circle(wcm, (int(col), int(row)), int(r), 0, -1)
 
@@ -332,7 +357,8 @@ def localize(
             break
         normalise(wcm, peak)
         raw = peak_mask(wcm, params["h_peak"])
-        blobs = components(denoise(raw))
+        region = peak_region(raw)
+        blobs = components(denoise(raw, region))
         keep = shape_filter(blobs, params["asp_min"], params["pd_min"])
         starts = blobs.centroids[keep][:, ::-1]
         sizes = np.maximum(1, np.rint(np.sqrt(blobs.areas[keep] / np.pi))).astype(np.int64)
@@ -346,7 +372,7 @@ def localize(
         found_r = np.concatenate([found_r, radius[chosen]])
         if len(found_r) >= params["n_top"]:
             break
-        clear_found(wcm, raw, centres[chosen], radius[chosen])
+        clear_found(wcm, raw, centres[chosen], radius[chosen], region)
     return best_candidates(cm, found_c, found_r, params["n_top"])
 
 

@@ -65,7 +65,9 @@ def prefix_tables(channel: np.ndarray, dtype: type = np.int32) -> np.ndarray:
     range; differences of entries stay exact modulo it.
     """
     height, width = channel.shape
-    stack = np.zeros((2, height + 1, width + 1), dtype)
+    stack = np.empty((2, height + 1, width + 1), dtype)
+    stack[:, 0] = 0
+    stack[:, :, 0] = 0
     fill_tables(channel, stack[PREFIX], stack[INTEGRAL])
     return stack
 
@@ -73,7 +75,8 @@ def prefix_tables(channel: np.ndarray, dtype: type = np.int32) -> np.ndarray:
 @njit(cache=True, nogil=True)
 def fill_tables(channel, prefix, integral):
     """Row prefix sums of ``channel`` into ``prefix`` and their running column sums into
-    ``integral`` (both zero on entry), in one pass over the rows; integer stores wrap."""
+    ``integral`` (row 0 and column 0 zero on entry, the rest is written), in one pass over the
+    rows; integer stores wrap."""
     height, width = channel.shape
     for y in range(height):
         total = 0
