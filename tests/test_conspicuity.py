@@ -97,7 +97,8 @@ def test_prefix_tables_are_row_prefixes_and_their_column_integrals():
 
 def radius_inputs(tables, pad, radius, margin, row):
     """What the kernel combines for one radius on one image row: the four quarter staircases
-    summed into buffers, the flat tables and the flat starts of the shared and corner entries."""
+    summed into buffers, the flat tables and the flat starts of the shared, corner and margin
+    entries (None with margin 0)."""
     plan = cs.kernel_plan((radius,), margin)
     count = tables.shape[2] - 1 - 2 * pad
     base = (pad + 1 + row) * tables.shape[2] + pad
@@ -106,9 +107,14 @@ def radius_inputs(tables, pad, radius, margin, row):
     offsets = ck.flat_offsets(plan.light_terms, tables.shape)
     for w, (a, b) in enumerate(pairwise(plan.light_starts)):
         ck.window_sum(flat, offsets, a, plan.light_mids[w], b, base, count, stairs[w])
-    shared = ck.flat_offsets(np.array(cs.SHARED_TERMS), tables.shape)
-    corners = ck.flat_offsets(plan.corners[0], tables.shape)
-    return stairs, flat, tuple(int(base + o) for o in shared), tuple(int(base + o) for o in corners)
+    shared, corners = (
+        tuple(int(base + o) for o in ck.flat_offsets(np.asarray(terms), tables.shape))
+        for terms in (cs.SHARED_TERMS, plan.corners[0])
+    )
+    margins = None
+    if plan.margins is not None:
+        margins = tuple(int(base + o) for o in ck.flat_offsets(plan.margins[0], tables.shape))
+    return stairs, flat, shared, corners, margins
 
 
 def row_features(channel, radius, margin, row, use_min=False, dtype=np.int32):
@@ -118,8 +124,8 @@ def row_features(channel, radius, margin, row, use_min=False, dtype=np.int32):
     count = channel.shape[1]
     disk, contrast = np.zeros(count, np.int64), np.zeros(count, np.int64)
     nq, nb = cs.quarter_disk_size(radius), (radius + margin + 1) ** 2
-    stairs, flat, shared, corners = radius_inputs(tables, pad, radius, margin, row)
-    ck.light_features(stairs, flat, shared, corners, nq, nb, use_min, count, disk, contrast, dtype)
+    inputs = radius_inputs(tables, pad, radius, margin, row)
+    ck.light_features(*inputs, nq, nb, use_min, count, disk, contrast, dtype)
     return disk, contrast
 
 
@@ -395,17 +401,14 @@ def test_fused_combination_equals_the_integer_steps_bit_for_bit(shared_datasets)
         count = image.shape[1]
         for k, radius in enumerate(plan.radii):
             nq, nb = int(plan.n_quarter[k]), int(plan.n_box[k])
-            stairs, flat, shared, corners = radius_inputs(light, pad, int(radius), 0, 30)
+            inputs = radius_inputs(light, pad, int(radius), 0, 30)
             inner, outer = (disk_row(cs.saturation(image), r, 30) for r in (radius, 2 * radius))
             start = rng.uniform(0, 1e-5, count).astype(np.float32)
             results = []
             for exact in (np.float32, np.int64):
                 best = (start.copy(), np.zeros(count, np.int32))
                 ck.unit_max_product(
-                    stairs,
-                    flat,
-                    shared,
-                    corners,
+                    *inputs,
                     inner,
                     outer,
                     nq,
@@ -419,9 +422,7 @@ def test_fused_combination_equals_the_integer_steps_bit_for_bit(shared_datasets)
                 )
                 results.append(best)
             disk, contrast = np.zeros(count, np.int64), np.zeros(count, np.int64)
-            ck.light_features(
-                stairs, flat, shared, corners, nq, nb, False, count, disk, contrast, np.int16
-            )
+            ck.light_features(*inputs, nq, nb, False, count, disk, contrast, np.int16)
             features, product = np.zeros((3, count), np.float32), np.zeros(count, np.float32)
             features[0] = disk.astype(np.float32) * plan.scales[k, 0]
             features[1] = contrast.astype(np.float32) * plan.scales[k, 1]

@@ -201,8 +201,9 @@ def corner_terms(radius: int, half_side: int) -> tuple[tuple[int, int, int], ...
     left of the disk; the column integrals above and below the disk's centre-column run (these
     close the four quarters with :data:`SHARED_TERMS` and :func:`stair_plan`, and with the
     centre row give the axes term, minus the centre column and the two centre-row runs the
-    quarters share); then the corners of the four quadrant boxes of A1 + A2, up-right,
-    up-left, down-left, down-right (Eq. 3.8), three or four each beside the shared ones.
+    quarters share); then the outer corners of the quadrant boxes of A1 + A2 (Eq. 3.8): two
+    each of the up-right, up-left, down-left and down-right box. With :func:`margin_terms` and
+    :data:`SHARED_TERMS` these close the boxes.
     """
     r, s = radius, half_side
     return (
@@ -214,17 +215,22 @@ def corner_terms(radius: int, half_side: int) -> tuple[tuple[int, int, int], ...
         (INTEGRAL, r, 1),
         (INTEGRAL, 0, s + 1),
         (INTEGRAL, -s - 1, s + 1),
-        (INTEGRAL, -s - 1, 0),
-        (INTEGRAL, -s - 1, 1),
         (INTEGRAL, 0, -s),
         (INTEGRAL, -s - 1, -s),
-        (INTEGRAL, s, 1),
         (INTEGRAL, s, -s),
         (INTEGRAL, -1, -s),
         (INTEGRAL, s, s + 1),
         (INTEGRAL, -1, s + 1),
-        (INTEGRAL, s, 0),
     )
+
+
+def margin_terms(half_side: int) -> tuple[tuple[int, int, int], ...]:
+    """The quadrant boxes' entries on the centre column's edges, above and below the box
+    (plane, dy, dc): left and right of the centre column at the top, then at the bottom. With
+    margin 0 (``half_side`` = radius) they are :func:`corner_terms`' own column entries and are
+    not read again."""
+    s = half_side
+    return ((INTEGRAL, -s - 1, 0), (INTEGRAL, -s - 1, 1), (INTEGRAL, s, 0), (INTEGRAL, s, 1))
 
 
 def kernel_terms(plan) -> list[tuple[int, int, int, int]]:
@@ -247,6 +253,7 @@ class KernelPlan:
     light_starts: np.ndarray
     light_mids: np.ndarray
     corners: np.ndarray
+    margins: np.ndarray | None
     sat_terms: np.ndarray
     sat_starts: np.ndarray
     sat_mids: np.ndarray
@@ -300,6 +307,7 @@ def kernel_plan(radii: tuple[int, ...], margin: int) -> KernelPlan:
         light_starts,
         positive_ends(light_terms, light_starts),
         np.array([corner_terms(r, r + margin) for r in radii], np.int32),
+        np.array([margin_terms(r + margin) for r in radii], np.int32) if margin else None,
         sat_terms,
         sat_starts,
         positive_ends(sat_terms, sat_starts),
@@ -455,6 +463,9 @@ def products_on_runs(
         plan.light_mids,
         flat_offsets(np.array(SHARED_TERMS), light_tables.shape),
         flat_offsets(plan.corners.reshape(-1, 3), light_tables.shape).reshape(len(radii), -1),
+        None
+        if plan.margins is None
+        else flat_offsets(plan.margins.reshape(-1, 3), light_tables.shape).reshape(len(radii), -1),
         flat_offsets(plan.sat_terms, sat_tables.shape),
         plan.sat_starts,
         plan.sat_mids,

@@ -38,6 +38,8 @@ from itertools import pairwise
 
 import numpy as np
 from numba import njit
+from numba.core import types
+from numba.extending import overload
 
 #: Plane of a channel's table stack: the row prefix sums, and their column integrals.
 PREFIX, INTEGRAL = range(2)
@@ -191,31 +193,56 @@ def _at(flat, start, x):
     return flat[np.uint64(start + x)]
 
 
+def _box_columns(flat, margin, x, columns):
+    """The entries of the quadrant boxes' centre-column edges beyond the centre row (top left,
+    top right, bottom left, bottom right of the centre column): with margin 0 they are the
+    quarters' own ``columns``, otherwise read at the flat starts ``margin``. (Compiled only
+    through its overload, chosen by the type of ``margin``.)"""
+
+
+@overload(_box_columns, inline="always")
+def _box_columns_overload(flat, margin, x, columns):
+    """:func:`_box_columns` without a read when ``margin`` is None (margin 0)."""
+    if isinstance(margin, types.NoneType):
+        return lambda flat, margin, x, columns: columns
+    return lambda flat, margin, x, columns: (
+        _at(flat, margin[0], x),
+        _at(flat, margin[1], x),
+        _at(flat, margin[2], x),
+        _at(flat, margin[3], x),
+    )
+
+
 @njit(cache=True, nogil=True, inline="always")
-def _light_windows(stairs, flat, s, c, x, wrap):
+def _light_windows(stairs, flat, s, c, m, x, wrap):
     """The nine lightness window sums of one radius at pixel ``x`` of a run, each wrapped to the
     tables' integer type ``wrap`` (exact, see the module notes): the quarters of A1 (Eq. 3.7
     numerators), the quadrant boxes of A1 + A2 (Eq. 3.8) and the axes term that rebuilds the
     full disk from the quarters.
 
     ``stairs`` holds the quarters' staircase rows (``conspicuity.stair_plan``), ``s`` the flat
-    starts of the ``SHARED_TERMS`` entries and ``c`` those of the radius's ``corner_terms``
-    (``conspicuity.py``); every entry is read once and shared by the windows that use it.
+    starts of the ``SHARED_TERMS`` entries, ``c`` those of the radius's ``corner_terms`` and
+    ``m`` those of its ``margin_terms`` (None with margin 0, where the quarters' column entries
+    serve the boxes too) (``conspicuity.py``); every entry is read once and shared by the
+    windows that use it.
     """
     p0, p1 = _at(flat, s[0], x), _at(flat, s[1], x)
     e0, e1, g0, g1 = _at(flat, s[2], x), _at(flat, s[3], x), _at(flat, s[4], x), _at(flat, s[5], x)
     right, left = _at(flat, c[0], x), _at(flat, c[1], x)
     top0, top1 = _at(flat, c[2], x), _at(flat, c[3], x)
     bottom0, bottom1 = _at(flat, c[4], x), _at(flat, c[5], x)
+    box_top0, box_top1, box_bottom0, box_bottom1 = _box_columns(
+        flat, m, x, (top0, top1, bottom0, bottom1)
+    )
     return (
         wrap(stairs[0, x] + right - e0 + top0),
         wrap(stairs[1, x] - left + e1 - top1),
         wrap(stairs[2, x] - left + bottom1 - g1),
         wrap(stairs[3, x] + right - bottom0 + g0),
-        wrap(_at(flat, c[6], x) - _at(flat, c[7], x) - e0 + _at(flat, c[8], x)),
-        wrap(e1 - _at(flat, c[9], x) - _at(flat, c[10], x) + _at(flat, c[11], x)),
-        wrap(_at(flat, c[12], x) - g1 - _at(flat, c[13], x) + _at(flat, c[14], x)),
-        wrap(_at(flat, c[15], x) - _at(flat, c[16], x) - _at(flat, c[17], x) + g0),
+        wrap(_at(flat, c[6], x) - _at(flat, c[7], x) - e0 + box_top0),
+        wrap(e1 - box_top1 - _at(flat, c[8], x) + _at(flat, c[9], x)),
+        wrap(box_bottom1 - g1 - _at(flat, c[10], x) + _at(flat, c[11], x)),
+        wrap(_at(flat, c[12], x) - _at(flat, c[13], x) - box_bottom0 + g0),
         wrap((left - right) + (p0 - p1) + (top1 - top0) + (bottom0 - bottom1)),
     )
 
@@ -238,11 +265,11 @@ def _disk_and_contrast(w, n_quarter, n_box, use_min, exact):
 
 
 @njit(cache=True, nogil=True)
-def light_features(stairs, flat, s, c, n_quarter, n_box, use_min, count, disk, contrast, wrap):
+def light_features(stairs, flat, s, c, m, n_quarter, n_box, use_min, count, disk, contrast, wrap):
     """The A1 sums and the integer contrasts of one radius over a run (in int64), see
     :func:`_disk_and_contrast`."""
     for x in range(count):
-        w = _light_windows(stairs, flat, s, c, x, wrap)
+        w = _light_windows(stairs, flat, s, c, m, x, wrap)
         disk[x], contrast[x] = _disk_and_contrast(w, n_quarter, n_box, use_min, np.int64)
 
 
@@ -293,6 +320,7 @@ def unit_max_product(
     flat,
     s,
     c,
+    m,
     inner,
     outer,
     n_quarter,
@@ -318,7 +346,7 @@ def unit_max_product(
     ``contract`` lets the compiler fuse only the multiply-subtracts of the exact integer
     contrasts, whose float32 results are exact either way."""
     for x in range(count):
-        w = _light_windows(stairs, flat, s, c, x, wrap)
+        w = _light_windows(stairs, flat, s, c, m, x, wrap)
         disk, contrast = _disk_and_contrast(w, n_quarter, n_box, False, exact)
         product = (np.float32(disk) * scales[0]) * (np.float32(contrast) * scales[1])
         ring = np.float32(exact(outer[x]) - exact(inner[x]))
@@ -360,10 +388,24 @@ def _corner_starts(offsets, k, base):
         base + o[11],
         base + o[12],
         base + o[13],
-        base + o[14],
-        base + o[15],
-        base + o[16],
-        base + o[17],
+    )
+
+
+def _margin_starts(offsets, k, base):
+    """The flat starts of radius index ``k``'s ``margin_terms`` for a run starting at ``base``,
+    None when ``offsets`` is None (margin 0). (Compiled only through its overload.)"""
+
+
+@overload(_margin_starts, inline="always")
+def _margin_starts_overload(offsets, k, base):
+    """:func:`_margin_starts`, chosen by the type of ``offsets``."""
+    if isinstance(offsets, types.NoneType):
+        return lambda offsets, k, base: None
+    return lambda offsets, k, base: (
+        base + offsets[k, 0],
+        base + offsets[k, 1],
+        base + offsets[k, 2],
+        base + offsets[k, 3],
     )
 
 
@@ -378,6 +420,7 @@ def best_products(
     light_mids,
     shared_offsets,
     corner_offsets,
+    margin_offsets,
     sat_offsets,
     sat_starts,
     sat_mids,
@@ -411,9 +454,10 @@ def best_products(
         each radius, window ``w`` of radius index ``k`` spanning
         ``light_starts[k * LIGHT_WINDOWS + w]`` to the next start, its positive terms ending at
         ``light_mids[k * LIGHT_WINDOWS + w]``.
-    shared_offsets, corner_offsets : ndarray
+    shared_offsets, corner_offsets, margin_offsets : ndarray
         Flat offsets of the single lightness entries the windows share: (6,) for every radius,
-        (R, 18) per radius (``SHARED_TERMS`` and ``corner_terms`` in ``conspicuity.py``).
+        (R, 14) and (R, 4) per radius (``SHARED_TERMS``, ``corner_terms`` and ``margin_terms``
+        in ``conspicuity.py``); ``margin_offsets`` is None with margin 0.
     sat_offsets, sat_starts, sat_mids : ndarray
         The same as ``light_*`` for the bands of the saturation disks, band ``b`` spanning
         ``sat_starts[b:b + 2]``.
@@ -452,7 +496,6 @@ def best_products(
         base = (pad + 1 + i) * sat_tables.shape[2] + pad + x0
         for d in range(sat.shape[0]):
             total = sat[d]
-            total[:count] = 0
             for b in range(sat_bands[d], sat_bands[d + 1]):
                 window_sum(
                     sat_flat,
@@ -464,6 +507,10 @@ def best_products(
                     count,
                     band,
                 )
+                if b == sat_bands[d]:
+                    for x in range(count):
+                        total[x] = band[x]
+                    continue
                 for x in range(count):
                     total[x] += band[x]
         shared = _shared_starts(shared_offsets, base)
@@ -481,6 +528,7 @@ def best_products(
                     stairs[w],
                 )
             corners = _corner_starts(corner_offsets, k, base)
+            margins = _margin_starts(margin_offsets, k, base)
             inner, outer = sat[sat_inner[k]], sat[sat_outer[k]]
             if fused:
                 unit_max_product(
@@ -488,6 +536,7 @@ def best_products(
                     light_flat,
                     shared,
                     corners,
+                    margins,
                     inner,
                     outer,
                     n_quarter[k],
@@ -506,6 +555,7 @@ def best_products(
                 light_flat,
                 shared,
                 corners,
+                margins,
                 n_quarter[k],
                 n_box[k],
                 use_min,
