@@ -461,3 +461,16 @@ def test_one_pass_conversion_equals_opencv_lightness_and_saturation(shared_datas
         light, sat = lightness_and_saturation(image)
         assert np.array_equal(light, cs.lightness(image))
         assert np.array_equal(sat, cs.saturation(image))
+
+
+def test_workspace_reuses_buffers_but_returned_maps_are_fresh():
+    first, second = random_image(10), lit_disk(4)
+    kept = cs.conspicuity_map(first)
+    expected = kept.values.copy()
+    cs.conspicuity_map(second)
+    assert np.array_equal(kept.values, expected)
+    space = cs.Workspace()
+    a = space.array("x", (4, 5), np.int16)
+    assert space.array("x", (2, 3), np.uint8).ctypes.data == a.ctypes.data
+    tables = cs.channel_tables(first, list(range(1, 11)), 0, space)
+    assert np.array_equal(tables[0], cs.channel_tables(first, list(range(1, 11)), 0)[0])

@@ -52,10 +52,13 @@ _LIGHTNESS = _lightness_table()
 _SATURATION = _saturation_table()
 
 
-def lightness_and_saturation(image: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """OpenCV's 8-bit CIELab L and HSV S of a BGR uint8 image, as two uint8 (H, W) arrays."""
-    light = np.empty(image.shape[:2], np.uint8)
-    sat = np.empty(image.shape[:2], np.uint8)
+def lightness_and_saturation(
+    image: np.ndarray, light: np.ndarray | None = None, sat: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """OpenCV's 8-bit CIELab L and HSV S of a BGR uint8 image, as two uint8 (H, W) arrays
+    (written into ``light`` and ``sat`` when given)."""
+    light = np.empty(image.shape[:2], np.uint8) if light is None else light
+    sat = np.empty(image.shape[:2], np.uint8) if sat is None else sat
     _convert(image, _Y_WEIGHTS, _LIGHTNESS, _SATURATION, light, sat)
     return light, sat
 

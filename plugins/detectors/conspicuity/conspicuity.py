@@ -61,12 +61,17 @@ from tsrkit_plugins.detectors.conspicuity.conspicuity_kernel import (
     positive_ends,
     prefix_tables,
 )
+from tsrkit_plugins.detectors.conspicuity.workspace import Workspace
 from tsrkit_plugins.detectors.localization import (
     LOCALIZATION_PARAMS,
     ROI_PARAM,
     localize,
     region_of_interest,
 )
+
+#: The scratch arrays of :func:`conspicuity_map`, one set per thread (``workspace.py``); the
+#: arrays it returns are never among them.
+WORKSPACE = Workspace()
 
 #: Quadrant directions as (vertical sign, horizontal sign): up-right, up-left, down-left,
 #: down-right (Figure 3-7).
@@ -100,9 +105,10 @@ def quarter_disk_size(radius: int) -> int:
     return sum(h + 1 for h in half_widths(radius))
 
 
-def mirror(channel: np.ndarray, pad: int) -> np.ndarray:
-    """The channel with ``pad`` mirrored pixels on every side (reflect-101)."""
-    return cv2.copyMakeBorder(channel, pad, pad, pad, pad, cv2.BORDER_REFLECT_101)
+def mirror(channel: np.ndarray, pad: int, out: np.ndarray | None = None) -> np.ndarray:
+    """The channel with ``pad`` mirrored pixels on every side (reflect-101), written into
+    ``out`` when given."""
+    return cv2.copyMakeBorder(channel, pad, pad, pad, pad, cv2.BORDER_REFLECT_101, dst=out)
 
 
 def compile_terms(runs: Sequence[tuple[int, int, int]]):
@@ -395,7 +401,7 @@ def conspicuity_map(
         raise ValueError(
             f"expected a BGR uint8 image of shape (H, W, 3); got {image.dtype} {image.shape}"
         )
-    light_tables, sat_tables, pad = channel_tables(image, radii, margin)
+    light_tables, sat_tables, pad = channel_tables(image, radii, margin, WORKSPACE)
     best, best_radius = products_on_runs(
         light_tables,
         sat_tables,
@@ -405,6 +411,7 @@ def conspicuity_map(
         weights,
         margin,
         quadrant_rule,
+        WORKSPACE,
     )
     return ConspicuityMap(weighted_root(best, weights), best_radius)
 
@@ -421,19 +428,33 @@ def narrow_sums(radii: Sequence[int], margin: int) -> bool:
 
 
 def channel_tables(
-    image: np.ndarray, radii: Sequence[int], margin: int
+    image: np.ndarray, radii: Sequence[int], margin: int, workspace: Workspace | None = None
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """Prefix tables of the mirrored lightness and saturation (int16 and uint16 with
     :func:`narrow_sums`, int32 otherwise), with the padding they need. The channels are those
-    of :func:`lightness` and :func:`saturation`, converted in one pass (``colour.py``)."""
+    of :func:`lightness` and :func:`saturation`, converted in one pass (``colour.py``). With a
+    ``workspace`` every array, the tables included, is one of its buffers."""
     pad = max(2 * max(radii), max(radii) + margin)
     narrow = narrow_sums(radii, margin)
-    light, sat = lightness_and_saturation(image)
-    return (
-        prefix_tables(mirror(light, pad), np.int16 if narrow else np.int32),
-        prefix_tables(mirror(sat, pad), np.uint16 if narrow else np.int32),
-        pad,
+    height, width = image.shape[:2]
+    padded = (height + 2 * pad, width + 2 * pad)
+
+    def scratch(key, shape, dtype):
+        return None if workspace is None else workspace.array(key, shape, dtype)
+
+    channels = lightness_and_saturation(
+        image,
+        scratch("light", (height, width), np.uint8),
+        scratch("sat", (height, width), np.uint8),
     )
+    tables = []
+    for name, channel, dtype in zip(
+        ("light", "sat"), channels, (np.int16, np.uint16) if narrow else (np.int32, np.int32)
+    ):
+        mirrored = mirror(channel, pad, scratch(f"{name} mirrored", padded, np.uint8))
+        stack = scratch(f"{name} tables", (2, padded[0] + 1, padded[1] + 1), dtype)
+        tables.append(prefix_tables(mirrored, dtype, stack))
+    return tables[0], tables[1], pad
 
 
 def products_on_runs(
@@ -445,13 +466,18 @@ def products_on_runs(
     weights: Sequence[float],
     margin: int,
     quadrant_rule: str,
+    workspace: Workspace | None = None,
 ):
     """Eq. 3.1 under its root, maximised over the radii (Eq. 3.2), on the pixels of ``runs``;
-    returns the float32 maximum (0 elsewhere) and the int32 arg-max radius (smallest radius
-    elsewhere and on ties)."""
+    returns the float32 maximum (0 elsewhere; a ``workspace`` buffer when one is given) and
+    the int32 arg-max radius (smallest radius elsewhere and on ties)."""
     shape = (sat_tables.shape[1] - 1 - 2 * pad, sat_tables.shape[2] - 1 - 2 * pad)
     plan = kernel_plan(tuple(radii), margin)
-    best = np.zeros(shape, np.float32)
+    if workspace is None:
+        best = np.zeros(shape, np.float32)
+    else:
+        best = workspace.array("best", shape, np.float32)
+        best.fill(0)
     best_radius = np.full(shape, min(radii), np.int32)
     best_products(
         light_tables,

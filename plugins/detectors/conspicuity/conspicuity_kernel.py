@@ -58,16 +58,19 @@ BAND_PIXELS = np.iinfo(np.uint16).max // 255
 LIGHT_WINDOWS = 4
 
 
-def prefix_tables(channel: np.ndarray, dtype: type = np.int32) -> np.ndarray:
+def prefix_tables(
+    channel: np.ndarray, dtype: type = np.int32, out: np.ndarray | None = None
+) -> np.ndarray:
     """Row prefix sums of a mirrored uint8 channel and their column integrals, stacked.
 
     ``table[PREFIX, y, c]`` is the sum of padded row ``y - 1`` left of column ``c`` (row 0 and
     column 0 are zero); ``table[INTEGRAL]`` sums the prefix rows ``0..y``. Entries are stored
     in ``dtype`` (int32, or int16 for :data:`NARROW_PIXELS` windows) and wrap modulo its
-    range; differences of entries stay exact modulo it.
+    range; differences of entries stay exact modulo it. Written into ``out`` (of that shape
+    and type) when given.
     """
     height, width = channel.shape
-    stack = np.empty((2, height + 1, width + 1), dtype)
+    stack = np.empty((2, height + 1, width + 1), dtype) if out is None else out
     stack[:, 0] = 0
     stack[:, :, 0] = 0
     fill_tables(channel, stack[PREFIX], stack[INTEGRAL])
