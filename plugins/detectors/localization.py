@@ -148,19 +148,14 @@ def peak_region(mask: np.ndarray) -> tuple[slice, slice]:
     return slice(max(y - 1, 0), y + h + 1), slice(max(x - 1, 0), x + w + 1)
 
 
-def denoise(mask: np.ndarray, region: tuple[slice, slice] | None = None) -> np.ndarray:
+def denoise(mask: np.ndarray) -> np.ndarray:
     """Eq. 3.15: morphological opening with the radius-1 disk.
 
-    Only ``region`` (:func:`peak_region` of ``mask``, found when not given) is opened, the rest
-    is 0: outside the set pixels' rectangle the opening is 0, and its one-pixel frame of zeros
-    (or the image border, handled alike) gives the pixels inside the same neighbours.
+    ``localize`` opens only :func:`peak_region` of the raw peaks: outside the set pixels'
+    rectangle the opening is 0, and the rectangle's one-pixel frame of zeros (or the image
+    border, handled alike) gives the pixels inside the same neighbours.
     """
-    rows, cols = peak_region(mask) if region is None else region
-    opened = np.zeros_like(mask)
-    if rows.stop > rows.start:
-        part = np.ascontiguousarray(mask[rows, cols])
-        opened[rows, cols] = cv2.morphologyEx(part, cv2.MORPH_OPEN, DISK_1)
-    return opened
+    return cv2.morphologyEx(mask, cv2.MORPH_OPEN, DISK_1)
 
 
 @dataclass(frozen=True)
@@ -172,8 +167,9 @@ class Components:
     centroids: np.ndarray
 
 
-def components(mask: np.ndarray) -> Components:
-    """Step 2.1: 8-connected components of a binary mask (background excluded).
+def components(mask: np.ndarray, origin: tuple[int, int] = (0, 0)) -> Components:
+    """Step 2.1: 8-connected components of a binary mask (background excluded), in the
+    coordinates of a frame in which ``mask`` starts at ``origin`` = (x, y).
 
     Labelling runs on the bounding rectangle of the set pixels only (the peaks are sparse).
     """
@@ -183,6 +179,7 @@ def components(mask: np.ndarray) -> Components:
     _, _, stats, centroids = cv2.connectedComponentsWithStats(
         np.ascontiguousarray(mask[y : y + h, x : x + w]), connectivity=8
     )
+    x, y = x + origin[0], y + origin[1]
     boxes = stats[1:, :4] + np.array([x, y, 0, 0])
     return Components(boxes, stats[1:, cv2.CC_STAT_AREA], centroids[1:] + np.array([x, y]))
 
@@ -358,7 +355,8 @@ def localize(
         normalise(wcm, peak)
         raw = peak_mask(wcm, params["h_peak"])
         region = peak_region(raw)
-        blobs = components(denoise(raw, region))
+        opened = denoise(np.ascontiguousarray(raw[region]))
+        blobs = components(opened, (region[1].start, region[0].start))
         keep = shape_filter(blobs, params["asp_min"], params["pd_min"])
         starts = blobs.centroids[keep][:, ::-1]
         sizes = np.maximum(1, np.rint(np.sqrt(blobs.areas[keep] / np.pi))).astype(np.int64)
