@@ -335,11 +335,14 @@ def full_runs(height: int, width: int) -> np.ndarray:
     return runs
 
 
-def weighted_root(product: np.ndarray, weights: Sequence[float]) -> np.ndarray:
+def weighted_root(
+    product: np.ndarray, weights: Sequence[float], out: np.ndarray | None = None
+) -> np.ndarray:
     """The ``(w_L + w_LC + w_S)``-th root of Eq. 3.1; with the product of the weighted features
     (``conspicuity_kernel.weighted_product``) this is the weighted geometric mean whose pixel
-    ratios do not change when a feature is rescaled (Appendix A)."""
-    return np.power(product, 1.0 / float(sum(weights)), dtype=np.float32)
+    ratios do not change when a feature is rescaled (Appendix A). Written into ``out`` (which
+    may be ``product``) when given."""
+    return np.power(product, 1.0 / float(sum(weights)), dtype=np.float32, out=out)
 
 
 @dataclass(frozen=True)
@@ -366,6 +369,8 @@ def conspicuity_map(
     weights: Sequence[float] = (1.0, 1.0, 1.0),
     margin: int = 0,
     quadrant_rule: str = "max",
+    *,
+    scratch: bool = False,
 ) -> ConspicuityMap:
     """Eq. 3.1-3.12 on every pixel of a BGR uint8 image.
 
@@ -381,6 +386,9 @@ def conspicuity_map(
         The A2 margin ``m`` (Table 5-1: 0).
     quadrant_rule : {"max", "min"}
         How Eq. 3.5 combines the quadrants (see the module notes).
+    scratch : bool
+        Return the calling thread's :data:`WORKSPACE` buffers, valid only until its next
+        call, instead of new arrays (the detector's own use: its map never leaves ``detect``).
 
     Returns
     -------
@@ -402,18 +410,23 @@ def conspicuity_map(
             f"expected a BGR uint8 image of shape (H, W, 3); got {image.dtype} {image.shape}"
         )
     light_tables, sat_tables, pad = channel_tables(image, radii, margin, WORKSPACE)
-    best, best_radius = products_on_runs(
+    shape = image.shape[:2]
+    best = WORKSPACE.array("best", shape, np.float32)
+    best_radius = (
+        WORKSPACE.array("radius", shape, np.int32) if scratch else np.empty(shape, np.int32)
+    )
+    products_on_runs(
         light_tables,
         sat_tables,
         pad,
-        full_runs(*image.shape[:2]),
+        full_runs(*shape),
         radii,
         weights,
         margin,
         quadrant_rule,
-        WORKSPACE,
+        (best, best_radius),
     )
-    return ConspicuityMap(weighted_root(best, weights), best_radius)
+    return ConspicuityMap(weighted_root(best, weights, best if scratch else None), best_radius)
 
 
 def narrow_sums(radii: Sequence[int], margin: int) -> bool:
@@ -466,19 +479,18 @@ def products_on_runs(
     weights: Sequence[float],
     margin: int,
     quadrant_rule: str,
-    workspace: Workspace | None = None,
+    out: tuple[np.ndarray, np.ndarray] | None = None,
 ):
     """Eq. 3.1 under its root, maximised over the radii (Eq. 3.2), on the pixels of ``runs``;
-    returns the float32 maximum (0 elsewhere; a ``workspace`` buffer when one is given) and
-    the int32 arg-max radius (smallest radius elsewhere and on ties)."""
+    returns the float32 maximum (0 elsewhere) and the int32 arg-max radius (smallest radius
+    elsewhere and on ties), written into the two arrays of ``out`` when given."""
     shape = (sat_tables.shape[1] - 1 - 2 * pad, sat_tables.shape[2] - 1 - 2 * pad)
     plan = kernel_plan(tuple(radii), margin)
-    if workspace is None:
-        best = np.zeros(shape, np.float32)
-    else:
-        best = workspace.array("best", shape, np.float32)
-        best.fill(0)
-    best_radius = np.full(shape, min(radii), np.int32)
+    if out is None:
+        out = (np.empty(shape, np.float32), np.empty(shape, np.int32))
+    best, best_radius = out
+    best.fill(0)
+    best_radius.fill(min(radii))
     best_products(
         light_tables,
         sat_tables,
@@ -570,7 +582,9 @@ class Conspicuity(Detector):
         """Candidates, best first, each scored by its conspicuity with its arg-max radius."""
         p = self.params
         roi = region_of_interest(frame.image, p["roi_top"])
-        cmap = conspicuity_map(roi, p["radii"], p["weights"], p["margin"], p["quadrant_rule"])
+        cmap = conspicuity_map(
+            roi, p["radii"], p["weights"], p["margin"], p["quadrant_rule"], scratch=True
+        )
         return localize(cmap.values, p, radius_map=cmap.radius)
 
 
