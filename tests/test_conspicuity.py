@@ -316,6 +316,15 @@ def test_map_does_not_depend_on_how_the_rows_are_split_into_runs():
         *tables, pieces[pieces[:, 1] == 7], list(range(1, 11)), (1.0, 1.0, 1.0), 0, "max"
     )
     assert np.array_equal(partial[0][:, 7], whole[0][:, 7]) and not partial[0][:, 8:].any()
+    # Output arrays holding anything: every pixel of the runs is written.
+    garbage = (np.full((30, 41), np.nan, np.float32), np.full((30, 41), 99, np.int32))
+    cs.products_on_runs(
+        *tables, cs.full_runs(30, 41), list(range(1, 11)), (1.0, 2.0, 1.0), 0, "max", garbage
+    )
+    expected = cs.products_on_runs(
+        *tables, cs.full_runs(30, 41), list(range(1, 11)), (1.0, 2.0, 1.0), 0, "max"
+    )
+    assert np.array_equal(garbage[0], expected[0]) and np.array_equal(garbage[1], expected[1])
 
 
 def test_lightness_windows_are_exact_in_int16_at_their_largest():
@@ -417,6 +426,7 @@ def test_fused_combination_equals_the_integer_steps_bit_for_bit(shared_datasets)
                     radius,
                     count,
                     *best,
+                    False,
                     np.int16,
                     exact,
                 )
@@ -431,7 +441,7 @@ def test_fused_combination_equals_the_integer_steps_bit_for_bit(shared_datasets)
             )
             ck.weighted_product(*features, np.ones(3, np.float32), count, product)
             steps = (start.copy(), np.zeros(count, np.int32))
-            ck.keep_best(product, radius, count, *steps)
+            ck.keep_best(product, radius, count, *steps, False)
             for fused in results:
                 assert np.array_equal(fused[0], steps[0]) and np.array_equal(fused[1], steps[1])
             assert np.count_nonzero(steps[1]) > count // 10

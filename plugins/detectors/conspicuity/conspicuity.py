@@ -483,14 +483,13 @@ def products_on_runs(
 ):
     """Eq. 3.1 under its root, maximised over the radii (Eq. 3.2), on the pixels of ``runs``;
     returns the float32 maximum (0 elsewhere) and the int32 arg-max radius (smallest radius
-    elsewhere and on ties), written into the two arrays of ``out`` when given."""
+    elsewhere and on ties). With ``out``, the two arrays are written on the runs' pixels and
+    left as they are elsewhere."""
     shape = (sat_tables.shape[1] - 1 - 2 * pad, sat_tables.shape[2] - 1 - 2 * pad)
     plan = kernel_plan(tuple(radii), margin)
     if out is None:
-        out = (np.empty(shape, np.float32), np.empty(shape, np.int32))
+        out = (np.zeros(shape, np.float32), np.full(shape, min(radii), np.int32))
     best, best_radius = out
-    best.fill(0)
-    best_radius.fill(min(radii))
     best_products(
         light_tables,
         sat_tables,

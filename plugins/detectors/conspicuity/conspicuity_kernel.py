@@ -309,10 +309,12 @@ def _powered(feature, weight):
 
 
 @njit(cache=True, nogil=True)
-def keep_best(product, radius, count, best, best_radius):
-    """Eq. 3.2's running maximum over radii; the earlier (smaller) radius wins ties."""
+def keep_best(product, radius, count, best, best_radius, first):
+    """Eq. 3.2's running maximum over radii; the earlier (smaller) radius wins ties. At the
+    ``first`` (smallest) radius every pixel is written, whatever ``best`` held: its product
+    (never negative) is the maximum so far, as it would be over a ``best`` of zeros."""
     for x in range(count):
-        if product[x] > best[x]:
+        if first or product[x] > best[x]:
             best[x] = product[x]
             best_radius[x] = radius
 
@@ -333,6 +335,7 @@ def unit_max_product(
     count,
     best,
     best_radius,
+    first,
     wrap,
     exact,
 ):
@@ -347,14 +350,14 @@ def unit_max_product(
     2 * 10) below ``1257 * 255``, so every sum, product and difference is the same integer, in
     twice the lanes. The float32 steps after them are the same operations in the same order;
     ``contract`` lets the compiler fuse only the multiply-subtracts of the exact integer
-    contrasts, whose float32 results are exact either way."""
+    contrasts, whose float32 results are exact either way. ``first`` as in :func:`keep_best`."""
     for x in range(count):
         w = _light_windows(stairs, flat, s, c, m, x, wrap)
         disk, contrast = _disk_and_contrast(w, n_quarter, n_box, False, exact)
         product = (np.float32(disk) * scales[0]) * (np.float32(contrast) * scales[1])
         ring = np.float32(exact(outer[x]) - exact(inner[x]))
         product *= max(np.float32(inner[x]) * scales[2], ring * scales[3])
-        if product > best[x]:
+        if first or product > best[x]:
             best[x] = product
             best_radius[x] = radius
 
@@ -441,7 +444,9 @@ def best_products(
     best_radius,
 ):
     """Eq. 3.1 (under its root) for every radius and the maximum of Eq. 3.2 over the pixels
-    of ``runs``; ``best`` (zeros on entry) and ``best_radius`` are written in place.
+    of ``runs``; ``best`` and ``best_radius`` are written in place there (every pixel of the
+    runs, whatever they held: the first radius's products are the maximum so far) and left
+    as they are elsewhere.
 
     Parameters
     ----------
@@ -549,6 +554,7 @@ def best_products(
                     count,
                     best[i, x0 : x0 + count],
                     best_radius[i, x0 : x0 + count],
+                    k == 0,
                     wrap,
                     exact,
                 )
@@ -573,5 +579,10 @@ def best_products(
             saturation_feature(inner, outer, scales[k, 2], scales[k, 3], count, features[2])
             weighted_product(features[0], features[1], features[2], weights, count, product)
             keep_best(
-                product, radii[k], count, best[i, x0 : x0 + count], best_radius[i, x0 : x0 + count]
+                product,
+                radii[k],
+                count,
+                best[i, x0 : x0 + count],
+                best_radius[i, x0 : x0 + count],
+                k == 0,
             )
