@@ -487,3 +487,19 @@ def test_workspace_reuses_buffers_but_returned_maps_are_fresh():
     assert space.array("x", (2, 3), np.uint8).ctypes.data == a.ctypes.data
     tables = cs.channel_tables(first, list(range(1, 11)), 0, space)
     assert np.array_equal(tables[0], cs.channel_tables(first, list(range(1, 11)), 0)[0])
+
+
+def test_threads_get_their_own_workspace():
+    from concurrent.futures import ThreadPoolExecutor
+
+    images = [random_image(seed, (90, 120)) for seed in range(6)]
+    serial = [cs.conspicuity_map(image) for image in images]
+    detector = tsrkit.detector("conspicuity")
+    expected = [detector.detect(Frame(image, "x")) for image in images]
+    with ThreadPoolExecutor(3) as pool:
+        maps = list(pool.map(cs.conspicuity_map, images * 3))
+        found = list(pool.map(lambda image: detector.detect(Frame(image, "x")), images * 3))
+    for k, cmap in enumerate(maps):
+        assert np.array_equal(cmap.values, serial[k % 6].values)
+        assert np.array_equal(cmap.radius, serial[k % 6].radius)
+    assert found == expected * 3

@@ -32,7 +32,8 @@ quarters, saturation disks are shared between radii, the sums run in 16 bits whe
 lightness window is small enough to be exact there (:func:`narrow_sums`: int16 lightness,
 uint16 saturation in bands of rows), L and S come from one compiled pass (``colour.py``), and
 the root of Eq. 3.1 is taken once after the maximum of Eq. 3.2 (the root is monotonic, so the
-arg-max is unchanged).
+arg-max is unchanged). Intermediate arrays are per-thread buffers reused from frame to frame
+(``workspace.py``).
 ``tests/oracles/conspicuity_oracle.py`` is the direct reference these are tested against.
 """
 
