@@ -13,6 +13,7 @@ import tsrkit
 from tsrkit.types import Frame
 from tsrkit_plugins.detectors.conspicuity import conspicuity as cs
 from tsrkit_plugins.detectors.conspicuity import conspicuity_kernel as ck
+from tsrkit_plugins.detectors.conspicuity.colour import lightness_and_saturation
 
 
 def random_image(seed, shape=(44, 57)):
@@ -80,7 +81,10 @@ def window_sums(channel, pad, windows, row, dtype=np.int32):
 
 
 def test_prefix_tables_are_row_prefixes_and_their_column_integrals():
-    for channel in (cs.lightness(random_image(7)), cs.saturation(random_image(7))):
+    # Heights 44 (rows four at a time), 7 and 3 (with a tail of single rows).
+    channels = [f(random_image(7)) for f in (cs.lightness, cs.saturation)]
+    channels += [cs.saturation(random_image(7, (h, 9))) for h in (7, 3)]
+    for channel in channels:
         tables = ck.prefix_tables(channel)
         prefix, integral = tables[ck.PREFIX], tables[ck.INTEGRAL]
         rows = np.cumsum(channel, axis=1, dtype=np.int64)
@@ -90,30 +94,75 @@ def test_prefix_tables_are_row_prefixes_and_their_column_integrals():
         assert not integral[0].any() and not integral[:, 0].any()
         # int16 tables hold the same entries modulo 2**16 (they pass 32767 here).
         narrow = ck.prefix_tables(channel, np.int16)
-        assert narrow.dtype == np.int16 and tables.max() > 32767
+        assert narrow.dtype == np.int16 and (tables.max() > 32767 or channel.shape[0] < 44)
         assert np.array_equal(narrow, tables.astype(np.int16))
 
 
-def test_window_sums_are_exact_integer_sums():
+def radius_inputs(tables, pad, radius, margin, row):
+    """What the kernel combines for one radius on one image row: the four quarter staircases
+    summed into buffers, the flat tables and the flat starts of the shared, corner and margin
+    entries (None with margin 0)."""
+    plan = cs.kernel_plan((radius,), margin)
+    count = tables.shape[2] - 1 - 2 * pad
+    base = (pad + 1 + row) * tables.shape[2] + pad
+    flat = tables.reshape(-1)
+    stairs = np.zeros((ck.LIGHT_WINDOWS, count), tables.dtype)
+    offsets = ck.flat_offsets(plan.light_terms, tables.shape)
+    for w, (a, b) in enumerate(pairwise(plan.light_starts)):
+        ck.window_sum(flat, offsets, a, plan.light_mids[w], b, base, count, stairs[w])
+    shared, corners = (
+        tuple(int(base + o) for o in ck.flat_offsets(np.asarray(terms), tables.shape))
+        for terms in (cs.SHARED_TERMS, plan.corners[0])
+    )
+    margins = None
+    if plan.margins is not None:
+        margins = tuple(int(base + o) for o in ck.flat_offsets(plan.margins[0], tables.shape))
+    return stairs, flat, shared, corners, margins
+
+
+def row_features(channel, radius, margin, row, use_min=False, dtype=np.int32):
+    """The kernel's A1 sums and integer contrasts (Eq. 3.5-3.8) of one radius on one row."""
+    pad = 2 * radius + margin
+    tables = ck.prefix_tables(cs.mirror(channel, pad), dtype)
+    count = channel.shape[1]
+    disk, contrast = np.zeros(count, np.int64), np.zeros(count, np.int64)
+    nq, nb = cs.quarter_disk_size(radius), (radius + margin + 1) ** 2
+    inputs = radius_inputs(tables, pad, radius, margin, row)
+    ck.light_features(*inputs, nq, nb, use_min, count, disk, contrast, dtype)
+    return disk, contrast
+
+
+def direct_features(channel, radius, margin, row, x):
+    """The A1 sum and the integer contrast at one pixel, summed directly over masks."""
+    pad = 2 * radius + margin
+    r, s = radius, radius + margin
+    padded = cs.mirror(channel, pad).astype(np.int64)
+    cy, cx = pad + row, pad + x
+    dy, dx = np.mgrid[-s : s + 1, -s : s + 1]
+    window = padded[cy - s : cy + s + 1, cx - s : cx + s + 1]
+    disk = np.hypot(dy, dx) <= r
+    parts = []
+    for v, h in cs.QUADRANTS:
+        side = (v * dy >= 0) & (h * dx >= 0)
+        quarter, box = int(window[disk & side].sum()), int(window[side].sum())
+        parts.append((r + margin + 1) ** 2 * quarter - cs.quarter_disk_size(r) * box)
+    return int(window[disk].sum()), parts
+
+
+def test_lightness_windows_are_exact_integer_sums():
     light = cs.lightness(random_image(4))
-    padded = cs.mirror(light, 20).astype(np.int64)
-    for r in (1, 4, 10):
-        windows = [cs.quarter_plan(r, q) for q in cs.QUADRANTS] + [
-            cs.box_plan(r, (1, 1)),
-            cs.box_plan(r, (1, 1)),
-            cs.box_plan(r, (1, 1)),
-            cs.box_plan(r, (1, 1)),
-            cs.axes_plan(r),
-            cs.disk_plan(r),
-        ]
-        sums = window_sums(light, 20, windows, 7)
-        rebuilt = np.zeros(light.shape[1], np.int32)
-        ck.disk_from_quarters(sums, light.shape[1], rebuilt)
-        assert np.array_equal(rebuilt, sums[9])
-        disk = np.hypot(*np.mgrid[-r : r + 1, -r : r + 1]) <= r
-        assert int(sums[9, 9]) == int(np.sum(padded[27 - r : 28 + r, 29 - r : 30 + r] * disk))
-        assert int(sums[3, 9]) == int(np.sum(padded[27 : 28 + r, 29 : 30 + r] * disk[r:, r:]))
-        assert int(sums[4, 6]) == int(padded[27 : 28 + r, 26 : 27 + r].sum())
+    for radius, margin in ((1, 0), (4, 0), (10, 0), (3, 2)):
+        disk, contrast = row_features(light, radius, margin, 7)
+        low, _ = row_features(light, radius, margin, 7, use_min=True)
+        for x in (0, 9, 30, 56):
+            total, parts = direct_features(light, radius, margin, 7, x)
+            assert disk[x] == total and low[x] == total
+            assert contrast[x] == max(0, max(parts))
+        _, strict = row_features(light, radius, margin, 7, use_min=True)
+        assert all(
+            strict[x] == max(0, min(direct_features(light, radius, margin, 7, x)[1]))
+            for x in (0, 9, 30, 56)
+        )
 
 
 def test_window_sums_survive_wrapping_integrals():
@@ -143,20 +192,9 @@ def test_quadrant_contrast_is_zero_on_a_flat_image():
     flat = np.full((30, 40, 3), (20, 120, 200), np.uint8)
     light = cs.lightness(flat)
     for r in (1, 3, 6):
-        windows = [cs.quarter_plan(r, q) for q in cs.QUADRANTS] + [
-            cs.box_plan(r, q) for q in cs.QUADRANTS
-        ]
-        contrast = np.ones(40, np.int64)
         for use_min in (False, True):
-            ck.lightness_contrast(
-                window_sums(light, 12, windows, 5),
-                cs.quarter_disk_size(r),
-                (r + 1) ** 2,
-                use_min,
-                40,
-                contrast,
-            )
-            assert not contrast.any()
+            disk, contrast = row_features(light, r, 0, 5, use_min)
+            assert not contrast.any() and np.all(disk == int(light[0, 0]) * cs.disk_size(r))
     assert cs.conspicuity_map(flat, radii=(1, 3, 6)).values.max() < 1e-2
 
 
@@ -281,18 +319,34 @@ def test_map_does_not_depend_on_how_the_rows_are_split_into_runs():
         *tables, pieces[pieces[:, 1] == 7], list(range(1, 11)), (1.0, 1.0, 1.0), 0, "max"
     )
     assert np.array_equal(partial[0][:, 7], whole[0][:, 7]) and not partial[0][:, 8:].any()
+    # Output arrays holding anything: every pixel of the runs is written.
+    garbage = (np.full((30, 41), np.nan, np.float32), np.full((30, 41), 99, np.int32))
+    cs.products_on_runs(
+        *tables, cs.full_runs(30, 41), list(range(1, 11)), (1.0, 2.0, 1.0), 0, "max", garbage
+    )
+    expected = cs.products_on_runs(
+        *tables, cs.full_runs(30, 41), list(range(1, 11)), (1.0, 2.0, 1.0), 0, "max"
+    )
+    assert np.array_equal(garbage[0], expected[0]) and np.array_equal(garbage[1], expected[1])
 
 
 def test_lightness_windows_are_exact_in_int16_at_their_largest():
     # All-white lightness: every radius-10 window at its largest magnitude (the quadrant box
-    # 121 * 255 = 30855, the axes term -43 * 255), summed over tables that wrap many times.
+    # 121 * 255 = 30855, the axes term -43 * 255), summed over tables that wrap many times; a
+    # white half-plane gives the largest contrasts.
     white = np.full((50, 3000), 255, np.uint8)
-    windows = [cs.box_plan(10, q) for q in cs.QUADRANTS] + [cs.quarter_plan(10, (1, 1))]
-    windows.append(cs.axes_plan(10))
-    narrow = window_sums(white, 10, windows, 20, np.int16)
-    assert np.array_equal(narrow, window_sums(white, 10, windows, 20))
-    assert narrow[0, 2990] == 30855 and narrow[4, 2990] == 255 * cs.quarter_disk_size(10)
-    assert narrow[5, 2990] == -255 * (4 * 10 + 3)
+    disk, contrast = row_features(white, 10, 0, 20, dtype=np.int16)
+    assert np.all(disk == 255 * cs.disk_size(10)) and not contrast.any()
+    half = white.copy()
+    half[:, 1500:] = 0
+    for use_min in (False, True):
+        narrow = row_features(half, 10, 0, 20, use_min, np.int16)
+        wide = row_features(half, 10, 0, 20, use_min, np.int32)
+        assert np.array_equal(narrow[0], wide[0]) and np.array_equal(narrow[1], wide[1])
+        assert narrow[1][1499] == max(
+            0, (min if use_min else max)(direct_features(half, 10, 0, 20, 1499)[1])
+        )
+    assert narrow[0][1499] == direct_features(half, 10, 0, 20, 1499)[0]
 
 
 def test_saturation_disk_bands_are_exact_in_uint16_and_add_up_to_the_disk():
@@ -336,47 +390,64 @@ def test_16_bit_tables_give_the_32_bit_map_bit_for_bit(shared_datasets):
         assert narrow[0].max() > 0
 
 
-def test_fused_combination_equals_the_integer_steps_bit_for_bit():
-    # Window sums up to their 16-bit extremes; the fused pass (in float32 and in int64) against
-    # the separate int64 steps, for every radius of the paper's plan.
+def disk_row(channel, radius, row):
+    """Direct int32 disk sums of radius ``radius`` along one row of a mirrored channel."""
+    padded = cs.mirror(channel, radius).astype(np.int64)[row : row + 2 * radius + 1]
+    windows = np.lib.stride_tricks.sliding_window_view(padded, (2 * radius + 1,) * 2)[0]
+    disk = np.hypot(*np.mgrid[-radius : radius + 1, -radius : radius + 1]) <= radius
+    return (windows * disk).sum(axis=(1, 2)).astype(np.int32)
+
+
+def test_fused_combination_equals_the_integer_steps_bit_for_bit(shared_datasets):
+    # The fused pass (in float32 and in int64) against the separate int64 steps, for every
+    # radius of the paper's plan, on rows of a real frame and of a black-and-white pattern
+    # (window sums at their 16-bit extremes).
+    root = shared_datasets / "dtld_fridtjofs"
+    entry = json.loads((root / "annotations.json").read_text())[0]
+    real = cv2.imread(str(root / entry["file"]))[:60, :400]
+    pattern = np.where(random_image(8, (60, 400)) > 127, 255, 0).astype(np.uint8)
+    plan = cs.kernel_plan(tuple(range(1, 11)), 0)
     rng = np.random.default_rng(8)
-    count, plan = 4000, cs.kernel_plan(tuple(range(1, 11)), 0)
-    for k, radius in enumerate(plan.radii):
-        nq, nb = int(plan.n_quarter[k]), int(plan.n_box[k])
-        light = np.zeros((ck.LIGHT_WINDOWS, count), np.int16)
-        light[:4] = rng.integers(0, 255 * nq + 1, (4, count))
-        light[4:8] = np.minimum(
-            light[:4] + rng.integers(0, 255 * (nb - nq) + 1, (4, count)), 255 * nb
-        )
-        light[8] = -rng.integers(0, 255 * (4 * radius + 3) + 1, count)
-        inner = rng.integers(0, 255 * cs.disk_size(radius) + 1, count).astype(np.int32)
-        outer = inner + rng.integers(
-            0, 255 * (cs.disk_size(2 * radius) - cs.disk_size(radius)) + 1, count
-        ).astype(np.int32)
-        start = rng.uniform(0, 0.3, count).astype(np.float32)
-        fused = (start.copy(), np.zeros(count, np.int32))
-        wide = (start.copy(), np.zeros(count, np.int32))
-        ck.unit_max_product(
-            light, inner, outer, nq, nb, plan.scales[k], radius, count, *fused, np.float32
-        )
-        ck.unit_max_product(
-            light, inner, outer, nq, nb, plan.scales[k], radius, count, *wide, np.int64
-        )
-        contrast, disk = np.zeros(count, np.int64), np.zeros(count, np.int32)
-        features, product = np.zeros((3, count), np.float32), np.zeros(count, np.float32)
-        ck.lightness_contrast(light, nq, nb, False, count, contrast)
-        ck.disk_from_quarters(light, count, disk)
-        features[0] = disk.astype(np.float32) * plan.scales[k, 0]
-        features[1] = contrast.astype(np.float32) * plan.scales[k, 1]
-        ck.saturation_feature(
-            inner, outer, plan.scales[k, 2], plan.scales[k, 3], count, features[2]
-        )
-        ck.weighted_product(*features, np.ones(3, np.float32), count, product)
-        steps = (start.copy(), np.zeros(count, np.int32))
-        ck.keep_best(product, radius, count, *steps)
-        assert np.array_equal(fused[0], steps[0]) and np.array_equal(fused[1], steps[1])
-        assert np.array_equal(wide[0], steps[0]) and np.array_equal(wide[1], steps[1])
-        assert np.count_nonzero(fused[1]) > count // 10
+    for image in (real, pattern):
+        light, _, pad = cs.channel_tables(image, list(range(1, 11)), 0)
+        count = image.shape[1]
+        for k, radius in enumerate(plan.radii):
+            nq, nb = int(plan.n_quarter[k]), int(plan.n_box[k])
+            inputs = radius_inputs(light, pad, int(radius), 0, 30)
+            inner, outer = (disk_row(cs.saturation(image), r, 30) for r in (radius, 2 * radius))
+            start = rng.uniform(0, 1e-5, count).astype(np.float32)
+            results = []
+            for exact in (np.float32, np.int64):
+                best = (start.copy(), np.zeros(count, np.int32))
+                ck.unit_max_product(
+                    *inputs,
+                    inner,
+                    outer,
+                    nq,
+                    nb,
+                    plan.scales[k],
+                    radius,
+                    count,
+                    *best,
+                    False,
+                    np.int16,
+                    exact,
+                )
+                results.append(best)
+            disk, contrast = np.zeros(count, np.int64), np.zeros(count, np.int64)
+            ck.light_features(*inputs, nq, nb, False, count, disk, contrast, np.int16)
+            features, product = np.zeros((3, count), np.float32), np.zeros(count, np.float32)
+            features[0] = disk.astype(np.float32) * plan.scales[k, 0]
+            features[1] = contrast.astype(np.float32) * plan.scales[k, 1]
+            ck.saturation_feature(
+                inner, outer, plan.scales[k, 2], plan.scales[k, 3], count, features[2]
+            )
+            ck.weighted_product(*features, np.ones(3, np.float32), count, product)
+            steps = (start.copy(), np.zeros(count, np.int32))
+            ck.keep_best(product, radius, count, *steps, False)
+            for fused in results:
+                assert np.array_equal(fused[0], steps[0]) and np.array_equal(fused[1], steps[1])
+            assert np.count_nonzero(steps[1]) > count // 10
 
 
 def test_unusable_settings_fail_at_construction_as_a_parameter_error():
@@ -385,3 +456,50 @@ def test_unusable_settings_fail_at_construction_as_a_parameter_error():
 
     with pytest.raises(ParamError, match="detector 'conspicuity': weights must be"):
         tsrkit.detector("conspicuity", weights=(0, 0, 0))
+
+
+def test_one_pass_conversion_equals_opencv_lightness_and_saturation(shared_datasets):
+    # All 2**24 colours agreed in a scratch run (benchmarks/RESULTS.scaling.md); here a random
+    # sample of 2**20 colours, the grey ramp, the pure hues, and a real frame (as a view).
+    rng = np.random.default_rng(9)
+    sample = rng.integers(0, 256, (1024, 1024, 3), dtype=np.uint8)
+    ramps = np.zeros((4, 256, 3), np.uint8)
+    ramps[0] = np.arange(256)[:, None]
+    for channel in range(3):
+        ramps[channel + 1, :, channel] = np.arange(256)
+    root = shared_datasets / "roboflow_traffic_light_kr"
+    entry = json.loads((root / "annotations.json").read_text())[0]
+    frame = cv2.imread(str(root / entry["file"]))[10:200:2, 5:300]
+    for image in (sample, ramps, frame):
+        light, sat = lightness_and_saturation(image)
+        assert np.array_equal(light, cs.lightness(image))
+        assert np.array_equal(sat, cs.saturation(image))
+
+
+def test_workspace_reuses_buffers_but_returned_maps_are_fresh():
+    first, second = random_image(10), lit_disk(4)
+    kept = cs.conspicuity_map(first)
+    expected = kept.values.copy()
+    cs.conspicuity_map(second)
+    assert np.array_equal(kept.values, expected)
+    space = cs.Workspace()
+    a = space.array("x", (4, 5), np.int16)
+    assert space.array("x", (2, 3), np.uint8).ctypes.data == a.ctypes.data
+    tables = cs.channel_tables(first, list(range(1, 11)), 0, space)
+    assert np.array_equal(tables[0], cs.channel_tables(first, list(range(1, 11)), 0)[0])
+
+
+def test_threads_get_their_own_workspace():
+    from concurrent.futures import ThreadPoolExecutor
+
+    images = [random_image(seed, (90, 120)) for seed in range(6)]
+    serial = [cs.conspicuity_map(image) for image in images]
+    detector = tsrkit.detector("conspicuity")
+    expected = [detector.detect(Frame(image, "x")) for image in images]
+    with ThreadPoolExecutor(3) as pool:
+        maps = list(pool.map(cs.conspicuity_map, images * 3))
+        found = list(pool.map(lambda image: detector.detect(Frame(image, "x")), images * 3))
+    for k, cmap in enumerate(maps):
+        assert np.array_equal(cmap.values, serial[k % 6].values)
+        assert np.array_equal(cmap.radius, serial[k % 6].radius)
+    assert found == expected * 3

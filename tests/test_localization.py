@@ -1,5 +1,6 @@
 """Zheng's localization (3.2.2, Figure 3-10, Eq. 3.13-3.15, Algorithm 3-1)."""
 
+import cv2
 import numpy as np
 import pytest
 from oracles.conspicuity_oracle import drmshift_reference
@@ -169,3 +170,17 @@ def test_normalise_divides_in_place_and_drmshift_takes_a_known_reach():
     found = loc.drmshift(cm, starts, rm)
     for got, want in zip(loc.drmshift(cm, starts, rm, reach=9), found):
         assert np.array_equal(got, want)
+
+
+def test_sparse_components_are_opencvs_components_in_opencvs_order():
+    # Masks of odd and even sizes, sparse to dense, opened like the peak masks; statistics,
+    # centroids and label order as cv2.connectedComponentsWithStats gives them.
+    rng = np.random.default_rng(3)
+    for trial in range(400):
+        h, w = rng.integers(1, 50, 2) if trial < 300 else rng.integers(100, 300, 2)
+        mask = (rng.random((h, w)) < rng.uniform(0.01, 0.6)).astype(np.uint8)
+        if trial >= 300:
+            mask = loc.denoise(cv2.dilate(mask, np.ones((3, 3), np.uint8)))
+        _, _, stats, centroids = cv2.connectedComponentsWithStats(mask, connectivity=8)
+        mine, middles = loc.sparse_components(np.flatnonzero(mask), w)
+        assert np.array_equal(mine, stats[1:]) and np.array_equal(middles, centroids[1:])

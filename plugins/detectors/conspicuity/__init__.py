@@ -1,7 +1,8 @@
 """Zheng's conspicuity detector (Zheng 2016, 3.2.1-3.2.2): the map, its kernels, the plugin.
 
 ``conspicuity.py`` holds the map (Eq. 3.1-3.12) and the plugin, ``conspicuity_kernel.py`` the
-compiled window sums; the localization of 3.2.2 is shared with gray-tophat
+compiled window sums, ``colour.py`` the one-pass L and S, ``workspace.py`` the per-thread
+scratch arrays; the localization of 3.2.2 is shared with gray-tophat
 (:mod:`tsrkit_plugins.detectors.localization`).
 """
 

@@ -24,11 +24,16 @@ Reading choices (the thesis leaves them open or prints them ambiguously):
 Speed: every window sum is an exact integer sum of entries of one row-prefix table per
 channel (rows of equal half-width merged into one look-up in its column integral; the plan of
 each window is computed once per radius and executed by the numba kernel in
-``conspicuity_kernel.py``, one image row at a time), the full lightness disk is assembled from
-its four quarters, saturation disks are shared between radii, the sums run in 16 bits when
-every lightness window is small enough to be exact there (:func:`narrow_sums`: int16 lightness,
-uint16 saturation in bands of rows), and the root of Eq. 3.1 is taken once after the maximum
-of Eq. 3.2 (the root is monotonic, so the arg-max is unchanged).
+``conspicuity_kernel.py``, one image row at a time). Lightness entries that several windows of
+a radius use (the quarters' centre column and centre row, the quadrant boxes' corners, the
+axes) are read once per pixel in the pass that combines them, and only the quarters'
+staircases go through row buffers; the full lightness disk is assembled from its four
+quarters, saturation disks are shared between radii, the sums run in 16 bits when every
+lightness window is small enough to be exact there (:func:`narrow_sums`: int16 lightness,
+uint16 saturation in bands of rows), L and S come from one compiled pass (``colour.py``), and
+the root of Eq. 3.1 is taken once after the maximum of Eq. 3.2 (the root is monotonic, so the
+arg-max is unchanged). Intermediate arrays are per-thread buffers reused from frame to frame
+(``workspace.py``).
 ``tests/oracles/conspicuity_oracle.py`` is the direct reference these are tested against.
 """
 
@@ -46,20 +51,28 @@ from tsrkit.hookspecs import hookimpl
 from tsrkit.params import Param, ParamError
 from tsrkit.plugin import Detector
 from tsrkit.types import Candidate, Frame
+from tsrkit_plugins.detectors.conspicuity.colour import lightness_and_saturation
 from tsrkit_plugins.detectors.conspicuity.conspicuity_kernel import (
     BAND_PIXELS,
+    INTEGRAL,
     NARROW_PIXELS,
+    PREFIX,
     best_products,
     flat_offsets,
     positive_ends,
     prefix_tables,
 )
+from tsrkit_plugins.detectors.conspicuity.workspace import Workspace
 from tsrkit_plugins.detectors.localization import (
     LOCALIZATION_PARAMS,
     ROI_PARAM,
     localize,
     region_of_interest,
 )
+
+#: The scratch arrays of :func:`conspicuity_map`, one set per thread (``workspace.py``); the
+#: arrays it returns are never among them.
+WORKSPACE = Workspace()
 
 #: Quadrant directions as (vertical sign, horizontal sign): up-right, up-left, down-left,
 #: down-right (Figure 3-7).
@@ -93,23 +106,20 @@ def quarter_disk_size(radius: int) -> int:
     return sum(h + 1 for h in half_widths(radius))
 
 
-def mirror(channel: np.ndarray, pad: int) -> np.ndarray:
-    """The channel with ``pad`` mirrored pixels on every side (reflect-101)."""
-    return cv2.copyMakeBorder(channel, pad, pad, pad, pad, cv2.BORDER_REFLECT_101)
+def mirror(channel: np.ndarray, pad: int, out: np.ndarray | None = None) -> np.ndarray:
+    """The channel with ``pad`` mirrored pixels on every side (reflect-101), written into
+    ``out`` when given."""
+    return cv2.copyMakeBorder(channel, pad, pad, pad, pad, cv2.BORDER_REFLECT_101, dst=out)
 
 
-def compile_terms(
-    runs: Sequence[tuple[int, int, int]], columns: Sequence[tuple[int, int, int, int]] = ()
-):
-    """Plan a window sum: ``sign * prefix(dy, dc)`` over ``runs`` = (dy, dc, sign) plus, over
-    ``columns`` = (top, bottom, dc, sign), ``sign`` times the prefix at column offset ``dc``
-    summed over rows ``top..bottom``.
+def compile_terms(runs: Sequence[tuple[int, int, int]]):
+    """Plan a window sum: ``sign * prefix(dy, dc)`` over ``runs`` = (dy, dc, sign).
 
     Runs sharing ``dc`` and ``sign`` on consecutive rows are merged into one column look-up
     (two array operations instead of one per row). Returns ``(on_integral, dy, dc, sign)``
     terms, positive ones first.
     """
-    merged = list(columns)
+    merged = []
     terms = []
     ordered = sorted(runs, key=lambda t: (t[1], t[2], t[0]))
     start = 0
@@ -159,39 +169,75 @@ def disk_bands(radius: int, limit: int | None) -> tuple[tuple[int, int], ...]:
 
 
 @cache
-def quarter_plan(radius: int, quadrant: tuple[int, int]):
-    """Plan of quadrant ``k`` of A1, axes included (numerator of Eq. 3.7).
+def stair_plan(radius: int, quadrant: tuple[int, int]):
+    """Plan of the staircase of quadrant ``k`` of A1: the far-edge prefixes of its rows
+    ``1..radius`` away from the centre row, the part of the quarter (numerator of Eq. 3.7) that
+    no other window shares.
 
-    Every row run of the quarter starts (or ends) on the centre column, so that edge is one
-    column look-up; the other edge follows the disk's staircase.
+    The staircase follows the disk's edge (rows of equal half-width merged into one column
+    look-up); the centre-column edge of those rows (one column look-up) and the centre row are
+    single entries of :func:`corner_terms` and :data:`SHARED_TERMS`, read once per pixel for
+    the quarters, boxes and axes together (``conspicuity_kernel._light_windows``).
     """
     vertical, horizontal = quadrant
     w = half_widths(radius)
-    rows = (-radius, 0) if vertical < 0 else (0, radius)
     if horizontal > 0:
-        runs = [(vertical * dy, w[dy] + 1, 1) for dy in range(radius + 1)]
-        return compile_terms(runs, [(rows[0], rows[1], 0, -1)])
-    runs = [(vertical * dy, -w[dy], -1) for dy in range(radius + 1)]
-    return compile_terms(runs, [(rows[0], rows[1], 1, 1)])
+        return compile_terms([(vertical * dy, w[dy] + 1, 1) for dy in range(1, radius + 1)])
+    return compile_terms([(vertical * dy, -w[dy], -1) for dy in range(1, radius + 1)])
+
+
+#: The single lightness entries every radius shares, as kernel terms (plane, dy, dc): the row
+#: prefix left of the centre and right of it, and the column integrals at the centre row and
+#: the row above it, left and right of the centre column.
+SHARED_TERMS = (
+    (PREFIX, 0, 0),
+    (PREFIX, 0, 1),
+    (INTEGRAL, 0, 0),
+    (INTEGRAL, 0, 1),
+    (INTEGRAL, -1, 0),
+    (INTEGRAL, -1, 1),
+)
 
 
 @cache
-def box_plan(half_side: int, quadrant: tuple[int, int]):
-    """Plan of quadrant ``k`` of the bounding box of side ``half_side + 1`` (A1 + A2)."""
-    vertical, horizontal = quadrant
-    top, bottom = (-half_side, 0) if vertical < 0 else (0, half_side)
-    left, right = (-half_side, 0) if horizontal < 0 else (0, half_side)
-    return compile_terms((), [(top, bottom, right + 1, 1), (top, bottom, left, -1)])
+def corner_terms(radius: int, half_side: int) -> tuple[tuple[int, int, int], ...]:
+    """The single lightness entries of radius ``radius`` (plane, dy, dc), read once per pixel
+    and shared by its windows (``conspicuity_kernel._light_windows``).
 
-
-@cache
-def axes_plan(radius: int):
-    """Plan of minus the centre column ``|dy| <= radius`` and the two centre-row runs
-    ``0 <= +-dx <= radius`` (the parts the four quarters share)."""
-    return compile_terms(
-        [(0, radius + 1, -1), (0, 0, 1), (0, 1, -1), (0, -radius, 1)],
-        [(-radius, radius, 1, -1), (-radius, radius, 0, 1)],
+    With ``r = radius`` and ``s = half_side`` (``r + m``): the centre row's prefix right and
+    left of the disk; the column integrals above and below the disk's centre-column run (these
+    close the four quarters with :data:`SHARED_TERMS` and :func:`stair_plan`, and with the
+    centre row give the axes term, minus the centre column and the two centre-row runs the
+    quarters share); then the outer corners of the quadrant boxes of A1 + A2 (Eq. 3.8): two
+    each of the up-right, up-left, down-left and down-right box. With :func:`margin_terms` and
+    :data:`SHARED_TERMS` these close the boxes.
+    """
+    r, s = radius, half_side
+    return (
+        (PREFIX, 0, r + 1),
+        (PREFIX, 0, -r),
+        (INTEGRAL, -r - 1, 0),
+        (INTEGRAL, -r - 1, 1),
+        (INTEGRAL, r, 0),
+        (INTEGRAL, r, 1),
+        (INTEGRAL, 0, s + 1),
+        (INTEGRAL, -s - 1, s + 1),
+        (INTEGRAL, 0, -s),
+        (INTEGRAL, -s - 1, -s),
+        (INTEGRAL, s, -s),
+        (INTEGRAL, -1, -s),
+        (INTEGRAL, s, s + 1),
+        (INTEGRAL, -1, s + 1),
     )
+
+
+def margin_terms(half_side: int) -> tuple[tuple[int, int, int], ...]:
+    """The quadrant boxes' entries on the centre column's edges, above and below the box
+    (plane, dy, dc): left and right of the centre column at the top, then at the bottom. With
+    margin 0 (``half_side`` = radius) they are :func:`corner_terms`' own column entries and are
+    not read again."""
+    s = half_side
+    return ((INTEGRAL, -s - 1, 0), (INTEGRAL, -s - 1, 1), (INTEGRAL, s, 0), (INTEGRAL, s, 1))
 
 
 def kernel_terms(plan) -> list[tuple[int, int, int, int]]:
@@ -213,6 +259,8 @@ class KernelPlan:
     light_terms: np.ndarray
     light_starts: np.ndarray
     light_mids: np.ndarray
+    corners: np.ndarray
+    margins: np.ndarray | None
     sat_terms: np.ndarray
     sat_starts: np.ndarray
     sat_mids: np.ndarray
@@ -237,16 +285,13 @@ def concatenated(plans: Sequence[list]) -> tuple[np.ndarray, np.ndarray]:
 def kernel_plan(radii: tuple[int, ...], margin: int) -> KernelPlan:
     """The windows of Eq. 3.3-3.11 for the radius set RAD and margin ``m``.
 
-    Per radius: the four quarters of A1, the four quadrant boxes of A1 + A2 (half-side
-    ``r + m``) and the shared axes on lightness; the saturation disks of radius ``r`` and ``2 r``
+    Per radius: the staircases of the four quarters of A1 and the single entries that close
+    them, the quadrant boxes of A1 + A2 (half-side ``r + m``) and the axes term on lightness;
+    the saturation disks of radius ``r`` and ``2 r``
     are planned once per distinct radius (the annulus A3 is their difference), as bands of at
     most :data:`conspicuity_kernel.BAND_PIXELS` pixels with :func:`narrow_sums`.
     """
-    light = []
-    for r in radii:
-        light += [kernel_terms(quarter_plan(r, q)) for q in QUADRANTS]
-        light += [kernel_terms(box_plan(r + margin, q)) for q in QUADRANTS]
-        light.append(kernel_terms(axes_plan(r)))
+    light = [kernel_terms(stair_plan(r, q)) for r in radii for q in QUADRANTS]
     sat_radii = sorted(set(radii) | {2 * r for r in radii})
     limit = BAND_PIXELS if narrow_sums(radii, margin) else None
     bands = [disk_bands(r, limit) for r in sat_radii]
@@ -268,6 +313,8 @@ def kernel_plan(radii: tuple[int, ...], margin: int) -> KernelPlan:
         light_terms,
         light_starts,
         positive_ends(light_terms, light_starts),
+        np.array([corner_terms(r, r + margin) for r in radii], np.int32),
+        np.array([margin_terms(r + margin) for r in radii], np.int32) if margin else None,
         sat_terms,
         sat_starts,
         positive_ends(sat_terms, sat_starts),
@@ -289,11 +336,14 @@ def full_runs(height: int, width: int) -> np.ndarray:
     return runs
 
 
-def weighted_root(product: np.ndarray, weights: Sequence[float]) -> np.ndarray:
+def weighted_root(
+    product: np.ndarray, weights: Sequence[float], out: np.ndarray | None = None
+) -> np.ndarray:
     """The ``(w_L + w_LC + w_S)``-th root of Eq. 3.1; with the product of the weighted features
     (``conspicuity_kernel.weighted_product``) this is the weighted geometric mean whose pixel
-    ratios do not change when a feature is rescaled (Appendix A)."""
-    return np.power(product, 1.0 / float(sum(weights)), dtype=np.float32)
+    ratios do not change when a feature is rescaled (Appendix A). Written into ``out`` (which
+    may be ``product``) when given."""
+    return np.power(product, 1.0 / float(sum(weights)), dtype=np.float32, out=out)
 
 
 @dataclass(frozen=True)
@@ -320,6 +370,8 @@ def conspicuity_map(
     weights: Sequence[float] = (1.0, 1.0, 1.0),
     margin: int = 0,
     quadrant_rule: str = "max",
+    *,
+    scratch: bool = False,
 ) -> ConspicuityMap:
     """Eq. 3.1-3.12 on every pixel of a BGR uint8 image.
 
@@ -335,6 +387,9 @@ def conspicuity_map(
         The A2 margin ``m`` (Table 5-1: 0).
     quadrant_rule : {"max", "min"}
         How Eq. 3.5 combines the quadrants (see the module notes).
+    scratch : bool
+        Return the calling thread's :data:`WORKSPACE` buffers, valid only until its next
+        call, instead of new arrays (the detector's own use: its map never leaves ``detect``).
 
     Returns
     -------
@@ -355,18 +410,24 @@ def conspicuity_map(
         raise ValueError(
             f"expected a BGR uint8 image of shape (H, W, 3); got {image.dtype} {image.shape}"
         )
-    light_tables, sat_tables, pad = channel_tables(image, radii, margin)
-    best, best_radius = products_on_runs(
+    light_tables, sat_tables, pad = channel_tables(image, radii, margin, WORKSPACE)
+    shape = image.shape[:2]
+    best = WORKSPACE.array("best", shape, np.float32)
+    best_radius = (
+        WORKSPACE.array("radius", shape, np.int32) if scratch else np.empty(shape, np.int32)
+    )
+    products_on_runs(
         light_tables,
         sat_tables,
         pad,
-        full_runs(*image.shape[:2]),
+        full_runs(*shape),
         radii,
         weights,
         margin,
         quadrant_rule,
+        (best, best_radius),
     )
-    return ConspicuityMap(weighted_root(best, weights), best_radius)
+    return ConspicuityMap(weighted_root(best, weights, best if scratch else None), best_radius)
 
 
 def narrow_sums(radii: Sequence[int], margin: int) -> bool:
@@ -381,17 +442,33 @@ def narrow_sums(radii: Sequence[int], margin: int) -> bool:
 
 
 def channel_tables(
-    image: np.ndarray, radii: Sequence[int], margin: int
+    image: np.ndarray, radii: Sequence[int], margin: int, workspace: Workspace | None = None
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """Prefix tables of the mirrored lightness and saturation (int16 and uint16 with
-    :func:`narrow_sums`, int32 otherwise), with the padding they need."""
+    :func:`narrow_sums`, int32 otherwise), with the padding they need. The channels are those
+    of :func:`lightness` and :func:`saturation`, converted in one pass (``colour.py``). With a
+    ``workspace`` every array, the tables included, is one of its buffers."""
     pad = max(2 * max(radii), max(radii) + margin)
     narrow = narrow_sums(radii, margin)
-    return (
-        prefix_tables(mirror(lightness(image), pad), np.int16 if narrow else np.int32),
-        prefix_tables(mirror(saturation(image), pad), np.uint16 if narrow else np.int32),
-        pad,
+    height, width = image.shape[:2]
+    padded = (height + 2 * pad, width + 2 * pad)
+
+    def scratch(key, shape, dtype):
+        return None if workspace is None else workspace.array(key, shape, dtype)
+
+    channels = lightness_and_saturation(
+        image,
+        scratch("light", (height, width), np.uint8),
+        scratch("sat", (height, width), np.uint8),
     )
+    tables = []
+    for name, channel, dtype in zip(
+        ("light", "sat"), channels, (np.int16, np.uint16) if narrow else (np.int32, np.int32)
+    ):
+        mirrored = mirror(channel, pad, scratch(f"{name} mirrored", padded, np.uint8))
+        stack = scratch(f"{name} tables", (2, padded[0] + 1, padded[1] + 1), dtype)
+        tables.append(prefix_tables(mirrored, dtype, stack))
+    return tables[0], tables[1], pad
 
 
 def products_on_runs(
@@ -403,14 +480,17 @@ def products_on_runs(
     weights: Sequence[float],
     margin: int,
     quadrant_rule: str,
+    out: tuple[np.ndarray, np.ndarray] | None = None,
 ):
     """Eq. 3.1 under its root, maximised over the radii (Eq. 3.2), on the pixels of ``runs``;
     returns the float32 maximum (0 elsewhere) and the int32 arg-max radius (smallest radius
-    elsewhere and on ties)."""
+    elsewhere and on ties). With ``out``, the two arrays are written on the runs' pixels and
+    left as they are elsewhere."""
     shape = (sat_tables.shape[1] - 1 - 2 * pad, sat_tables.shape[2] - 1 - 2 * pad)
     plan = kernel_plan(tuple(radii), margin)
-    best = np.zeros(shape, np.float32)
-    best_radius = np.full(shape, min(radii), np.int32)
+    if out is None:
+        out = (np.zeros(shape, np.float32), np.full(shape, min(radii), np.int32))
+    best, best_radius = out
     best_products(
         light_tables,
         sat_tables,
@@ -419,6 +499,11 @@ def products_on_runs(
         flat_offsets(plan.light_terms, light_tables.shape),
         plan.light_starts,
         plan.light_mids,
+        flat_offsets(np.array(SHARED_TERMS), light_tables.shape),
+        flat_offsets(plan.corners.reshape(-1, 3), light_tables.shape).reshape(len(radii), -1),
+        None
+        if plan.margins is None
+        else flat_offsets(plan.margins.reshape(-1, 3), light_tables.shape).reshape(len(radii), -1),
         flat_offsets(plan.sat_terms, sat_tables.shape),
         plan.sat_starts,
         plan.sat_mids,
@@ -497,7 +582,9 @@ class Conspicuity(Detector):
         """Candidates, best first, each scored by its conspicuity with its arg-max radius."""
         p = self.params
         roi = region_of_interest(frame.image, p["roi_top"])
-        cmap = conspicuity_map(roi, p["radii"], p["weights"], p["margin"], p["quadrant_rule"])
+        cmap = conspicuity_map(
+            roi, p["radii"], p["weights"], p["margin"], p["quadrant_rule"], scratch=True
+        )
         return localize(cmap.values, p, radius_map=cmap.radius)
 
 
