@@ -58,7 +58,7 @@ def scale_box(box: Sequence[float], sx: float, sy: float) -> Box:
     >>> scale_box((9.5, 19.5, 29.5, 39.5), 0.5, 0.5)
     (4.5, 9.5, 14.5, 19.5)
     >>> scale_box((0, 0, 10, 4), 1.5, 2.0)
-    (0.25, 0.5, 15.25, 9.5)
+    (0.25, 0.5, 15.25, 8.5)
     """
     x0, y0, x1, y1 = (float(v) for v in box)
     return (
