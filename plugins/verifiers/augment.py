@@ -18,6 +18,10 @@ frame widen what it sees:
    Gaussian blur and a JPEG re-encoding (``cv2.imencode``): the colour, sharpness and
    compression of another camera.
 
+The synthetic no-light training scenes get the camera looks too (not the scales): with looks
+on the real frames alone, the extra positives raised leave-one-dataset-out false positives on
+no-light scenes on every fold; with the looks on both, they fell (benchmarks/RESULTS.verifier.md).
+
 Every draw comes from a generator seeded by ``(seed, CRC-32 of the frame's source, view)``: the
 views, and the model trained on them, are a deterministic function of the training frames and
 the seed, and a frame's views do not depend on the other frames it is trained with.
@@ -133,9 +137,15 @@ class Augmentation:
     def views(
         self, frame: Frame, boxes: Sequence[Sequence[float]]
     ) -> Iterator[tuple[Frame, Sequence[Sequence[float]]]]:
-        """The views of the real ``frame`` with its ``boxes``."""
+        """The views of the real ``frame`` with its ``boxes``: every scale, then every look."""
         for factor in self.scales:
             yield (frame, boxes) if factor == 1 else resized(frame, boxes, factor)
+        yield from self.looked(frame, boxes)
+
+    def looked(
+        self, frame: Frame, boxes: Sequence[Sequence[float]]
+    ) -> Iterator[tuple[Frame, Sequence[Sequence[float]]]]:
+        """The ``looks`` camera looks of ``frame`` (full size) with its ``boxes``."""
         for look in range(self.looks):
             rng = np.random.default_rng([self.seed, zlib.crc32(frame.source.encode()), look])
             source = f"{frame.source}@look{self.seed}.{look}"

@@ -109,7 +109,8 @@ def labelled_candidates(
     augmentation: Augmentation | None = None,
 ) -> Labelled:
     """Run ``detector`` (then ``stage``) on every sample (on each of its ``augmentation``
-    views: :mod:`augment`), on ``no_light`` synthetic frames and on ``heads`` synthetic frames
+    views: :mod:`augment`), on ``no_light`` synthetic frames (and their camera looks) and on
+    ``heads`` synthetic frames
     with rendered lit heads (:func:`head_frames`); return every candidate's features, its Zheng
     label and its frame index."""
     parts = []
@@ -117,7 +118,9 @@ def labelled_candidates(
     frames: Iterator[tuple[Frame, Sequence[Sequence[float]]]] = (
         view for s in samples for view in views.views(s.load(), [a.bbox for a in s.annotations])
     )
-    synthetic = ((f, []) for f in no_light_frames(no_light))
+    synthetic = (
+        view for f in no_light_frames(no_light) for view in chain([(f, [])], views.looked(f, []))
+    )
     for index, (frame, boxes) in enumerate(chain(frames, synthetic, head_frames(heads))):
         candidates = stage(frame, detector.detect(frame))
         if not candidates:
