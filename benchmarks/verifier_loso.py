@@ -11,6 +11,9 @@ candidate recall per light size.
 Run: python benchmarks/verifier_loso.py [--detector lab-frst]... [-p lab-frst.KEY=V]
          [-p verifier.KEY=V] [--housing housing] [--no-light 30] [--skip-paper]
          [--out benchmarks/out/verifier_loso]
+Training-time augmentation (plugins/verifiers/augment.py): ``-p verifier.augment_scales=1,0.5,1.5``
+``-p verifier.augment_colour=2``; the augmented views carry their own ``source``, so the cached
+candidates below keep them apart.
 Several detectors: ``--detector union -p "union.members=lab-frst top=15; conspicuity n_top=15"``
 (the ``union`` plugin; its default members are the loosened four of RESULTS.verifier.md).
 """

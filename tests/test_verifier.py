@@ -180,6 +180,9 @@ def test_model_round_trip_scores_like_the_fitted_estimator(trained):
     assert np.allclose(loaded.probabilities(frame, candidates), expected)
     kept = loaded.verify(frame, candidates)
     assert len(kept) == len(candidates)
+    # verify scores the candidates after its housing stage (after=housing)
+    housed = get_registry().create("verifier", "housing").verify(frame, candidates)
+    expected = loaded.probabilities(frame, housed)
     assert [c.score for c in kept] == sorted(expected.tolist(), reverse=True)
     assert make(model=str(trained[0]), threshold=1.0).verify(frame, candidates) == [
         c for c in kept if c.score >= 1.0

@@ -28,6 +28,7 @@ from tsrkit.params import Param
 from tsrkit.plugin import Detector, Verifier
 from tsrkit.registry import get_registry
 from tsrkit.types import Candidate, Frame, Sample
+from tsrkit_plugins.verifiers.augment import Augmentation
 from tsrkit_plugins.verifiers.features import candidate_features, feature_names, layout
 from tsrkit_plugins.verifiers.forest import Forest
 from tsrkit_plugins.verifiers.mining import Labelled, Stage, hard_negatives, labelled_candidates
@@ -147,11 +148,37 @@ class LearnedVerifier(Verifier):
             help="training: synthetic 1280x720 scenes with 5 rendered lit heads each (jittered "
             "scale, colour, blur and exposure), whose candidates on a head are positives",
         ),
+        Param(
+            "augment_scales",
+            "floats",
+            (1.0,),
+            min=0.25,
+            max=3.0,
+            help="training: every real training frame is seen resized by each of these factors "
+            "(1: as it is), the detector and housing stage re-run on it, boxes scaled with it "
+            "(a camera's other distances and resolutions: augment.py)",
+        ),
+        Param(
+            "augment_colour",
+            "int",
+            2,
+            min=0,
+            max=10,
+            help="training: extra full-size views of every real training frame and synthetic "
+            "no-light scene under a random camera look (exposure, gamma, white balance, "
+            "saturation, blur, JPEG: augment.py); 2 lowered leave-one-dataset-out false "
+            "positives and raised held-out DTLD recall (benchmarks/RESULTS.verifier.md)",
+        ),
         Param("seed", "int", 0, min=0, help="training: seed of the negative draw and the trees"),
     )
 
     def __init__(self, **params):
         super().__init__(**params)
+        self._augmentation = Augmentation(  # checked now: a bad value fails before training
+            tuple(self.params["augment_scales"]),
+            self.params["augment_colour"],
+            self.params["seed"],
+        )
         self._estimator: HistGradientBoostingClassifier | None = None
         self._forest: Forest | None = None
 
@@ -217,7 +244,9 @@ class LearnedVerifier(Verifier):
     def fit(self, samples: Iterable[Sample], *, detector: Detector | None = None) -> Model:
         """Learn to verify ``detector``'s candidates on ``samples`` (deterministic).
 
-        Every candidate is labelled by Zheng's centre rule; candidates of
+        Every real frame is seen at each factor of ``augment_scales`` and in
+        ``augment_colour`` camera looks (:mod:`augment`). Every candidate is labelled by
+        Zheng's centre rule; candidates of
         ``synthetic_frames`` no-light scenes are negatives, and those of ``head_frames`` scenes
         with rendered lit heads are labelled by the heads' housings. The first round draws
         ``negative_ratio`` negatives per positive (seeded); each mining round adds as many of
@@ -238,6 +267,7 @@ class LearnedVerifier(Verifier):
             len(feature_names()),
             self.params["synthetic_frames"],
             self.params["head_frames"],
+            self._augmentation,
         )
         return self.fit_labelled(data)
 

@@ -20,6 +20,7 @@ from tsrkit.plugin import Detector
 from tsrkit.synth import SynthOptions, render_frame
 from tsrkit.synth.heads import scatter_heads
 from tsrkit.types import Candidate, Frame, Sample
+from tsrkit_plugins.verifiers.augment import Augmentation
 
 #: Candidates of one frame -> the candidates the verifier will see (e.g. after a housing stage).
 Stage = Callable[[Frame, list[Candidate]], list[Candidate]]
@@ -105,15 +106,21 @@ def labelled_candidates(
     width: int,
     no_light: int,
     heads: int = 0,
+    augmentation: Augmentation | None = None,
 ) -> Labelled:
-    """Run ``detector`` (then ``stage``) on every sample, on ``no_light`` synthetic frames and on
-    ``heads`` synthetic frames with rendered lit heads (:func:`head_frames`); return every
-    candidate's features, its Zheng label and its frame index."""
+    """Run ``detector`` (then ``stage``) on every sample (on each of its ``augmentation``
+    views: :mod:`augment`), on ``no_light`` synthetic frames (and their camera looks) and on
+    ``heads`` synthetic frames
+    with rendered lit heads (:func:`head_frames`); return every candidate's features, its Zheng
+    label and its frame index."""
     parts = []
-    frames: Iterator[tuple[Frame, list[tuple[float, ...]]]] = (
-        (s.load(), [a.bbox for a in s.annotations]) for s in samples
+    views = augmentation or Augmentation()
+    frames: Iterator[tuple[Frame, Sequence[Sequence[float]]]] = (
+        view for s in samples for view in views.views(s.load(), [a.bbox for a in s.annotations])
     )
-    synthetic = ((f, []) for f in no_light_frames(no_light))
+    synthetic = (
+        view for f in no_light_frames(no_light) for view in chain([(f, [])], views.looked(f, []))
+    )
     for index, (frame, boxes) in enumerate(chain(frames, synthetic, head_frames(heads))):
         candidates = stage(frame, detector.detect(frame))
         if not candidates:
