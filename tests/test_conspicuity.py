@@ -349,19 +349,55 @@ def test_lightness_windows_are_exact_in_int16_at_their_largest():
     assert narrow[0][1499] == direct_features(half, 10, 0, 20, 1499)[0]
 
 
-def test_saturation_disk_bands_are_exact_in_uint16_and_add_up_to_the_disk():
+def column_disk_rows(channel, radii, row, dtype=np.uint16):
+    """The kernel's disks of radii ``radii`` (the saturation plan of ``kernel_plan``: 1..10
+    and their doubles) on one row of a channel, from its column sums (``fill_columns``,
+    ``column_disks``), with tables and band sums in ``dtype``."""
+    plan = cs.kernel_plan(tuple(radii), 0)
+    pad = 2 * max(radii)
+    tables = ck.prefix_tables(cs.mirror(channel, pad), dtype)
+    count = channel.shape[1]
+    columns = np.full((pad + 2, tables.shape[2]), 7, dtype)
+    columns[-1] = 0
+    flat = tables.reshape(-1)
+    ck.fill_columns(flat, tables[0].size, tables.shape[2], pad, row, 0, count, columns)
+    offsets = plan.sat_terms[:, 0] * tables.shape[2] + plan.sat_terms[:, 1]
+    sat = np.full((len(plan.sat_bands) - 1, count), -1, np.int32)
+    band = np.zeros(count, dtype)
+    ck.column_disks(
+        columns.reshape(-1), offsets, plan.sat_starts, plan.sat_bands, pad, count, band, sat
+    )
+    return sat
+
+
+def test_saturation_disks_from_column_sums_are_exact_in_uint16_bands():
+    radii = list(range(1, 11))
+    sat_radii = sorted(set(radii) | {2 * r for r in radii})
+    # All white: every band at its largest sum (up to 257 * 255 = 65535), tables wrapping.
     white = np.full((60, 3000), 255, np.uint8)
+    disks = column_disk_rows(white, radii, 30)
+    assert np.all(disks == 255 * np.array([cs.disk_size(r) for r in sat_radii])[:, None])
+    # Black-and-white pattern and a real frame's saturation: equal to direct sums.
+    pattern = np.where(random_image(9, (50, 300)) > 127, 255, 0).astype(np.uint8)[:, :, 0]
+    for channel in (pattern, cs.saturation(random_image(10, (45, 77)))):
+        for row in (0, 21, channel.shape[0] - 1):
+            disks = column_disk_rows(channel, radii, row)
+            for d, radius in enumerate(sat_radii):
+                assert np.array_equal(disks[d], disk_row(channel, radius, row))
     for radius in (9, 10, 14, 20):
         bands = cs.disk_bands(radius, ck.BAND_PIXELS)
         assert bands[0][0] == -radius and bands[-1][1] == radius
         assert all(a[1] + 1 == b[0] for a, b in pairwise(bands))
-        windows = [cs.disk_plan(radius, *band) for band in bands] + [cs.disk_plan(radius)]
-        wide = window_sums(white, 20, windows, 25)
-        narrow = window_sums(white, 20, windows[:-1], 25, np.uint16)
-        assert np.array_equal(narrow, wide[:-1]) and narrow.max() <= 65535
-        assert np.all(narrow.astype(np.int64).sum(axis=0) == wide[-1])
-        assert wide[-1, 2990] == 255 * cs.disk_size(radius)
-    assert len(cs.disk_bands(20, ck.BAND_PIXELS)) == 6 and cs.disk_bands(20, None) == ((-20, 20),)
+        sizes = [
+            sum(2 * cs.half_widths(radius)[abs(d)] + 1 for d in range(a, b + 1)) for a, b in bands
+        ]
+        assert max(sizes) <= ck.BAND_PIXELS and sum(sizes) == cs.disk_size(radius)
+        plans = [cs.column_plan(radius, *band, 99) for band in bands]
+        assert all(len(plan) % 4 == 0 for plan in plans)
+        assert [t for plan in plans for t in plan if t[0] != 99] == [
+            (cs.half_widths(radius)[abs(dx)], dx) for dx in range(-radius, radius + 1)
+        ]
+    assert len(cs.disk_bands(20, ck.BAND_PIXELS)) == 6
 
 
 @pytest.mark.parametrize(

@@ -30,7 +30,8 @@ axes) are read once per pixel in the pass that combines them, and only the quart
 staircases go through row buffers; the full lightness disk is assembled from its four
 quarters, saturation disks are shared between radii, the sums run in 16 bits when every
 lightness window is small enough to be exact there (:func:`narrow_sums`: int16 lightness,
-uint16 saturation in bands of rows), L and S come from one compiled pass (``colour.py``), and
+uint16 saturation in bands of columns, summed from each row's vertical sums of the saturation:
+:func:`column_plan`), L and S come from one compiled pass (``colour.py``), and
 the root of Eq. 3.1 is taken once after the maximum of Eq. 3.2 (the root is monotonic, so the
 arg-max is unchanged). Intermediate arrays are per-thread buffers reused from frame to frame
 (``workspace.py``).
@@ -142,30 +143,42 @@ def compile_terms(runs: Sequence[tuple[int, int, int]]):
 
 
 @cache
-def disk_plan(radius: int, top: int | None = None, bottom: int | None = None):
-    """Plan of the disk ``|d| <= radius`` (numerator of Eq. 3.3 and Eq. 3.10), or of its rows
-    ``top..bottom`` (a band, see :func:`disk_bands`)."""
+def disk_plan(radius: int):
+    """Plan of the disk ``|d| <= radius`` (numerator of Eq. 3.3 and Eq. 3.10)."""
     w = half_widths(radius)
     runs = []
-    for dy in range(-radius if top is None else top, (radius if bottom is None else bottom) + 1):
+    for dy in range(-radius, radius + 1):
         half = w[abs(dy)]
         runs += [(dy, half + 1, 1), (dy, -half, -1)]
     return compile_terms(runs)
 
 
 @cache
-def disk_bands(radius: int, limit: int | None) -> tuple[tuple[int, int], ...]:
+def disk_bands(radius: int, limit: int) -> tuple[tuple[int, int], ...]:
     """The disk's rows ``(top, bottom)`` cut, from the top, into consecutive bands of at most
-    ``limit`` pixels each (one band when ``limit`` is None)."""
+    ``limit`` pixels each (by symmetry, its columns too: :func:`column_plan`)."""
     w = half_widths(radius)
     bands, top, pixels = [], -radius, 0
     for dy in range(-radius, radius + 1):
         width = 2 * w[abs(dy)] + 1
-        if limit is not None and pixels + width > limit:
+        if pixels + width > limit:
             bands.append((top, dy - 1))
             top, pixels = dy, 0
         pixels += width
     return (*bands, (top, radius))
+
+
+@cache
+def column_plan(radius: int, left: int, right: int, zero: int) -> tuple[tuple[int, int], ...]:
+    """Columns ``left..right`` of the disk ``|d| <= radius`` as terms ``(h, dx)``: the disk's
+    sum over them is the sum of column ``dx``'s vertical sums of half-height ``h`` centred on
+    the disk's row (``conspicuity_kernel.fill_columns``), padded to a multiple of four terms
+    with ``(zero, 0)``, a row of zeros (``conspicuity_kernel.column_disks``). The disk is
+    symmetric, so its columns' half-heights are its rows' half-widths, and :func:`disk_bands`
+    cuts it into bands of columns as well."""
+    w = half_widths(radius)
+    terms = [(w[abs(dx)], dx) for dx in range(left, right + 1)]
+    return tuple(terms + [(zero, 0)] * (-len(terms) % 4))
 
 
 @cache
@@ -265,6 +278,7 @@ class KernelPlan:
     sat_starts: np.ndarray
     sat_mids: np.ndarray
     sat_bands: np.ndarray
+    column_sums: bool
     sat_inner: np.ndarray
     sat_outer: np.ndarray
     radii: np.ndarray
@@ -288,14 +302,28 @@ def kernel_plan(radii: tuple[int, ...], margin: int) -> KernelPlan:
     Per radius: the staircases of the four quarters of A1 and the single entries that close
     them, the quadrant boxes of A1 + A2 (half-side ``r + m``) and the axes term on lightness;
     the saturation disks of radius ``r`` and ``2 r``
-    are planned once per distinct radius (the annulus A3 is their difference), as bands of at
-    most :data:`conspicuity_kernel.BAND_PIXELS` pixels with :func:`narrow_sums`.
+    are planned once per distinct radius (the annulus A3 is their difference). With
+    :func:`narrow_sums` they are bands of columns of at most
+    :data:`conspicuity_kernel.BAND_PIXELS` pixels, summed from vertical sums
+    (:func:`column_plan`; ``column_sums`` true, ``sat_terms`` rows ``(h, dx)``); otherwise
+    table plans (:func:`disk_plan`, one band).
     """
     light = [kernel_terms(stair_plan(r, q)) for r in radii for q in QUADRANTS]
     sat_radii = sorted(set(radii) | {2 * r for r in radii})
-    limit = BAND_PIXELS if narrow_sums(radii, margin) else None
-    bands = [disk_bands(r, limit) for r in sat_radii]
-    sat = [kernel_terms(disk_plan(r, *band)) for r, rows in zip(sat_radii, bands) for band in rows]
+    if narrow_sums(radii, margin):
+        bands = [disk_bands(r, BAND_PIXELS) for r in sat_radii]
+        zero = 2 * max(radii) + 1
+        columns = [
+            column_plan(r, *band, zero) for r, rows in zip(sat_radii, bands) for band in rows
+        ]
+        sat_terms = np.array([term for plan in columns for term in plan], np.int64)
+        sat_starts = np.cumsum([0] + [len(plan) for plan in columns]).astype(np.int64)
+        sat_mids = sat_starts[1:].copy()
+        sat_bands = np.cumsum([0] + [len(rows) for rows in bands]).astype(np.int64)
+    else:
+        sat_terms, sat_starts = concatenated([kernel_terms(disk_plan(r)) for r in sat_radii])
+        sat_mids = positive_ends(sat_terms, sat_starts)
+        sat_bands = np.arange(len(sat_radii) + 1, dtype=np.int64)
     n_quarter = [quarter_disk_size(r) for r in radii]
     n_box = [(r + margin + 1) ** 2 for r in radii]
     scales = [
@@ -308,7 +336,6 @@ def kernel_plan(radii: tuple[int, ...], margin: int) -> KernelPlan:
         for r, nq, nb in zip(radii, n_quarter, n_box)
     ]
     light_terms, light_starts = concatenated(light)
-    sat_terms, sat_starts = concatenated(sat)
     return KernelPlan(
         light_terms,
         light_starts,
@@ -317,8 +344,9 @@ def kernel_plan(radii: tuple[int, ...], margin: int) -> KernelPlan:
         np.array([margin_terms(r + margin) for r in radii], np.int32) if margin else None,
         sat_terms,
         sat_starts,
-        positive_ends(sat_terms, sat_starts),
-        np.cumsum([0] + [len(rows) for rows in bands]).astype(np.int64),
+        sat_mids,
+        sat_bands,
+        narrow_sums(radii, margin),
         np.array([sat_radii.index(r) for r in radii], np.int64),
         np.array([sat_radii.index(2 * r) for r in radii], np.int64),
         np.array(radii, np.int32),
@@ -491,6 +519,14 @@ def products_on_runs(
     if out is None:
         out = (np.zeros(shape, np.float32), np.full(shape, min(radii), np.int32))
     best, best_radius = out
+    if plan.column_sums:
+        table_width = sat_tables.shape[2]
+        columns = WORKSPACE.array("columns", (2 * max(radii) + 2, table_width), sat_tables.dtype)
+        columns[-1] = 0
+        sat_offsets = plan.sat_terms[:, 0] * table_width + plan.sat_terms[:, 1]
+    else:
+        columns = np.zeros((0, 0), sat_tables.dtype)
+        sat_offsets = flat_offsets(plan.sat_terms, sat_tables.shape)
     best_products(
         light_tables,
         sat_tables,
@@ -504,10 +540,11 @@ def products_on_runs(
         None
         if plan.margins is None
         else flat_offsets(plan.margins.reshape(-1, 3), light_tables.shape).reshape(len(radii), -1),
-        flat_offsets(plan.sat_terms, sat_tables.shape),
+        sat_offsets,
         plan.sat_starts,
         plan.sat_mids,
         plan.sat_bands,
+        columns,
         plan.sat_inner,
         plan.sat_outer,
         plan.radii,

@@ -5,7 +5,8 @@ The window sums are the same signed sums of shifted prefix-table entries that
 ``conspicuity.py`` plans (:func:`compile_terms`, the ``*_plan`` functions and the single
 entries of ``SHARED_TERMS`` and ``corner_terms`` there); this module only executes them. One
 call walks a list of row runs (row, first column, end column): for each run it sums the
-saturation disks and the lightness quarters' staircases into short integer row buffers and
+saturation disks (from the run's column sums, :func:`fill_columns`, with 16-bit sums; from the
+tables otherwise) and the lightness quarters' staircases into short integer row buffers and
 combines them, with the single lightness entries read in the same pass, into the product of
 Eq. 3.1 per radius, keeping the maximum and its radius. The float32 operations of the earlier
 NumPy/OpenCV execution (commit e57479b) are applied in the same order, so with unit weights
@@ -23,8 +24,11 @@ paper's defaults), the lightness tables and buffers are int16: the tables wrap m
 each window sum is computed modulo 2**16, and since its true value lies in [-32768, 32767] it
 comes out exact, with twice the lanes per vector operation (the lightness windows take about
 half the time they took in int32). The saturation disks (up to 1257 pixels) are then summed
-the same way in uint16, in bands of rows of at most :data:`BAND_PIXELS` pixels whose sums
-(in [0, 65535]) are added in int32. The nine lightness windows of a radius (Eq. 3.3, 3.7,
+in uint16, in bands of at most :data:`BAND_PIXELS` pixels whose sums (in [0, 65535]) are
+added in int32, and not from the tables: a disk is the sum of its columns' vertical sums, all
+centred on its row, so the row's 21 vertical sums per column (:func:`fill_columns`) serve
+every disk (:func:`column_disks`: 336 reads per pixel with 84 for the sums, against 494 table
+reads). The nine lightness windows of a radius (Eq. 3.3, 3.7,
 3.8) are built in the pass that combines them (:func:`_light_windows`) from the four quarters'
 staircases and 24 single entries each read once (548 table reads per pixel over the paper's
 ten radii became 188 buffered reads plus 240 single ones, and 90 buffered windows 40). Being
@@ -435,6 +439,105 @@ def _margin_starts_overload(offsets, k, base):
 
 
 @njit(cache=True, nogil=True)
+def disk_sums(flat, offsets, starts, mids, bands, base, count, band, sat):
+    """The saturation disks of a run into the int32 rows of ``sat``: disk ``d`` is the sum of
+    its bands ``bands[d]`` to ``bands[d + 1]``, each a :func:`window_sum` of ``flat`` into
+    ``band`` (exact in the tables' type, see :data:`BAND_PIXELS`), added in int32."""
+    for d in range(sat.shape[0]):
+        total = sat[d]
+        for b in range(bands[d], bands[d + 1]):
+            window_sum(flat, offsets, starts[b], mids[b], starts[b + 1], base, count, band)
+            if b == bands[d]:
+                for x in range(count):
+                    total[x] = band[x]
+                continue
+            for x in range(count):
+                total[x] += band[x]
+
+
+@njit(cache=True, nogil=True)
+def fill_columns(flat, plane, table_width, pad, i, x0, count, columns):
+    """The vertical sums of the saturation around image row ``i``, for the disks of the run
+    ``x0 .. x0 + count`` on that row: ``columns[h, c]`` = the sum of padded column ``c`` over
+    the ``2 h + 1`` rows ``i - h .. i + h``, for ``h <= reach = columns.shape[0] - 2`` and the
+    columns within ``reach`` of the run (the last row of ``columns`` is left as it is: the
+    caller keeps it zero, see :func:`column_disks`).
+
+    Four reads of the column integrals (plane ``plane`` of the flattened table stack ``flat``)
+    per entry. Stored in the tables' integer type, wrapping or not: a sum of at most
+    ``41 * 255`` is exact.
+    """
+    reach = columns.shape[0] - 2
+    first, length = pad + x0 - reach, count + 2 * reach
+    for h in range(reach + 1):
+        top = plane + (pad + i - h) * table_width + first
+        bottom = plane + (pad + i + h + 1) * table_width + first
+        below, below_next = flat[bottom : bottom + length], flat[bottom + 1 : bottom + 1 + length]
+        above, above_next = flat[top : top + length], flat[top + 1 : top + 1 + length]
+        target = columns[h, first : first + length]
+        for x in range(length):
+            target[x] = (below_next[x] - below[x]) - (above_next[x] - above[x])
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _four(flat, offsets, t, base, count):
+    """The sum of the entries of terms ``t .. t + 3`` at pixel ``x`` is
+    ``(a[x] + b[x]) + (c[x] + d[x])`` for the four sources returned."""
+    return (
+        _source(flat, offsets, t, base, count),
+        _source(flat, offsets, t + 1, base, count),
+        _source(flat, offsets, t + 2, base, count),
+        _source(flat, offsets, t + 3, base, count),
+    )
+
+
+@njit(cache=True, nogil=True)
+def column_disks(flat, offsets, starts, bands, base, count, band, sat):
+    """The saturation disks of a run from its column sums (:func:`fill_columns`, flattened in
+    ``flat``) into the int32 rows of ``sat``.
+
+    Disk ``d`` is the sum of its bands ``bands[d]`` to ``bands[d + 1]``, band ``b`` the sum of
+    the columns of terms ``starts[b]`` to ``starts[b + 1]`` (one read per column: a disk is
+    the sum of its columns, all centred on its row; ``conspicuity.column_plan``), a multiple
+    of four: a plan pads its bands with reads of the zero row. Four terms are added per pass;
+    a band's sum is exact in the type of ``band`` (at most :data:`BAND_PIXELS` pixels), and
+    its last pass widens it into the disk's int32 row directly.
+
+    With the saturation's row-prefix tables a disk is two reads per row of the disk or four
+    per run of rows of equal width (494 reads per pixel for the paper's 15 saturation disks,
+    in 31 bands); here it is one read per column, shared by every disk of the row: 285 reads
+    (336 with the padding), plus the 84 of :func:`fill_columns`, in fewer passes.
+    """
+    kind = band.dtype.type
+    for d in range(sat.shape[0]):
+        total = sat[d]
+        for b in range(bands[d], bands[d + 1]):
+            first, last = starts[b], starts[b + 1]
+            for t in range(first, last - 4, 4):
+                p, q, r, s = _four(flat, offsets, t, base, count)
+                if t == first:
+                    for x in range(count):
+                        band[x] = (p[x] + q[x]) + (r[x] + s[x])
+                else:
+                    for x in range(count):
+                        band[x] += (p[x] + q[x]) + (r[x] + s[x])
+            p, q, r, s = _four(flat, offsets, last - 4, base, count)
+            alone, assign = last - 4 == first, b == bands[d]
+            if alone and assign:
+                for x in range(count):
+                    total[x] = kind((p[x] + q[x]) + (r[x] + s[x]))
+            elif alone:
+                for x in range(count):
+                    total[x] += kind((p[x] + q[x]) + (r[x] + s[x]))
+            elif assign:
+                for x in range(count):
+                    total[x] = kind(band[x] + ((p[x] + q[x]) + (r[x] + s[x])))
+            else:
+                for x in range(count):
+                    total[x] += kind(band[x] + ((p[x] + q[x]) + (r[x] + s[x])))
+
+
+@njit(cache=True, nogil=True)
 def best_products(
     light_tables,
     sat_tables,
@@ -450,6 +553,7 @@ def best_products(
     sat_starts,
     sat_mids,
     sat_bands,
+    columns,
     sat_inner,
     sat_outer,
     radii,
@@ -487,9 +591,13 @@ def best_products(
         in ``conspicuity.py``); ``margin_offsets`` is None with margin 0.
     sat_offsets, sat_starts, sat_mids : ndarray
         The same as ``light_*`` for the bands of the saturation disks, band ``b`` spanning
-        ``sat_starts[b:b + 2]``.
+        ``sat_starts[b:b + 2]``; with ``columns``, offsets into the flattened ``columns``.
     sat_bands : ndarray
         Disk ``d`` is the sum of bands ``sat_bands[d]`` to ``sat_bands[d + 1]`` (exclusive).
+    columns : ndarray
+        (largest saturation radius + 2, table width) of the saturation tables' type, its last
+        row zero: room for the column sums of :func:`fill_columns`, from which
+        :func:`column_disks` sums the disks; or of shape (0, 0) to sum them from the tables.
     sat_inner, sat_outer : ndarray
         Per radius index, the saturation disk of radius ``r`` and of ``2 r``.
     radii, n_quarter, n_box : ndarray
@@ -510,6 +618,8 @@ def best_products(
     stairs = np.zeros((LIGHT_WINDOWS, longest), light_tables.dtype)
     sat = np.zeros((sat_bands.shape[0] - 1, longest), np.int32)
     band = np.zeros(longest, sat_tables.dtype)
+    column_flat = columns.reshape(columns.size)
+    plane = INTEGRAL * sat_tables.shape[1] * sat_tables.shape[2]
     contrast = np.zeros(longest, np.int64)
     disk = np.zeros(longest, np.int64)
     features = np.zeros((3, longest), np.float32)
@@ -521,25 +631,15 @@ def best_products(
     for run in range(runs.shape[0]):
         i, x0, count = runs[run, 0], runs[run, 1], runs[run, 2] - runs[run, 1]
         base = (pad + 1 + i) * sat_tables.shape[2] + pad + x0
-        for d in range(sat.shape[0]):
-            total = sat[d]
-            for b in range(sat_bands[d], sat_bands[d + 1]):
-                window_sum(
-                    sat_flat,
-                    sat_offsets,
-                    sat_starts[b],
-                    sat_mids[b],
-                    sat_starts[b + 1],
-                    base,
-                    count,
-                    band,
-                )
-                if b == sat_bands[d]:
-                    for x in range(count):
-                        total[x] = band[x]
-                    continue
-                for x in range(count):
-                    total[x] += band[x]
+        if columns.shape[0]:
+            fill_columns(sat_flat, plane, sat_tables.shape[2], pad, i, x0, count, columns)
+            column_disks(
+                column_flat, sat_offsets, sat_starts, sat_bands, pad + x0, count, band, sat
+            )
+        else:
+            disk_sums(
+                sat_flat, sat_offsets, sat_starts, sat_mids, sat_bands, base, count, band, sat
+            )
         shared = _shared_starts(shared_offsets, base)
         for k in range(radii.shape[0]):
             for w in range(LIGHT_WINDOWS):
