@@ -78,9 +78,9 @@ def thresholds(cmap, params):
     peaks = []
     plain = localization.normalise
 
-    def recording(wcm, peak=None):
+    def recording(wcm, peak=None, copy=False):
         peaks.append(float(wcm.max()) if peak is None else peak)
-        return plain(wcm, peak)
+        return plain(wcm, peak, copy)
 
     localization.normalise = recording
     try:

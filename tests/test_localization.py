@@ -163,6 +163,15 @@ def test_clear_found_zeroes_the_raw_peaks_and_the_digital_disks():
 def test_normalise_divides_in_place_and_drmshift_takes_a_known_reach():
     wcm = np.array([[1.0, 4.0], [2.0, 0.0]], np.float32)
     assert loc.normalise(wcm) is wcm and wcm.tolist() == [[0.25, 1.0], [0.5, 0.0]]
+    # With copy, the quotients go to a new array and the map is left as it was.
+    cm = np.array([[3.0, 0.7], [0.0, 1.9]], np.float32)
+    copied = loc.normalise(cm, 1.9, copy=True)
+    assert (
+        copied is not cm and cm.tolist() == np.array([[3.0, 0.7], [0.0, 1.9]], np.float32).tolist()
+    )
+    assert np.array_equal(copied, loc.normalise(cm.copy(), 1.9))
+    zeros = np.zeros((2, 2), np.float32)
+    assert loc.normalise(zeros, copy=True) is zeros
     cm = blob((40, 40), (20.0, 18.0), 3.0).astype(np.float32)
     rm = np.full((40, 40), 4, np.int32)
     rm[0, 0] = 9  # the map's maximum, out of every window's way

@@ -125,12 +125,13 @@ def region_of_interest(image: np.ndarray, top: float) -> np.ndarray:
     return image[: max(1, int(round(image.shape[0] * top)))]
 
 
-def normalise(wcm: np.ndarray, peak: float | None = None) -> np.ndarray:
+def normalise(wcm: np.ndarray, peak: float | None = None, copy: bool = False) -> np.ndarray:
     """Eq. 3.13: divide the float32 working map by its maximum ``peak`` (found when not given)
-    in place, and return it (unchanged when the maximum is 0)."""
+    in place, or into a new array when ``copy``, and return the result (``wcm`` itself,
+    unchanged, when the maximum is 0)."""
     peak = float(wcm.max()) if peak is None else peak
     if peak > 0:
-        np.divide(wcm, np.float32(peak), out=wcm)
+        return np.divide(wcm, np.float32(peak), out=None if copy else wcm)
     return wcm
 
 
@@ -422,15 +423,16 @@ def localize(
     list of Candidate
         At most ``n_top``, best score first; score is ``cm`` at the candidate's centre.
     """
-    wcm = np.array(cm, dtype=np.float32)
+    source = np.asarray(cm, dtype=np.float32)
     found_c = np.zeros((0, 2))
     found_r = np.zeros(0, np.int64)
     reach = None if radius_map is None else int(radius_map.max(initial=0))
-    for _ in range(params["max_iter"]):
-        peak = float(wcm.max())
+    for iteration in range(params["max_iter"]):
+        peak = float(source.max())
         if not peak > 0:
             break
-        normalise(wcm, peak)
+        # The first normalisation is the working copy of ``cm`` (one pass, not two).
+        wcm = source = normalise(source, peak, iteration == 0)
         raw = peak_mask(wcm, params["h_peak"])
         region = peak_region(raw)
         opened = denoise(np.ascontiguousarray(raw[region]))
