@@ -142,9 +142,11 @@ def load_model(path: str | os.PathLike, plugin: str) -> Model:
         EOFError,
         zlib.error,
         NotImplementedError,
+        RuntimeError,
     ) as exc:
         # a damaged deflate stream (zlib.error) or zip header (NotImplementedError: "zip file
-        # version 21.7", "compression method is not supported") found by benchmarks/fuzz.py
+        # version 21.7", "compression method is not supported") found by benchmarks/fuzz.py;
+        # RuntimeError: a damaged flag bit reads as "File ... is encrypted" (hypothesis)
         raise ModelError(
             f"model {npz_path}: corrupt archive ({type(exc).__name__}: {exc})"
         ) from None
