@@ -27,8 +27,8 @@ half the time they took in int32). The saturation disks (up to 1257 pixels) are 
 in uint16, in bands of at most :data:`BAND_PIXELS` pixels whose sums (in [0, 65535]) are
 added in int32, and not from the tables: a disk is the sum of its columns' vertical sums, all
 centred on its row, so the row's 21 vertical sums per column (:func:`fill_columns`) serve
-every disk (:func:`column_disks`: 336 reads per pixel with 84 for the sums, against 494 table
-reads). The nine lightness windows of a radius (Eq. 3.3, 3.7,
+every disk (:func:`column_disks`: 285 reads per pixel, 336 with padding, plus 84 for the
+sums, against 494 table reads). The nine lightness windows of a radius (Eq. 3.3, 3.7,
 3.8) are built in the pass that combines them (:func:`_light_windows`) from the four quarters'
 staircases and 24 single entries each read once (548 table reads per pixel over the paper's
 ten radii became 188 buffered reads plus 240 single ones, and 90 buffered windows 40). Being
@@ -439,23 +439,6 @@ def _margin_starts_overload(offsets, k, base):
 
 
 @njit(cache=True, nogil=True)
-def disk_sums(flat, offsets, starts, mids, bands, base, count, band, sat):
-    """The saturation disks of a run into the int32 rows of ``sat``: disk ``d`` is the sum of
-    its bands ``bands[d]`` to ``bands[d + 1]``, each a :func:`window_sum` of ``flat`` into
-    ``band`` (exact in the tables' type, see :data:`BAND_PIXELS`), added in int32."""
-    for d in range(sat.shape[0]):
-        total = sat[d]
-        for b in range(bands[d], bands[d + 1]):
-            window_sum(flat, offsets, starts[b], mids[b], starts[b + 1], base, count, band)
-            if b == bands[d]:
-                for x in range(count):
-                    total[x] = band[x]
-                continue
-            for x in range(count):
-                total[x] += band[x]
-
-
-@njit(cache=True, nogil=True)
 def fill_columns(flat, plane, table_width, pad, i, x0, count, columns):
     """The vertical sums of the saturation around image row ``i``, for the disks of the run
     ``x0 .. x0 + count`` on that row: ``columns[h, c]`` = the sum of padded column ``c`` over
@@ -590,10 +573,11 @@ def best_products(
         (R, 14) and (R, 4) per radius (``SHARED_TERMS``, ``corner_terms`` and ``margin_terms``
         in ``conspicuity.py``); ``margin_offsets`` is None with margin 0.
     sat_offsets, sat_starts, sat_mids : ndarray
-        The same as ``light_*`` for the bands of the saturation disks, band ``b`` spanning
-        ``sat_starts[b:b + 2]``; with ``columns``, offsets into the flattened ``columns``.
+        The same as ``light_*`` for the saturation disks, window ``b`` spanning
+        ``sat_starts[b:b + 2]``: one window per disk on the tables, or with ``columns`` the
+        bands of the disks (offsets into the flattened ``columns``, all terms positive).
     sat_bands : ndarray
-        Disk ``d`` is the sum of bands ``sat_bands[d]`` to ``sat_bands[d + 1]`` (exclusive).
+        Disk ``d`` is the sum of windows ``sat_bands[d]`` to ``sat_bands[d + 1]`` (exclusive).
     columns : ndarray
         (largest saturation radius + 2, table width) of the saturation tables' type, its last
         row zero: room for the column sums of :func:`fill_columns`, from which
@@ -637,9 +621,17 @@ def best_products(
                 column_flat, sat_offsets, sat_starts, sat_bands, pad + x0, count, band, sat
             )
         else:
-            disk_sums(
-                sat_flat, sat_offsets, sat_starts, sat_mids, sat_bands, base, count, band, sat
-            )
+            for d in range(sat.shape[0]):
+                window_sum(
+                    sat_flat,
+                    sat_offsets,
+                    sat_starts[d],
+                    sat_mids[d],
+                    sat_starts[d + 1],
+                    base,
+                    count,
+                    sat[d],
+                )
         shared = _shared_starts(shared_offsets, base)
         for k in range(radii.shape[0]):
             for w in range(LIGHT_WINDOWS):
