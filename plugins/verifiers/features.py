@@ -58,20 +58,17 @@ def housing_box(c: Candidate) -> Box:
     return c.housing if c.housing is not None else lens_context_box(c)
 
 
-def sample_boxes(
-    image: np.ndarray, boxes: np.ndarray, size: tuple[int, int], upright: bool = False
-) -> np.ndarray:
-    """Bilinear samples of every box of ``image`` at ``size`` (width, height), stacked.
+#: Widest row of sample points handed to one ``cv2.remap`` (which refuses 32767 or more).
+REMAP_ROW = 8192
 
-    One ``cv2.remap`` over the whole stack; pixels outside the frame replicate its border.
-    With ``upright``, a box wider than tall is read transposed, so its long side runs down.
 
-    Returns
-    -------
-    ndarray of shape (N, height, width, channels)
-    """
+def box_maps(
+    boxes: np.ndarray, size: tuple[int, int], upright: bool = False
+) -> tuple[np.ndarray, np.ndarray]:
+    """The sample points (x, y), flat float32, of every box of ``boxes`` at ``size`` (width,
+    height), box after box, row by row: pixel centres of the box scaled to ``size``. With
+    ``upright``, a box wider than tall is read transposed, so its long side runs down."""
     width, height = size
-    n = len(boxes)
     x0, y0, x1, y1 = (boxes[:, k, None, None] for k in range(4))
     v, u = np.mgrid[0:height, 0:width].astype(np.float32) + 0.5
     map_x = x0 + u * (x1 - x0) / width - 0.5
@@ -80,14 +77,51 @@ def sample_boxes(
         wide = (boxes[:, 2] - boxes[:, 0] > boxes[:, 3] - boxes[:, 1])[:, None, None]
         map_x = np.where(wide, x0 + v * (x1 - x0) / height - 0.5, map_x)
         map_y = np.where(wide, y0 + u * (y1 - y0) / width - 0.5, map_y)
+    return map_x.astype(np.float32).ravel(), map_y.astype(np.float32).ravel()
+
+
+def remap_points(image: np.ndarray, map_x: np.ndarray, map_y: np.ndarray) -> np.ndarray:
+    """Bilinear samples of ``image`` at the flat points ``map_x``, ``map_y``; pixels outside
+    the frame replicate its border.
+
+    The points go to ``cv2.remap`` as rows of up to :data:`REMAP_ROW` (its cost is mostly per
+    row: a tall stack of 12- or 16-pixel rows takes 3-4x as long); each output pixel is a
+    function of its own point alone, so the samples are those of any other layout
+    (``tests/test_verifier_features_oracle.py``).
+
+    Returns
+    -------
+    ndarray of shape (points, channels)
+    """
+    count = len(map_x)
+    width = max(min(count, REMAP_ROW), 1)
+    rows = -(-count // width)
+    maps = np.zeros((2, rows * width), np.float32)
+    maps[0, :count], maps[1, :count] = map_x, map_y
     out = cv2.remap(
         image,
-        map_x.reshape(n * height, width).astype(np.float32),
-        map_y.reshape(n * height, width).astype(np.float32),
+        maps[0].reshape(rows, width),
+        maps[1].reshape(rows, width),
         cv2.INTER_LINEAR,
         borderMode=cv2.BORDER_REPLICATE,
     )
-    return out.reshape(n, height, width, -1)
+    return out.reshape(rows * width, -1)[:count]
+
+
+def sample_boxes(
+    image: np.ndarray, boxes: np.ndarray, size: tuple[int, int], upright: bool = False
+) -> np.ndarray:
+    """Bilinear samples of every box of ``image`` at ``size`` (width, height), stacked
+    (:func:`box_maps` sampled by :func:`remap_points`, one ``cv2.remap`` for the stack).
+
+    Returns
+    -------
+    ndarray of shape (N, height, width, channels)
+    """
+    width, height = size
+    return remap_points(image, *box_maps(boxes, size, upright)).reshape(
+        len(boxes), height, width, -1
+    )
 
 
 def stacked_hog(lightness: np.ndarray, rows: int) -> np.ndarray:
@@ -113,7 +147,8 @@ def stacked_hog(lightness: np.ndarray, rows: int) -> np.ndarray:
         (width // HOG_SHRINK, n * height // HOG_SHRINK),
         interpolation=cv2.INTER_AREA,
     ).reshape(n, height // HOG_SHRINK, width // HOG_SHRINK)
-    framed = np.pad(small, ((0, 0), (2, 2), (0, 0)))
+    framed = np.zeros((n, small.shape[1] + 4, small.shape[2]), np.float32)
+    framed[:, 2:-2] = small
     cell_rows, remainder = divmod(framed.shape[1], rows)
     if remainder:
         raise ValueError(f"{framed.shape[1]} framed rows do not split into {rows} cells")
@@ -268,9 +303,16 @@ def candidate_features(image: np.ndarray, candidates: Sequence[Candidate]) -> np
         return np.zeros((0, len(feature_names())), np.float32)
     lens_boxes = np.array([lens_context_box(c) for c in candidates], np.float32)
     house_boxes = np.array([housing_box(c) for c in candidates], np.float32)
+    # both stacks sampled by one remap: their points one after the other
+    lens_x, lens_y = box_maps(lens_boxes, (LENS_PX, LENS_PX))
+    house_x, house_y = box_maps(house_boxes, HOUSING_PX, upright=True)
+    points = remap_points(
+        image, np.concatenate([lens_x, house_x]), np.concatenate([lens_y, house_y])
+    )
+    n = len(candidates)
     lens, housing = colour_planes(
-        sample_boxes(image, lens_boxes, (LENS_PX, LENS_PX)),
-        sample_boxes(image, house_boxes, HOUSING_PX, upright=True),
+        points[: len(lens_x)].reshape(n, LENS_PX, LENS_PX, 3),
+        points[len(lens_x) :].reshape(n, HOUSING_PX[1], HOUSING_PX[0], 3),
     )
     height, width = image.shape[:2]
     return np.column_stack(

@@ -1,0 +1,95 @@
+"""The verifier's features as ``plugins/verifiers/features.py`` computed them before the speed-up
+of issue 11 (speed11): each sample stack remapped as a tall image of its patches (one
+``cv2.remap`` per stack), the HOG patches framed by ``np.pad``. The oracle the faster features
+must match to the bit. The functions the speed-up left alone are imported."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+from skimage.feature._hoghistogram import hog_histograms
+
+from tsrkit_plugins.verifiers.features import (
+    HOG_SHRINK,
+    HOUSING_PX,
+    LENS_PX,
+    ORIENTATIONS,
+    colour_features,
+    colour_planes,
+    geometry_features,
+    housing_box,
+    lens_context_box,
+)
+
+
+def sample_boxes(image, boxes, size, upright=False):
+    width, height = size
+    n = len(boxes)
+    x0, y0, x1, y1 = (boxes[:, k, None, None] for k in range(4))
+    v, u = np.mgrid[0:height, 0:width].astype(np.float32) + 0.5
+    map_x = x0 + u * (x1 - x0) / width - 0.5
+    map_y = y0 + v * (y1 - y0) / height - 0.5
+    if upright:
+        wide = (boxes[:, 2] - boxes[:, 0] > boxes[:, 3] - boxes[:, 1])[:, None, None]
+        map_x = np.where(wide, x0 + v * (x1 - x0) / height - 0.5, map_x)
+        map_y = np.where(wide, y0 + u * (y1 - y0) / width - 0.5, map_y)
+    out = cv2.remap(
+        image,
+        map_x.reshape(n * height, width).astype(np.float32),
+        map_y.reshape(n * height, width).astype(np.float32),
+        cv2.INTER_LINEAR,
+        borderMode=cv2.BORDER_REPLICATE,
+    )
+    return out.reshape(n, height, width, -1)
+
+
+def stacked_hog(lightness, rows):
+    n, height, width = lightness.shape
+    small = cv2.resize(
+        np.ascontiguousarray(lightness.reshape(n * height, width), np.float32) / 255.0,
+        (width // HOG_SHRINK, n * height // HOG_SHRINK),
+        interpolation=cv2.INTER_AREA,
+    ).reshape(n, height // HOG_SHRINK, width // HOG_SHRINK)
+    framed = np.pad(small, ((0, 0), (2, 2), (0, 0)))
+    cell_rows = framed.shape[1] // rows
+    image = framed.reshape(-1, framed.shape[2])
+    g_row = np.zeros_like(image)
+    g_row[1:-1] = image[2:] - image[:-2]
+    g_col = np.zeros_like(image)
+    g_col[:, 1:-1] = image[:, 2:] - image[:, :-2]
+    cells = np.zeros((n * rows, 1, ORIENTATIONS))
+    hog_histograms(
+        g_col.astype(float),
+        g_row.astype(float),
+        image.shape[1],
+        cell_rows,
+        image.shape[1],
+        image.shape[0],
+        1,
+        n * rows,
+        ORIENTATIONS,
+        cells,
+    )
+    blocks = (cells / (np.abs(cells).sum(axis=-1, keepdims=True) + 1e-5)).astype(np.float32)
+    return blocks.reshape(n, -1)
+
+
+def candidate_features(image, candidates):
+    """The feature matrix of ``candidates`` on ``image``, computed the old way."""
+    if image.ndim == 2:
+        image = cv2.cvtColor(image, cv2.COLOR_GRAY2BGR)
+    lens_boxes = np.array([lens_context_box(c) for c in candidates], np.float32)
+    house_boxes = np.array([housing_box(c) for c in candidates], np.float32)
+    lens, housing = colour_planes(
+        sample_boxes(image, lens_boxes, (LENS_PX, LENS_PX)),
+        sample_boxes(image, house_boxes, HOUSING_PX, upright=True),
+    )
+    height, width = image.shape[:2]
+    return np.column_stack(
+        [
+            stacked_hog(lens[..., 0], 1),
+            stacked_hog(housing[..., 0], 3),
+            colour_features(lens, housing),
+            geometry_features(candidates, house_boxes, width, height),
+        ]
+    )
