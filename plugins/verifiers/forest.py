@@ -118,7 +118,7 @@ class Forest:
                 right &= ~(np.isnan(value) & self.nan_left.take(at))
             else:
                 right = value > self.threshold.take(at)
-            self.children.take(at + right, out=at)
+            self.children.take(at + right, out=at, mode="clip")  # always in range: unbuffered
         k = len(self.baseline)
         leaves = self.value.take(slot).reshape(len(self.roots), rows)[self.order]
         # one row per iteration, after the baselines: a reduction along the first axis adds the

@@ -1,7 +1,8 @@
 """The verifier's features as ``plugins/verifiers/features.py`` computed them before the speed-up
 of issue 11 (speed11): each sample stack remapped as a tall image of its patches (one
-``cv2.remap`` per stack), the HOG patches framed by ``np.pad``. The oracle the faster features
-must match to the bit. The functions the speed-up left alone are imported."""
+``cv2.remap`` per stack), the HOG patches framed by ``np.pad``, the colour statistics averaged
+patch by patch (8 channels last). The oracle the faster features must match to the bit. The
+functions the speed-up left alone are imported."""
 
 from __future__ import annotations
 
@@ -10,16 +11,70 @@ import numpy as np
 from skimage.feature._hoghistogram import hog_histograms
 
 from tsrkit_plugins.verifiers.features import (
+    COLOUR_NAMES,
     HOG_SHRINK,
     HOUSING_PX,
     LENS_PX,
     ORIENTATIONS,
-    colour_features,
-    colour_planes,
+    RING_MASKS,
     geometry_features,
     housing_box,
     lens_context_box,
 )
+
+_HUE_COS = np.cos(np.arange(180) * (np.pi / 90.0)).astype(np.float32)
+_HUE_SIN = np.sin(np.arange(180) * (np.pi / 90.0)).astype(np.float32)
+
+
+def colour_planes(*patches):
+    flat = np.concatenate([p.reshape(-1, 3) for p in patches])[None]
+    lab = cv2.cvtColor(flat, cv2.COLOR_BGR2LAB)[0].T.astype(np.float32)
+    hsv = cv2.cvtColor(flat, cv2.COLOR_BGR2HSV)[0].T
+    hue, saturation = hsv[0], hsv[1].astype(np.float32) / 255.0
+    a, b = lab[1] - 128.0, lab[2] - 128.0
+    planes = np.stack(
+        [
+            *lab,
+            hsv[1].astype(np.float32),
+            hsv[2].astype(np.float32),
+            _HUE_COS[hue] * saturation,
+            _HUE_SIN[hue] * saturation,
+            np.sqrt(a * a + b * b),
+        ],
+        axis=-1,
+    )
+    ends = np.cumsum([0] + [p.size // 3 for p in patches])
+    return [
+        planes[start:end].reshape(*p.shape[:-1], len(COLOUR_NAMES))
+        for p, start, end in zip(patches, ends[:-1], ends[1:])
+    ]
+
+
+def colour_features(lens, housing):
+    rings = [lens[:, m].mean(axis=1) for m in RING_MASKS]
+    lens_l = lens[..., 0][:, RING_MASKS[0]]
+    lens_v = lens[..., 4][:, RING_MASKS[0]]
+    peak = np.column_stack([lens_l.max(axis=1), lens_l.std(axis=1), (lens_v > 240).mean(axis=1)])
+    house = housing.reshape(len(housing), -1, len(COLOUR_NAMES))
+    light = house[..., 0]
+    house_stats = np.column_stack(
+        [
+            house.mean(axis=1),
+            light.std(axis=1),
+            np.percentile(light, 25, axis=1),
+            (house[..., 4] < 60).mean(axis=1),
+        ]
+    )
+    lens_mean_l = rings[0][:, 0] + 1.0
+    darkness = np.column_stack(
+        [
+            rings[0][:, 0] - rings[1][:, 0],
+            rings[0][:, 0] - rings[2][:, 0],
+            (rings[2][:, 0] + 1.0) / lens_mean_l,
+            (house_stats[:, 0] + 1.0) / lens_mean_l,
+        ]
+    )
+    return np.column_stack([*rings, peak, house_stats, darkness]).astype(np.float32)
 
 
 def sample_boxes(image, boxes, size, upright=False):
