@@ -70,15 +70,21 @@ def test_features_equal_the_oracle(scenes):
 def test_remap_points_do_not_depend_on_the_row_layout():
     rng = np.random.default_rng(3)
     image = rng.integers(0, 256, (90, 120, 3), np.uint8)
-    x = rng.uniform(-20, 140, 20000).astype(np.float32)
-    y = rng.uniform(-20, 110, 20000).astype(np.float32)
+    x = rng.uniform(-20, 140, 70001).astype(np.float32)  # three rows, the last one filled up
+    y = rng.uniform(-20, 110, 70001).astype(np.float32)
     x[::3] = np.round(x[::3])  # on pixel centres too
-    tall = cv2.remap(
-        image,
-        x.reshape(-1, 16),
-        y.reshape(-1, 16),
-        cv2.INTER_LINEAR,
-        borderMode=cv2.BORDER_REPLICATE,
-    ).reshape(-1, 3)
-    assert np.array_equal(remap_points(image, x, y), tall)
-    assert np.array_equal(remap_points(image, x[:7], y[:7]), tall[:7])
+
+    def tall(x, y, width):
+        return cv2.remap(
+            image,
+            x.reshape(-1, width),
+            y.reshape(-1, width),
+            cv2.INTER_LINEAR,
+            borderMode=cv2.BORDER_REPLICATE,
+        ).reshape(-1, 3)
+
+    got = remap_points(image, x, y)
+    assert got.shape == (70001, 3)
+    assert np.array_equal(got[:70000], tall(x[:70000], y[:70000], 16))
+    assert np.array_equal(got[70000:], tall(x[70000:], y[70000:], 1))
+    assert np.array_equal(remap_points(image, x[:7], y[:7]), got[:7])

@@ -59,7 +59,7 @@ def housing_box(c: Candidate) -> Box:
 
 
 #: Widest row of sample points handed to one ``cv2.remap`` (which refuses 32767 or more).
-REMAP_ROW = 8192
+REMAP_ROW = 32000
 
 
 def box_maps(
@@ -84,20 +84,21 @@ def remap_points(image: np.ndarray, map_x: np.ndarray, map_y: np.ndarray) -> np.
     """Bilinear samples of ``image`` at the flat points ``map_x``, ``map_y``; pixels outside
     the frame replicate its border.
 
-    The points go to ``cv2.remap`` as rows of up to :data:`REMAP_ROW` (its cost is mostly per
-    row: a tall stack of 12- or 16-pixel rows takes 3-4x as long); each output pixel is a
-    function of its own point alone, so the samples are those of any other layout
-    (``tests/test_verifier_features_oracle.py``).
+    The points go to ``cv2.remap`` as rows of up to :data:`REMAP_ROW` (one row for 50
+    candidates; its cost is mostly per row: a tall stack of 12- or 16-pixel rows takes 3x as
+    long); each output pixel is a function of its own point alone, so the samples are those of
+    any other layout (``tests/test_verifier_features_oracle.py``).
 
     Returns
     -------
     ndarray of shape (points, channels)
     """
     count = len(map_x)
-    width = max(min(count, REMAP_ROW), 1)
-    rows = -(-count // width)
-    maps = np.zeros((2, rows * width), np.float32)
-    maps[0, :count], maps[1, :count] = map_x, map_y
+    rows = max(-(-count // REMAP_ROW), 1)
+    width = max(-(-count // rows), 1)
+    maps = [np.asarray(m, np.float32) for m in (map_x, map_y)]
+    if rows * width != count:  # the last row filled up with points at (0, 0), cut after
+        maps = [np.concatenate([m, np.zeros(rows * width - count, np.float32)]) for m in maps]
     out = cv2.remap(
         image,
         maps[0].reshape(rows, width),
@@ -312,16 +313,16 @@ def candidate_features(image: np.ndarray, candidates: Sequence[Candidate]) -> np
     lens_boxes = np.array([lens_context_box(c) for c in candidates], np.float32)
     house_boxes = np.array([housing_box(c) for c in candidates], np.float32)
     n = len(candidates)
-    # both stacks sampled by one remap, pixel after pixel, candidate innermost
+    # both stacks sampled by one remap (candidate after candidate: near points, near in memory),
+    # then read pixel after pixel, candidate inside (see colour_features)
     lens_x, lens_y = box_maps(lens_boxes, (LENS_PX, LENS_PX))
     house_x, house_y = box_maps(house_boxes, HOUSING_PX, upright=True)
     points = remap_points(
-        image,
-        np.concatenate([lens_x.reshape(n, -1).T.ravel(), house_x.reshape(n, -1).T.ravel()]),
-        np.concatenate([lens_y.reshape(n, -1).T.ravel(), house_y.reshape(n, -1).T.ravel()]),
+        image, np.concatenate([lens_x, house_x]), np.concatenate([lens_y, house_y])
     )
     lens, housing = colour_planes(
-        points[: len(lens_x)].reshape(-1, n, 3), points[len(lens_x) :].reshape(-1, n, 3)
+        points[: len(lens_x)].reshape(n, -1, 3).transpose(1, 0, 2),
+        points[len(lens_x) :].reshape(n, -1, 3).transpose(1, 0, 2),
     )
     height, width = image.shape[:2]
     return np.column_stack(
