@@ -16,7 +16,7 @@ from oracles.frames import annotated_frames
 
 from tsrkit.registry import get_registry
 from tsrkit.types import Candidate, Frame
-from tsrkit_plugins.verifiers.features import candidate_features, remap_points
+from tsrkit_plugins.verifiers.features import candidate_features, remap_points, row_percentile
 
 
 def scattered(rng, width, height, n):
@@ -88,3 +88,12 @@ def test_remap_points_do_not_depend_on_the_row_layout():
     assert np.array_equal(got[:70000], tall(x[:70000], y[:70000], 16))
     assert np.array_equal(got[70000:], tall(x[70000:], y[70000:], 1))
     assert np.array_equal(remap_points(image, x[:7], y[:7]), got[:7])
+
+
+@pytest.mark.parametrize("n", [1, 2, 5, 264])
+def test_row_percentile_is_numpys_to_the_bit(n):
+    rng = np.random.default_rng(n)
+    values = (rng.standard_normal((40, n)) * 100).astype(np.float32)
+    values[:, : n // 2] = np.round(values[:, : n // 2])  # ties and whole numbers too
+    for q in (0, 10, 25, 50, 75, 90, 100):
+        assert np.array_equal(row_percentile(values, q), np.percentile(values, q, axis=1))
