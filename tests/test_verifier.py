@@ -63,7 +63,7 @@ def test_stacked_hog_is_skimage_hog_of_the_stack_on_real_patches(shared_datasets
         for r in rng.uniform(1, 20, 60)
     ]
     lens = F.colour_planes(
-        F.sample_boxes(image, np.array([F.lens_context_box(c) for c in candidates]), (16, 16))
+        F.sample_boxes(image, F.context_boxes(F.candidate_table(candidates))[0], (16, 16))
     )[0][..., 0]
     for rows, patches in ((1, lens), (3, lens[:, :, 2:14].repeat(2, axis=1)[:, :22])):
         n, height, width = patches.shape

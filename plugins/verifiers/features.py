@@ -15,7 +15,6 @@ import cv2
 import numpy as np
 from skimage.feature._hoghistogram import hog_histograms
 
-from tsrkit.geometry import Box
 from tsrkit.types import Candidate
 
 #: Side of the lens context, in lens radii (lens disk: 1 radius, annulus 1-2, surround 2-3).
@@ -47,15 +46,40 @@ def _ring_masks(size: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 RING_MASKS = _ring_masks(LENS_PX)
 
 
-def lens_context_box(c: Candidate) -> Box:
-    """The square of ``CONTEXT`` radii around the lens (the housing fallback)."""
-    half = max(c.radius, 1.0) * CONTEXT / 2
-    return (c.x - half, c.y - half, c.x + half, c.y + half)
+#: Columns of :func:`candidate_table`.
+TABLE = ("x", "y", "radius", "score", "housing_score", "has_housing", "hx0", "hy0", "hx1", "hy1")
+_NO_BOX = (np.nan,) * 4
 
 
-def housing_box(c: Candidate) -> Box:
-    """The candidate's housing, or its lens context when no housing stage fitted one."""
-    return c.housing if c.housing is not None else lens_context_box(c)
+def candidate_table(candidates: Sequence[Candidate]) -> np.ndarray:
+    """What the features read of each candidate, one pass over them: an (N, 10) float64 table
+    of :data:`TABLE` (housing score -1 and housing box NaN where no housing stage fitted one)."""
+    return np.array(
+        [
+            (
+                c.x,
+                c.y,
+                c.radius,
+                c.score,
+                -1.0 if c.housing_score is None else c.housing_score,
+                c.housing is not None,
+                *(_NO_BOX if c.housing is None else c.housing),
+            )
+            for c in candidates
+        ],
+        np.float64,
+    ).reshape(-1, len(TABLE))
+
+
+def context_boxes(table: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The lens context of each candidate of a :func:`candidate_table` (the square of
+    ``CONTEXT`` radii around the lens, at least 1 px) and its housing box (the fitted housing,
+    else the lens context), as (N, 4) float32 boxes."""
+    x, y, radius = table[:, 0], table[:, 1], table[:, 2]
+    half = np.maximum(radius, 1.0) * CONTEXT / 2
+    lens = np.column_stack([x - half, y - half, x + half, y + half])
+    housing = np.where(table[:, 5:6] > 0, table[:, 6:10], lens)
+    return lens.astype(np.float32), housing.astype(np.float32)
 
 
 #: Widest row of sample points handed to one ``cv2.remap`` (which refuses 32767 or more).
@@ -276,26 +300,12 @@ def colour_features(lens: np.ndarray, housing: np.ndarray) -> np.ndarray:
     return np.column_stack([*rings, peak, house_stats, darkness]).astype(np.float32)
 
 
-def geometry_features(
-    candidates: Sequence[Candidate], boxes: np.ndarray, width: int, height: int
-) -> np.ndarray:
+def geometry_features(table: np.ndarray, boxes: np.ndarray, width: int, height: int) -> np.ndarray:
     """Radius, housing shape in lens radii, the lens's place in its housing, the frame
-    position, and the detector's score (raw, relative to the frame's best, and rank)."""
-    xyrs = np.array(
-        [
-            (
-                c.x,
-                c.y,
-                max(c.radius, 0.5),
-                c.score,
-                -1.0 if c.housing_score is None else c.housing_score,
-                c.housing is not None,
-            )
-            for c in candidates
-        ],
-        np.float64,
-    )
-    x, y, radius, score, fit, has_housing = xyrs.T
+    position, and the detector's score (raw, relative to the frame's best, and rank), of the
+    candidates of a :func:`candidate_table` and their housing ``boxes``."""
+    x, y, score, fit, has_housing = table[:, [0, 1, 3, 4, 5]].T
+    radius = np.maximum(table[:, 2], 0.5)
     hw = np.maximum(boxes[:, 2] - boxes[:, 0], 1e-3)
     hh = np.maximum(boxes[:, 3] - boxes[:, 1], 1e-3)
     best = float(np.max(np.abs(score))) or 1.0
@@ -333,8 +343,8 @@ def candidate_features(image: np.ndarray, candidates: Sequence[Candidate]) -> np
         image = cv2.cvtColor(image, cv2.COLOR_GRAY2BGR)
     if not candidates:
         return np.zeros((0, len(feature_names())), np.float32)
-    lens_boxes = np.array([lens_context_box(c) for c in candidates], np.float32)
-    house_boxes = np.array([housing_box(c) for c in candidates], np.float32)
+    table = candidate_table(candidates)
+    lens_boxes, house_boxes = context_boxes(table)
     n = len(candidates)
     # both stacks sampled by one remap (candidate after candidate: near points, near in memory),
     # then read pixel after pixel, candidate inside (see colour_features)
@@ -353,7 +363,7 @@ def candidate_features(image: np.ndarray, candidates: Sequence[Candidate]) -> np
             stacked_hog(lens[:, :, 0].T.reshape(n, LENS_PX, LENS_PX), 1),
             stacked_hog(housing[:, :, 0].T.reshape(n, HOUSING_PX[1], HOUSING_PX[0]), 3),
             colour_features(lens, housing),
-            geometry_features(candidates, house_boxes, width, height),
+            geometry_features(table, house_boxes, width, height),
         ]
     )
 

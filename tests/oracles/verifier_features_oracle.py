@@ -12,14 +12,12 @@ from skimage.feature._hoghistogram import hog_histograms
 
 from tsrkit_plugins.verifiers.features import (
     COLOUR_NAMES,
+    CONTEXT,
     HOG_SHRINK,
     HOUSING_PX,
     LENS_PX,
     ORIENTATIONS,
     RING_MASKS,
-    geometry_features,
-    housing_box,
-    lens_context_box,
 )
 
 _HUE_COS = np.cos(np.arange(180) * (np.pi / 90.0)).astype(np.float32)
@@ -75,6 +73,61 @@ def colour_features(lens, housing):
         ]
     )
     return np.column_stack([*rings, peak, house_stats, darkness]).astype(np.float32)
+
+
+def lens_context_box(c):
+    """The square of ``CONTEXT`` radii around the lens (the housing fallback)."""
+    half = max(c.radius, 1.0) * CONTEXT / 2
+    return (c.x - half, c.y - half, c.x + half, c.y + half)
+
+
+def housing_box(c):
+    """The candidate's housing, or its lens context when no housing stage fitted one."""
+    return c.housing if c.housing is not None else lens_context_box(c)
+
+
+def geometry_features(candidates, boxes, width, height):
+    """Radius, housing shape in lens radii, the lens's place in its housing, the frame
+    position, and the detector's score (raw, relative to the frame's best, and rank)."""
+    xyrs = np.array(
+        [
+            (
+                c.x,
+                c.y,
+                max(c.radius, 0.5),
+                c.score,
+                -1.0 if c.housing_score is None else c.housing_score,
+                c.housing is not None,
+            )
+            for c in candidates
+        ],
+        np.float64,
+    )
+    x, y, radius, score, fit, has_housing = xyrs.T
+    hw = np.maximum(boxes[:, 2] - boxes[:, 0], 1e-3)
+    hh = np.maximum(boxes[:, 3] - boxes[:, 1], 1e-3)
+    best = float(np.max(np.abs(score))) or 1.0
+    rank = np.empty(len(score))
+    rank[np.argsort(-score, kind="stable")] = np.arange(len(score))
+    return np.column_stack(
+        [
+            radius,
+            radius / height,
+            hw / radius,
+            hh / radius,
+            np.log(hh / hw),
+            (x - boxes[:, 0]) / hw,
+            (y - boxes[:, 1]) / hh,
+            fit,
+            has_housing,
+            x / width,
+            y / height,
+            score,
+            score / best,
+            rank,
+            np.full(len(score), len(score)),
+        ]
+    ).astype(np.float32)
 
 
 def sample_boxes(image, boxes, size, upright=False):
