@@ -94,14 +94,20 @@ def box_maps(
     ``upright``, a box wider than tall is read transposed, so its long side runs down."""
     width, height = size
     x0, y0, x1, y1 = (boxes[:, k, None, None] for k in range(4))
-    v, u = np.mgrid[0:height, 0:width].astype(np.float32) + 0.5
+    # a column's x and a row's y, computed once per box and spread over the sample
+    u = np.arange(width, dtype=np.float32)[None, None, :] + 0.5
+    v = np.arange(height, dtype=np.float32)[None, :, None] + 0.5
     map_x = x0 + u * (x1 - x0) / width - 0.5
     map_y = y0 + v * (y1 - y0) / height - 0.5
     if upright:
         wide = (boxes[:, 2] - boxes[:, 0] > boxes[:, 3] - boxes[:, 1])[:, None, None]
         map_x = np.where(wide, x0 + v * (x1 - x0) / height - 0.5, map_x)
         map_y = np.where(wide, y0 + u * (y1 - y0) / width - 0.5, map_y)
-    return map_x.astype(np.float32).ravel(), map_y.astype(np.float32).ravel()
+    shape = (len(boxes), height, width)
+    return (
+        np.broadcast_to(map_x, shape).astype(np.float32).ravel(),
+        np.broadcast_to(map_y, shape).astype(np.float32).ravel(),
+    )
 
 
 def remap_points(image: np.ndarray, map_x: np.ndarray, map_y: np.ndarray) -> np.ndarray:
