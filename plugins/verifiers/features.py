@@ -139,22 +139,6 @@ def remap_points(image: np.ndarray, map_x: np.ndarray, map_y: np.ndarray) -> np.
     return out.reshape(rows * width, -1)[:count]
 
 
-def sample_boxes(
-    image: np.ndarray, boxes: np.ndarray, size: tuple[int, int], upright: bool = False
-) -> np.ndarray:
-    """Bilinear samples of every box of ``image`` at ``size`` (width, height), stacked
-    (:func:`box_maps` sampled by :func:`remap_points`, one ``cv2.remap`` for the stack).
-
-    Returns
-    -------
-    ndarray of shape (N, height, width, channels)
-    """
-    width, height = size
-    return remap_points(image, *box_maps(boxes, size, upright)).reshape(
-        len(boxes), height, width, -1
-    )
-
-
 def stacked_hog(lightness: np.ndarray, rows: int) -> np.ndarray:
     """Per-cell HOG (L1-normalised orientation histograms) of every patch at once, equal to
     ``skimage.feature.hog`` of the stacked patches with one-cell blocks.
