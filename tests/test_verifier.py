@@ -29,6 +29,13 @@ def lamp_scene() -> np.ndarray:
     return image
 
 
+def sample_boxes(image, boxes, size, upright=False):
+    """The (N, height, width, 3) samples of ``boxes`` at ``size`` = (width, height)."""
+    width, height = size
+    points = F.remap_points(image, *F.box_maps(boxes, size, upright))
+    return points.reshape(len(boxes), height, width, -1)
+
+
 def test_stacked_hog_equals_skimage_hog_of_each_patch():
     import cv2
 
@@ -63,7 +70,7 @@ def test_stacked_hog_is_skimage_hog_of_the_stack_on_real_patches(shared_datasets
         for r in rng.uniform(1, 20, 60)
     ]
     lens = F.colour_planes(
-        F.sample_boxes(image, np.array([F.lens_context_box(c) for c in candidates]), (16, 16))
+        sample_boxes(image, F.context_boxes(F.candidate_table(candidates))[0], (16, 16))
     )[0][..., 0]
     for rows, patches in ((1, lens), (3, lens[:, :, 2:14].repeat(2, axis=1)[:, :22])):
         n, height, width = patches.shape
@@ -88,9 +95,9 @@ def test_stacked_hog_is_skimage_hog_of_the_stack_on_real_patches(shared_datasets
 def test_sample_boxes_reads_the_box_and_turns_wide_boxes_upright():
     image = np.zeros((50, 80, 3), np.uint8)
     image[:, :, 0] = np.arange(80)[None, :]  # blue grows to the right
-    tall = F.sample_boxes(image, np.array([[10, 0, 22, 22]], np.float32), (12, 22))
+    tall = sample_boxes(image, np.array([[10, 0, 22, 22]], np.float32), (12, 22))
     assert np.array_equal(tall[0, 0, :, 0], np.arange(10, 22))
-    wide = F.sample_boxes(image, np.array([[10, 0, 32, 12]], np.float32), (12, 22), upright=True)
+    wide = sample_boxes(image, np.array([[10, 0, 32, 12]], np.float32), (12, 22), upright=True)
     # the box's x axis now runs down the sample
     assert np.array_equal(wide[0, :, 0, 0], np.arange(10, 32))
     assert np.all(wide[0, 5, :, 0] == 15)

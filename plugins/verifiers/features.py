@@ -15,7 +15,6 @@ import cv2
 import numpy as np
 from skimage.feature._hoghistogram import hog_histograms
 
-from tsrkit.geometry import Box
 from tsrkit.types import Candidate
 
 #: Side of the lens context, in lens radii (lens disk: 1 radius, annulus 1-2, surround 2-3).
@@ -47,47 +46,97 @@ def _ring_masks(size: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 RING_MASKS = _ring_masks(LENS_PX)
 
 
-def lens_context_box(c: Candidate) -> Box:
-    """The square of ``CONTEXT`` radii around the lens (the housing fallback)."""
-    half = max(c.radius, 1.0) * CONTEXT / 2
-    return (c.x - half, c.y - half, c.x + half, c.y + half)
+#: Columns of :func:`candidate_table`.
+TABLE = ("x", "y", "radius", "score", "housing_score", "has_housing", "hx0", "hy0", "hx1", "hy1")
+_NO_BOX = (np.nan,) * 4
 
 
-def housing_box(c: Candidate) -> Box:
-    """The candidate's housing, or its lens context when no housing stage fitted one."""
-    return c.housing if c.housing is not None else lens_context_box(c)
+def candidate_table(candidates: Sequence[Candidate]) -> np.ndarray:
+    """What the features read of each candidate, one pass over them: an (N, 10) float64 table
+    of :data:`TABLE` (housing score -1 and housing box NaN where no housing stage fitted one)."""
+    return np.array(
+        [
+            (
+                c.x,
+                c.y,
+                c.radius,
+                c.score,
+                -1.0 if c.housing_score is None else c.housing_score,
+                c.housing is not None,
+                *(_NO_BOX if c.housing is None else c.housing),
+            )
+            for c in candidates
+        ],
+        np.float64,
+    ).reshape(-1, len(TABLE))
 
 
-def sample_boxes(
-    image: np.ndarray, boxes: np.ndarray, size: tuple[int, int], upright: bool = False
-) -> np.ndarray:
-    """Bilinear samples of every box of ``image`` at ``size`` (width, height), stacked.
+def context_boxes(table: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The lens context of each candidate of a :func:`candidate_table` (the square of
+    ``CONTEXT`` radii around the lens, at least 1 px) and its housing box (the fitted housing,
+    else the lens context), as (N, 4) float32 boxes."""
+    x, y, radius = table[:, 0], table[:, 1], table[:, 2]
+    half = np.maximum(radius, 1.0) * CONTEXT / 2
+    lens = np.column_stack([x - half, y - half, x + half, y + half])
+    housing = np.where(table[:, 5:6] > 0, table[:, 6:10], lens)
+    return lens.astype(np.float32), housing.astype(np.float32)
 
-    One ``cv2.remap`` over the whole stack; pixels outside the frame replicate its border.
-    With ``upright``, a box wider than tall is read transposed, so its long side runs down.
 
-    Returns
-    -------
-    ndarray of shape (N, height, width, channels)
-    """
+#: Widest row of sample points handed to one ``cv2.remap`` (which refuses 32767 or more).
+REMAP_ROW = 32000
+
+
+def box_maps(
+    boxes: np.ndarray, size: tuple[int, int], upright: bool = False
+) -> tuple[np.ndarray, np.ndarray]:
+    """The sample points (x, y), flat float32, of every box of ``boxes`` at ``size`` (width,
+    height), box after box, row by row: pixel centres of the box scaled to ``size``. With
+    ``upright``, a box wider than tall is read transposed, so its long side runs down."""
     width, height = size
-    n = len(boxes)
     x0, y0, x1, y1 = (boxes[:, k, None, None] for k in range(4))
-    v, u = np.mgrid[0:height, 0:width].astype(np.float32) + 0.5
+    # a column's x and a row's y, computed once per box and spread over the sample
+    u = np.arange(width, dtype=np.float32)[None, None, :] + 0.5
+    v = np.arange(height, dtype=np.float32)[None, :, None] + 0.5
     map_x = x0 + u * (x1 - x0) / width - 0.5
     map_y = y0 + v * (y1 - y0) / height - 0.5
     if upright:
         wide = (boxes[:, 2] - boxes[:, 0] > boxes[:, 3] - boxes[:, 1])[:, None, None]
         map_x = np.where(wide, x0 + v * (x1 - x0) / height - 0.5, map_x)
         map_y = np.where(wide, y0 + u * (y1 - y0) / width - 0.5, map_y)
+    shape = (len(boxes), height, width)
+    return (
+        np.broadcast_to(map_x, shape).astype(np.float32).ravel(),
+        np.broadcast_to(map_y, shape).astype(np.float32).ravel(),
+    )
+
+
+def remap_points(image: np.ndarray, map_x: np.ndarray, map_y: np.ndarray) -> np.ndarray:
+    """Bilinear samples of ``image`` at the flat points ``map_x``, ``map_y``; pixels outside
+    the frame replicate its border.
+
+    The points go to ``cv2.remap`` as rows of up to :data:`REMAP_ROW` (one row for 50
+    candidates; its cost is mostly per row: a tall stack of 12- or 16-pixel rows takes 3x as
+    long); each output pixel is a function of its own point alone, so the samples are those of
+    any other layout (``tests/test_verifier_features_oracle.py``).
+
+    Returns
+    -------
+    ndarray of shape (points, channels)
+    """
+    count = len(map_x)
+    rows = max(-(-count // REMAP_ROW), 1)
+    width = max(-(-count // rows), 1)
+    maps = [np.asarray(m, np.float32) for m in (map_x, map_y)]
+    if rows * width != count:  # the last row filled up with points at (0, 0), cut after
+        maps = [np.concatenate([m, np.zeros(rows * width - count, np.float32)]) for m in maps]
     out = cv2.remap(
         image,
-        map_x.reshape(n * height, width).astype(np.float32),
-        map_y.reshape(n * height, width).astype(np.float32),
+        maps[0].reshape(rows, width),
+        maps[1].reshape(rows, width),
         cv2.INTER_LINEAR,
         borderMode=cv2.BORDER_REPLICATE,
     )
-    return out.reshape(n, height, width, -1)
+    return out.reshape(rows * width, -1)[:count]
 
 
 def stacked_hog(lightness: np.ndarray, rows: int) -> np.ndarray:
@@ -113,7 +162,8 @@ def stacked_hog(lightness: np.ndarray, rows: int) -> np.ndarray:
         (width // HOG_SHRINK, n * height // HOG_SHRINK),
         interpolation=cv2.INTER_AREA,
     ).reshape(n, height // HOG_SHRINK, width // HOG_SHRINK)
-    framed = np.pad(small, ((0, 0), (2, 2), (0, 0)))
+    framed = np.zeros((n, small.shape[1] + 4, small.shape[2]), np.float32)
+    framed[:, 2:-2] = small
     cell_rows, remainder = divmod(framed.shape[1], rows)
     if remainder:
         raise ValueError(f"{framed.shape[1]} framed rows do not split into {rows} cells")
@@ -176,25 +226,56 @@ def colour_planes(*patches: np.ndarray) -> list[np.ndarray]:
     ]
 
 
+#: The pixels of each of :data:`RING_MASKS`, as flat indices into the lens context (row-major).
+RING_AT = [np.flatnonzero(m) for m in RING_MASKS]
+
+
+def row_percentile(values: np.ndarray, q: float) -> np.ndarray:
+    """``np.percentile(values, q, axis=1)`` of a 2-D array, to the bit, by one partition.
+
+    numpy's default (linear) rule: the rank ``q / 100 * (n - 1)`` between the sorted values
+    ``a`` and ``b`` at its floor and the next, at fraction ``t``, gives ``a + (b - a) t`` when
+    ``t < 0.5``, else ``b - (b - a) (1 - t)``, in the values' own type.
+
+    Examples
+    --------
+    >>> row_percentile(np.array([[4.0, 1.0, 3.0, 2.0, 5.0]], np.float32), 30).tolist()
+    [2.200000047683716]
+    """
+    n = values.shape[1]
+    rank = q / 100 * (n - 1)
+    low = int(rank)
+    high = min(low + 1, n - 1)
+    t = rank - low
+    ordered = np.partition(values, (low, high), axis=1)
+    a, b = ordered[:, low], ordered[:, high]
+    kind = values.dtype.type
+    return b - (b - a) * kind(1 - t) if t >= 0.5 else a + (b - a) * kind(t)
+
+
 def colour_features(lens: np.ndarray, housing: np.ndarray) -> np.ndarray:
     """Lab / HSV statistics of lens, annulus, surround and housing, and surround darkness.
 
-    ``lens`` (N, 16, 16, 8) and ``housing`` (N, 22, 12, 8) are :func:`colour_planes` of the
-    samples. Hue enters as its cosine and sine weighted by saturation, so red near 0 and 180
-    is one colour.
+    ``lens`` (256, N, 8) and ``housing`` (264, N, 8) are :func:`colour_planes` of the samples,
+    pixel after pixel (row-major in the 16 x 16 and 22 x 12 samples), candidate inside. A mean
+    over the pixels adds whole rows of candidates pixel after pixel (numpy adds along an outer
+    axis in order): the sums of the patch-by-patch layout, in a fraction of its time. The
+    lightness deviations are taken on the memory layouts the patch-by-patch computation had
+    (lens: candidate innermost; housing: a row per candidate, summed pairwise by numpy), so
+    every value is the same to the bit (``tests/test_verifier_features_oracle.py``). Hue
+    enters as its cosine and sine weighted by saturation, so red near 0 and 180 is one colour.
     """
-    rings = [lens[:, m].mean(axis=1) for m in RING_MASKS]
-    lens_l = lens[..., 0][:, RING_MASKS[0]]
-    lens_v = lens[..., 4][:, RING_MASKS[0]]
-    peak = np.column_stack([lens_l.max(axis=1), lens_l.std(axis=1), (lens_v > 240).mean(axis=1)])
-    house = housing.reshape(len(housing), -1, len(COLOUR_NAMES))
-    light = house[..., 0]
+    rings = [lens[at].mean(axis=0) for at in RING_AT]
+    lens_l = np.ascontiguousarray(lens[RING_AT[0], :, 0])
+    lens_v = lens[RING_AT[0], :, 4]
+    peak = np.column_stack([lens_l.max(axis=0), lens_l.std(axis=0), (lens_v > 240).mean(axis=0)])
+    light = np.ascontiguousarray(housing[:, :, 0].T)
     house_stats = np.column_stack(
         [
-            house.mean(axis=1),
+            housing.mean(axis=0),
             light.std(axis=1),
-            np.percentile(light, 25, axis=1),
-            (house[..., 4] < 60).mean(axis=1),
+            row_percentile(light, 25),
+            (housing[:, :, 4] < 60).mean(axis=0),
         ]
     )
     lens_mean_l = rings[0][:, 0] + 1.0
@@ -209,26 +290,12 @@ def colour_features(lens: np.ndarray, housing: np.ndarray) -> np.ndarray:
     return np.column_stack([*rings, peak, house_stats, darkness]).astype(np.float32)
 
 
-def geometry_features(
-    candidates: Sequence[Candidate], boxes: np.ndarray, width: int, height: int
-) -> np.ndarray:
+def geometry_features(table: np.ndarray, boxes: np.ndarray, width: int, height: int) -> np.ndarray:
     """Radius, housing shape in lens radii, the lens's place in its housing, the frame
-    position, and the detector's score (raw, relative to the frame's best, and rank)."""
-    xyrs = np.array(
-        [
-            (
-                c.x,
-                c.y,
-                max(c.radius, 0.5),
-                c.score,
-                -1.0 if c.housing_score is None else c.housing_score,
-                c.housing is not None,
-            )
-            for c in candidates
-        ],
-        np.float64,
-    )
-    x, y, radius, score, fit, has_housing = xyrs.T
+    position, and the detector's score (raw, relative to the frame's best, and rank), of the
+    candidates of a :func:`candidate_table` and their housing ``boxes``."""
+    x, y, score, fit, has_housing = table[:, [0, 1, 3, 4, 5]].T
+    radius = np.maximum(table[:, 2], 0.5)
     hw = np.maximum(boxes[:, 2] - boxes[:, 0], 1e-3)
     hh = np.maximum(boxes[:, 3] - boxes[:, 1], 1e-3)
     best = float(np.max(np.abs(score))) or 1.0
@@ -266,19 +333,27 @@ def candidate_features(image: np.ndarray, candidates: Sequence[Candidate]) -> np
         image = cv2.cvtColor(image, cv2.COLOR_GRAY2BGR)
     if not candidates:
         return np.zeros((0, len(feature_names())), np.float32)
-    lens_boxes = np.array([lens_context_box(c) for c in candidates], np.float32)
-    house_boxes = np.array([housing_box(c) for c in candidates], np.float32)
+    table = candidate_table(candidates)
+    lens_boxes, house_boxes = context_boxes(table)
+    n = len(candidates)
+    # both stacks sampled by one remap (candidate after candidate: near points, near in memory),
+    # then read pixel after pixel, candidate inside (see colour_features)
+    lens_x, lens_y = box_maps(lens_boxes, (LENS_PX, LENS_PX))
+    house_x, house_y = box_maps(house_boxes, HOUSING_PX, upright=True)
+    points = remap_points(
+        image, np.concatenate([lens_x, house_x]), np.concatenate([lens_y, house_y])
+    )
     lens, housing = colour_planes(
-        sample_boxes(image, lens_boxes, (LENS_PX, LENS_PX)),
-        sample_boxes(image, house_boxes, HOUSING_PX, upright=True),
+        points[: len(lens_x)].reshape(n, -1, 3).transpose(1, 0, 2),
+        points[len(lens_x) :].reshape(n, -1, 3).transpose(1, 0, 2),
     )
     height, width = image.shape[:2]
     return np.column_stack(
         [
-            stacked_hog(lens[..., 0], 1),
-            stacked_hog(housing[..., 0], 3),
+            stacked_hog(lens[:, :, 0].T.reshape(n, LENS_PX, LENS_PX), 1),
+            stacked_hog(housing[:, :, 0].T.reshape(n, HOUSING_PX[1], HOUSING_PX[0]), 3),
             colour_features(lens, housing),
-            geometry_features(candidates, house_boxes, width, height),
+            geometry_features(table, house_boxes, width, height),
         ]
     )
 

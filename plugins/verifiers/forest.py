@@ -30,12 +30,15 @@ if TYPE_CHECKING:  # scikit-learn loads when a model is fitted or read, not on i
 class Forest:
     """The trees of a fitted classifier as flat node arrays.
 
-    ``roots`` (T,) index each tree's root in the node arrays, deepest tree first, and
-    ``depths`` (T,) are those trees' depths (at a step of the descent, only the trees still
-    deeper take part); ``order`` (T,) gives the place of each of scikit-learn's trees in that
-    list. ``children`` (nodes x 2, flat) hold each node's left and right child (a leaf is its
-    own child on both sides); ``value`` is a leaf's raw value. ``baseline`` (K,) holds each
-    class's starting value (K = 1: a binary classifier).
+    A node ``i`` is addressed by its slot ``2 i``: ``feature``, ``threshold``, ``nan_left`` and
+    ``value`` (a leaf's raw value) hold each node's entry twice, at slots ``2 i`` and
+    ``2 i + 1``, and ``children`` holds the slot of node ``i``'s left child at ``2 i`` and of
+    its right child at ``2 i + 1`` (a leaf is its own child on both sides), so one step of the
+    descent is ``children[slot + goes_right]``. ``roots`` (T,) are the slots of each tree's
+    root, deepest tree first, and ``depths`` (T,) those trees' depths (at a step of the
+    descent, only the trees still deeper take part); ``order`` (T,) gives the place of each of
+    scikit-learn's trees in that list. ``baseline`` (K,) holds each class's starting value
+    (K = 1: a binary classifier).
     """
 
     baseline: np.ndarray
@@ -80,14 +83,14 @@ class Forest:
         deepest = np.argsort(-depths, kind="stable")
         return cls(
             baseline=np.asarray(estimator._baseline_prediction, np.float64).ravel(),
-            roots=(np.cumsum(sizes) - sizes)[deepest],
+            roots=2 * (np.cumsum(sizes) - sizes)[deepest],
             depths=depths[deepest],
             order=np.argsort(deepest),
-            feature=np.where(leaf, 0, nodes["feature_idx"]),
-            threshold=nodes["num_threshold"].astype(np.float64),
-            nan_left=nodes["missing_go_to_left"].astype(bool),
-            children=children.ravel(),
-            value=nodes["value"].astype(np.float64),
+            feature=np.repeat(np.where(leaf, 0, nodes["feature_idx"]).astype(np.int64), 2),
+            threshold=np.repeat(nodes["num_threshold"].astype(np.float64), 2),
+            nan_left=np.repeat(nodes["missing_go_to_left"].astype(bool), 2),
+            children=2 * children.ravel(),
+            value=np.repeat(nodes["value"].astype(np.float64), 2),
         )
 
     def probability(self, features: np.ndarray) -> np.ndarray:
@@ -103,18 +106,22 @@ class Forest:
         x = np.asarray(features, np.float64)
         rows, columns = x.shape
         flat = x.ravel()
-        node = np.repeat(self.roots, rows)  # tree-major: the trees still descending lead
+        slot = np.repeat(self.roots, rows)  # tree-major: the trees still descending lead
         base = np.tile(np.arange(rows) * columns, len(self.roots))
         missing = bool(np.isnan(flat).any())
         for step in range(int(self.depths[0]) if len(self.depths) else 0):
             active = int(np.count_nonzero(self.depths > step)) * rows
-            at = node[:active]
+            at = slot[:active]
             value = flat.take(base[:active] + self.feature.take(at))
-            right = ~(value <= self.threshold.take(at))
-            if missing:
+            if missing:  # NaN: to the side the tree learned
+                right = ~(value <= self.threshold.take(at))
                 right &= ~(np.isnan(value) & self.nan_left.take(at))
-            node[:active] = self.children.take(2 * at + right)
+            else:
+                right = value > self.threshold.take(at)
+            self.children.take(at + right, out=at, mode="clip")  # always in range: unbuffered
         k = len(self.baseline)
-        leaves = self.value.take(node).reshape(len(self.roots), rows)[self.order]
-        start = np.zeros((1, k, rows)) + self.baseline[None, :, None]
-        return np.cumsum(np.concatenate([start, leaves.reshape(-1, k, rows)]), axis=0)[-1].T
+        leaves = self.value.take(slot).reshape(len(self.roots), rows)[self.order]
+        # one row per iteration, after the baselines: a reduction along the first axis adds the
+        # rows one after the other (not pairwise), as scikit-learn adds its trees
+        terms = np.concatenate([np.repeat(self.baseline, rows)[None], leaves.reshape(-1, k * rows)])
+        return np.add.reduce(terms, axis=0).reshape(k, rows).T

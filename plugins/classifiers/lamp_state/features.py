@@ -142,29 +142,14 @@ def area_resample(crop: np.ndarray, size: tuple[int, int], first: int, axis: int
     return cv2.resize(cut, None, fx=fx, fy=fy, interpolation=cv2.INTER_AREA)[:, :first]
 
 
-def patches(
-    image: np.ndarray,
-    boxes: np.ndarray,
-    size: tuple[int, int],
-    turned: np.ndarray | None = None,
-    first: int | None = None,
-) -> np.ndarray:
-    """The (N, height, width, 3) stack of ``boxes`` resampled to ``size`` = (width, height);
-    a box wholly outside the image gives a black patch. A box where ``turned`` is set is
-    resampled to (height, width) and transposed. With ``first``, only the first ``first``
-    columns of each patch are resampled (:func:`area_resample`), the others left black."""
+def patches(image: np.ndarray, boxes: np.ndarray, size: tuple[int, int]) -> np.ndarray:
+    """The (N, height, width, 3) stack of ``boxes`` resampled to ``size`` = (width, height) by
+    OpenCV's area rule; a box wholly outside the image gives a black patch."""
     out = np.zeros((len(boxes), size[1], size[0], 3), np.uint8)
-    turned = np.zeros(len(boxes), bool) if turned is None else turned
-    first = size[0] if first is None else first
     bounds = pixel_bounds(boxes, image.shape[1], image.shape[0]).tolist()
-    for i, ((x0, y0, x1, y1), turn) in enumerate(zip(bounds, turned.tolist())):
+    for i, (x0, y0, x1, y1) in enumerate(bounds):
         if x1 > x0 and y1 > y0:
-            crop = image[y0:y1, x0:x1]
-            if turn:
-                upright = area_resample(crop, size[::-1], first, 0).transpose(1, 0, 2)
-            else:
-                upright = area_resample(crop, size, first, 1)
-            out[i, :, :first] = upright
+            out[i] = cv2.resize(image[y0:y1, x0:x1], size, interpolation=cv2.INTER_AREA)
     return out
 
 
@@ -209,11 +194,24 @@ def lens_features(image: np.ndarray, lenses: Sequence[Candidate]) -> np.ndarray:
 
 
 def upright_housings(image: np.ndarray, boxes: np.ndarray, vertical: np.ndarray) -> np.ndarray:
-    """The housings resampled to :data:`HOUSING_SIZE`, long axis vertical (those not
-    ``vertical``, horizontal heads, transposed). Only their central :func:`band` is read: the
-    columns past it are left black (a quarter less source resampled)."""
-    across = HOUSING_SIZE[0]
-    return patches(image, boxes, HOUSING_SIZE, ~vertical, across - across // 4)
+    """The housings resampled to :data:`HOUSING_SIZE` by OpenCV's area rule, long axis
+    vertical (those not ``vertical``, horizontal heads, resampled to the transposed size and
+    transposed); a box wholly outside the image gives a black patch. Only their central
+    :func:`band` is read: the columns past it are left black (:func:`area_resample`, a quarter
+    less source resampled)."""
+    across, along = HOUSING_SIZE
+    first = across - across // 4
+    out = np.zeros((len(boxes), along, across, 3), np.uint8)
+    bounds = pixel_bounds(boxes, image.shape[1], image.shape[0]).tolist()
+    for i, ((x0, y0, x1, y1), upright) in enumerate(zip(bounds, vertical.tolist())):
+        if x1 > x0 and y1 > y0:
+            crop = image[y0:y1, x0:x1]
+            if upright:
+                out[i, :, :first] = area_resample(crop, HOUSING_SIZE, first, 1)
+            else:
+                turned = area_resample(crop, (along, across), first, 0)
+                out[i, :, :first] = turned.transpose(1, 0, 2)
+    return out
 
 
 def lit_lenses(
