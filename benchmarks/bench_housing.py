@@ -4,11 +4,20 @@ the real housing boxes given their lit lens, and housing AP50 / recall after the
     python benchmarks/bench_housing.py
     python benchmarks/bench_housing.py --stages    # only: where the fit is lost, stage by stage
     python benchmarks/bench_housing.py --fit       # only: speed and fit quality
+    python benchmarks/bench_housing.py --select roboflow_cinta_v2_id:valid dtld_fridtjofs:train
 
 ``--stages`` fits each test housing from four starts and gives the share at IoU >= 0.5: the
 true lit lens (centre and radius from the box, :func:`find_lens`), the ``union`` detector's
 best-scored candidate whose centre lies in the box's circle (Zheng's rule), and the two mixed
 (true centre with the candidate's radius, the candidate's centre with the true radius).
+
+``--select SET:SPLIT...`` asks which of the ``union`` candidates on one light gives its box: the
+share of annotated boxes (housings; lenses on lens-boxed sets) met at IoU >= 0.5 by the
+best-scored candidate whose centre hits the light (Zheng's rule), by the housing stage's
+first-ranked hitting candidate (after its duplicate suppression), by any hitting candidate, and
+by any candidate the stage keeps; with the AP50 (pycocotools) of all the stage's candidates
+ranked by the detector's scores (on a set that is not exhaustively labelled it counts
+unlabelled lights as false).
 
 Datasets draw their boxes with different margins around the head (DTLD's carry several pixels
 of background), so each share is also given margin-free (:func:`margin_free_iou`): a fit that
@@ -34,8 +43,9 @@ import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
 from tsrkit.datasets import open_dataset  # noqa: E402
+from tsrkit.eval.coco import coco_ap, coco_dataset  # noqa: E402
 from tsrkit.eval.matching import centre_hits  # noqa: E402
-from tsrkit.geometry import iou_matrix  # noqa: E402
+from tsrkit.geometry import iou_matrix, xyxy_to_xywh  # noqa: E402
 from tsrkit.registry import get_registry  # noqa: E402
 from tsrkit.synth.heads import background, render_head  # noqa: E402
 from tsrkit.types import Candidate, Frame  # noqa: E402
@@ -134,6 +144,63 @@ def stage_starts(name: str) -> str:
     return f"| {name} | {total} | {len(offsets) / total:.2f} | {cells} | {np.median(offsets):.2f} |"
 
 
+def matches(out: list[Candidate], boxes: list, lens_boxed: bool) -> tuple[np.ndarray, np.ndarray]:
+    """(candidates, boxes) matrices: IoU >= 0.5 of the evaluated box, and centre hits."""
+    fitted = [c.bbox if lens_boxed else c.housing for c in out]
+    return iou_matrix(fitted, boxes) >= 0.5, centre_hits([(c.x, c.y) for c in out], boxes)
+
+
+def first_met(good: np.ndarray, hits: np.ndarray) -> int:
+    """Boxes met by the first (best-ranked) candidate that hits them."""
+    first = np.argmax(hits, axis=0)  # the first hitting row of each box's column
+    return int((good[first, np.arange(hits.shape[1])] & hits.any(axis=0)).sum())
+
+
+def selection(spec: str) -> str:
+    """One ``--select`` row (module docstring) for ``spec`` = ``SET:SPLIT``."""
+    name, split = spec.split(":")
+    lens_boxed = open_dataset(name).info.get("box") == "lens"
+    union = get_registry().create("detector", "union")
+    create = get_registry().create
+    every, stage = create("verifier", "housing", {"nms_iou": 1.0}), create("verifier", "housing")
+    counts = dict.fromkeys(("best", "first", "any", "kept"), 0)
+    images: list[dict] = []
+    truth: list[dict] = []
+    results: list[dict] = []
+    total = 0
+    for index, sample in enumerate(open_dataset(name).split(split), 1):
+        boxes = [a.bbox for a in sample.annotations]
+        total += len(boxes)
+        frame = sample.load()
+        images.append({"id": index, "width": sample.width, "height": sample.height})
+        truth += [
+            {"id": len(truth) + k, "image_id": index, "category_id": 1, "iscrowd": 0,
+             "bbox": xyxy_to_xywh(b), "area": (b[2] - b[0]) * (b[3] - b[1])}
+            for k, b in enumerate(boxes, 1)
+        ]  # fmt: skip
+        found = union.detect(frame)
+        if not found:
+            continue
+        if boxes:
+            good, hits = matches(every.verify(frame, found), boxes, lens_boxed)  # by score
+            counts["best"] += first_met(good, hits)
+            counts["any"] += int((good & hits).any(axis=0).sum())
+        out = stage.verify(frame, found)
+        results += [
+            {"image_id": index, "category_id": 1, "score": c.score,
+             "bbox": xyxy_to_xywh(c.bbox if lens_boxed else c.housing)}
+            for c in out
+        ]  # fmt: skip
+        if not boxes:
+            continue
+        good, hits = matches(out, boxes, lens_boxed)
+        counts["first"] += first_met(good, hits)
+        counts["kept"] += int(good.any(axis=0).sum())
+    cells = " | ".join(f"{v / total:.3f}" for v in counts.values())
+    ap50 = coco_ap(coco_dataset(images, truth, name), results)["ap50"]
+    return f"| {name} {split} | {total} | {cells} | {ap50:.3f} |"
+
+
 def detector_runs(name: str, detector: str, stage: list[str]) -> str:
     """Housing AP50 and recall at IoU 0.5 of ``detector`` with ``stage`` on ``name`` test."""
     with tempfile.TemporaryDirectory() as out:
@@ -154,7 +221,16 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--stages", action="store_true", help="only the stage-by-stage table")
     parser.add_argument("--fit", action="store_true", help="only the speed and fit quality")
+    parser.add_argument("--select", nargs="+", metavar="SET:SPLIT", help="only: which candidate")
     args = parser.parse_args()
+    if args.select:
+        print(
+            "| set | boxes | best-scored hitting | stage's first hitting | any hitting | any kept "
+            "| AP50 |\n|---|---:|---:|---:|---:|---:|---:|"
+        )
+        for spec in args.select:
+            print(selection(spec), flush=True)
+        return
     if args.stages:
         print("shares at IoU >= 0.5, margin-free in brackets\n")
         print(
