@@ -17,15 +17,15 @@ def planes(values: list[float], pixels: int = 4) -> np.ndarray:
 
 def test_frame_statistics_of_a_frame_of_known_pixels():
     image = np.zeros((80, 160, 3), np.uint8)
-    image[:, :80] = 100  # half the frame grey 100 ...
-    image[:, 80:] = (0, 0, 200)  # ... half pure red of V 200, S 255
+    image[:, :96] = 100  # 60 % of the frame grey 100 ...
+    image[:, 96:] = (0, 0, 200)  # ... 40 % pure red of V 200, S 255
     stats = C.frame_statistics(image)
-    assert (stats.v_low, stats.v_high, stats.s_high) == (150.0, 200.0, 255.0)
+    assert (stats.v_low, stats.v_high, stats.s_high) == (100.0, 200.0, 255.0)
     # grey-world neutral: the mean of grey (a = 128) and red (OpenCV 8-bit Lab a of pure red)
     import cv2
 
     red_a = float(cv2.cvtColor(np.array([[[0, 0, 200]]], np.uint8), cv2.COLOR_BGR2LAB)[0, 0, 1])
-    assert stats.a_mean == pytest.approx((128.0 + red_a) / 2)
+    assert stats.a_mean == pytest.approx(0.6 * 128.0 + 0.4 * red_a)
 
 
 def test_photometric_features_place_the_lens_in_the_frames_range():
