@@ -17,7 +17,6 @@ from skimage.feature._hoghistogram import hog_histograms
 
 from tsrkit.geometry import Box
 from tsrkit.types import Candidate
-from tsrkit_plugins.verifiers.context import CONTEXT_NAMES, context_features
 
 #: Side of the lens context, in lens radii (lens disk: 1 radius, annulus 1-2, surround 2-3).
 CONTEXT = 6.0
@@ -31,7 +30,7 @@ HOUSING_PX = (12, 22)
 HOG_SHRINK = 2
 ORIENTATIONS = 9
 #: Version of the feature layout; a model trained on another layout is refused.
-FEATURE_VERSION = 3
+FEATURE_VERSION = 2
 
 COLOUR_NAMES = ("L", "a", "b", "S", "V", "hue_cos", "hue_sin", "chroma")
 RINGS = ("lens", "annulus", "surround")
@@ -261,8 +260,7 @@ def candidate_features(image: np.ndarray, candidates: Sequence[Candidate]) -> np
 
     Columns (:func:`feature_names`): HOG of the lightness (CIELab L) of the lens context (one
     cell) and of the upright housing (top, middle, bottom cells), colour statistics
-    (:func:`colour_features`), geometry (:func:`geometry_features`) and the candidate against
-    its frame (:func:`context.context_features`).
+    (:func:`colour_features`) and geometry (:func:`geometry_features`).
     """
     if image.ndim == 2:
         image = cv2.cvtColor(image, cv2.COLOR_GRAY2BGR)
@@ -281,7 +279,6 @@ def candidate_features(image: np.ndarray, candidates: Sequence[Candidate]) -> np
             stacked_hog(housing[..., 0], 3),
             colour_features(lens, housing),
             geometry_features(candidates, house_boxes, width, height),
-            context_features(image, candidates, lens[:, RING_MASKS[0]]),
         ]
     )
 
@@ -337,4 +334,4 @@ def feature_names() -> list[str]:
         "score_rank",
         "candidates",
     ]
-    return hog_lens + hog_housing + rings + peak + house + darkness + geometry + list(CONTEXT_NAMES)
+    return hog_lens + hog_housing + rings + peak + house + darkness + geometry
