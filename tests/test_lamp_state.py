@@ -3,6 +3,7 @@
 import cv2
 import numpy as np
 import pytest
+from oracles.lamp_state_oracle import halved
 
 import tsrkit
 from tsrkit.models import ModelError, load_model, save_model
@@ -223,3 +224,48 @@ def test_area_resample_equals_opencv_whole_resampling(size, first, axis):
             whole = cv2.resize(crop, size, interpolation=cv2.INTER_AREA)
             wanted = whole[:first] if axis == 0 else whole[:, :first]
             assert np.array_equal(area_resample(crop, size, first, axis), wanted), shape
+
+
+def test_area_resample_halving_averages_pixel_pairs_and_drops_an_odd_last_one():
+    """Hand case: a 73 x 25 crop of 2 x 2 blocks of known colour (row 72 and column 24 white,
+    past the last whole block) resampled to 12 x 36, halved first (sides from twice the
+    output's): each block is one output cell, its colour exactly; the white rest is dropped,
+    not averaged in. Sides under ``halve_from`` times the output's are not halved: the area
+    rule alone, as without halving."""
+    colours = np.arange(36 * 12 * 3, dtype=np.int64).reshape(36, 12, 3) % 200
+    crop = np.full((73, 25, 3), 255, np.uint8)
+    crop[:72, :24] = colours.repeat(2, axis=0).repeat(2, axis=1)
+    assert np.array_equal(area_resample(crop, (12, 36), 9, 1, halve_from=2), colours[:, :9])
+    whole = cv2.resize(crop, (12, 36), interpolation=cv2.INTER_AREA)[:, :9]
+    assert np.array_equal(area_resample(crop, (12, 36), 9, 1, halve_from=4), whole)
+
+
+@pytest.mark.parametrize("factors", [(2, 2), (2, 1), (1, 2)])
+def test_opencv_integer_area_resampling_is_the_block_mean(factors):
+    """OpenCV's area rule at integer scale factors (``halved``'s second step) gives each
+    block's mean rounded to the nearest integer (exact ties go either way)."""
+    kx, ky = factors
+    crop = np.random.default_rng(kx * ky).integers(0, 256, (ky * 36, kx * 12, 3), np.uint8)
+    means = crop.reshape(36, ky, 12, kx, 3).sum(axis=(1, 3)) / (kx * ky)
+    got = cv2.resize(crop, (12, 36), interpolation=cv2.INTER_AREA)
+    assert np.abs(got - means).max() <= 0.5
+
+
+@pytest.mark.parametrize(
+    ("size", "first", "axis"), [((12, 36), 9, 1), ((36, 12), 9, 0), ((12, 36), 12, 1)]
+)
+@pytest.mark.parametrize("halve_from", [2, 4])
+def test_area_resample_halved_equals_halving_then_area(size, first, axis, halve_from):
+    """Halved, the wanted rows or columns equal the whole crop halved
+    (``tests/oracles/lamp_state_oracle.py``'s ``halved``: trimmed in numpy, averaged by
+    OpenCV) and resampled whole by OpenCV's area rule, bit for bit, at every length of the cut
+    side up to 600 and other sides short, even and odd."""
+    rng = np.random.default_rng(4)
+    image = rng.integers(0, 256, (601, 601, 3), np.uint8)
+    for length in range(1, 601):
+        for other in (1, 35, 72, 73, int(rng.integers(37, 600))):
+            shape = (length, other) if axis == 0 else (other, length)
+            crop = image[: shape[0], : shape[1]]
+            whole = cv2.resize(halved(crop, size, halve_from), size, interpolation=cv2.INTER_AREA)
+            wanted = whole[:first] if axis == 0 else whole[:, :first]
+            assert np.array_equal(area_resample(crop, size, first, axis, halve_from), wanted)

@@ -1,7 +1,12 @@
 """lamp-state as the plugin computed it before it was batched (one ``clip_box`` per crop, every
 housing resampled upright and again transposed when wide, a colour conversion over a tall
 stack, ``np.digitize`` hue bins, scikit-learn's ``predict_proba``): the oracle the faster
-classifier must match exactly. The feature functions the speed-up left alone are imported."""
+classifier must match exactly. The feature functions the speed-up left alone are imported.
+
+Housings are resampled as lamp-state defines it since lampcrop (outputs changed by design):
+a side at least ``HALVE_FROM`` times its output length is first halved (:func:`halved`: an
+odd last pixel dropped, pairs averaged), then the whole crop resampled by OpenCV's area
+rule."""
 
 from __future__ import annotations
 
@@ -12,6 +17,7 @@ from tsrkit.geometry import clip_box
 from tsrkit_plugins.classifiers.lamp_state import STATES, blend, prefer_red, red_yellow
 from tsrkit_plugins.classifiers.lamp_state.features import (
     DISK,
+    HALVE_FROM,
     HOUSING_SIZE,
     HUE_EDGES,
     LENS_PATCH,
@@ -34,6 +40,33 @@ def _patches(image, boxes, size):
         x0, y0, x1, y1 = clip_box(box, image.shape[1], image.shape[0])
         if x1 > x0 and y1 > y0:
             out[i] = cv2.resize(image[y0:y1, x0:x1], size, interpolation=cv2.INTER_AREA)
+    return out
+
+
+def halved(crop, size, halve_from):
+    """``crop`` with each side at least ``halve_from`` times its ``size`` (width, height)
+    length halved: its last pixel dropped there when the length is odd, then each 2 x 2 (or
+    2 x 1) block's mean by OpenCV's integer-scale area resampling (the mean rounded to the
+    nearest integer, exact ties either way: ``tests/test_lamp_state.py`` checks it against
+    numpy's block sums); ``crop`` itself when no side is that long or one enlarges."""
+    height, width = crop.shape[:2]
+    if width < size[0] or height < size[1]:
+        return crop
+    kx = 2 if width >= halve_from * size[0] else 1
+    ky = 2 if height >= halve_from * size[1] else 1
+    if kx == ky == 1:
+        return crop
+    w, h = width // kx, height // ky
+    return cv2.resize(crop[: ky * h, : kx * w], (w, h), interpolation=cv2.INTER_AREA)
+
+
+def _housing_patches(image, boxes, size):
+    out = np.zeros((len(boxes), size[1], size[0], 3), np.uint8)
+    for i, box in enumerate(boxes):
+        x0, y0, x1, y1 = clip_box(box, image.shape[1], image.shape[0])
+        if x1 > x0 and y1 > y0:
+            crop = halved(image[y0:y1, x0:x1], size, HALVE_FROM)
+            out[i] = cv2.resize(crop, size, interpolation=cv2.INTER_AREA)
     return out
 
 
@@ -124,10 +157,11 @@ def _housing_features(upright, hsv, vertical):
 
 def _upright_housings(image, boxes):
     vertical = (boxes[:, 3] - boxes[:, 1]) >= (boxes[:, 2] - boxes[:, 0])
-    out = _patches(image, boxes, HOUSING_SIZE)
+    out = _housing_patches(image, boxes, HOUSING_SIZE)
     wide = np.flatnonzero(~vertical)
     if len(wide):
-        out[wide] = _patches(image, boxes[wide], HOUSING_SIZE[::-1]).transpose(0, 2, 1, 3)
+        turned = _housing_patches(image, boxes[wide], HOUSING_SIZE[::-1])
+        out[wide] = turned.transpose(0, 2, 1, 3)
     return out, vertical
 
 

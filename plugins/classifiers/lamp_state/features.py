@@ -44,6 +44,10 @@ LENS_PATCH = 16
 HOUSING_SIZE = (12, 36)
 #: Long / short side ratio from which a box without a fitted housing is read as a housing.
 ELONGATION = 1.5
+#: Housings are halved before their area resampling (:func:`area_resample`'s
+#: ``halve_from``): a side at least this many times its :data:`HOUSING_SIZE` length is first
+#: averaged over pixel pairs.
+HALVE_FROM = 2
 #: Feature layout version: a model trained on another layout is refused.
 VERSION = 3
 
@@ -119,9 +123,12 @@ def pixel_bounds(boxes: np.ndarray, width: int, height: int) -> np.ndarray:
     return np.concatenate([low, high], axis=1).astype(np.int64)
 
 
-def area_resample(crop: np.ndarray, size: tuple[int, int], first: int, axis: int) -> np.ndarray:
+def area_resample(
+    crop: np.ndarray, size: tuple[int, int], first: int, axis: int, halve_from: int = 0
+) -> np.ndarray:
     """The first ``first`` rows (``axis`` 0) or columns (``axis`` 1) of ``crop`` resampled to
-    ``size`` = (width, height) by OpenCV's area rule (``cv2.INTER_AREA``), the same to the bit.
+    ``size`` = (width, height) by OpenCV's area rule (``cv2.INTER_AREA``): the mean colour of
+    each cell of a ``size`` grid over the crop.
 
     When both sides shrink (OpenCV's area decimation), each output row or column is summed from
     its own source cells, with weights set by its index times the scale factor alone (clamped
@@ -129,17 +136,33 @@ def area_resample(crop: np.ndarray, size: tuple[int, int], first: int, axis: int
     with the whole crop's scale factors (``fx``, ``fy``: the quotients OpenCV takes of the
     sizes), so less source is read for the same values (``tests/test_lamp_state.py`` compares
     them with whole resamplings at every crop length up to a frame's width).
+
+    ``halve_from`` > 1 first halves each side at least ``halve_from`` times its output length:
+    the crop is trimmed to an even length there (the last pixel dropped from an odd one) and
+    each 2 x 2 (or 2 x 1) block averaged, OpenCV's integer-scale area path (a box average,
+    vectorised for 2 x 2; with the area rule on the halved crop after it, about half the time
+    of the area rule alone on a frame's housings: ``benchmarks/RESULTS.state.md``). The cells
+    keep their meaning (a cell's mean colour), with the far edge moved by at most a pixel and
+    the colours rounded twice. ``halve_from`` 0: the area rule alone, on the whole crop.
     """
     height, width = crop.shape[:2]
     if width < size[0] or height < size[1]:  # enlarging: OpenCV's area rule is then linear
         whole = cv2.resize(crop, size, interpolation=cv2.INTER_AREA)
         return whole[:first] if axis == 0 else whole[:, :first]
+    kx = 2 if halve_from and width >= halve_from * size[0] else 1
+    ky = 2 if halve_from and height >= halve_from * size[1] else 1
+    width, height = width // kx, height // ky
     fx, fy = size[0] / width, size[1] / height
+    rows, cols = height, width
     if axis == 0:
-        cut = crop[: first * height // size[1] + 2]
-        return cv2.resize(cut, None, fx=fx, fy=fy, interpolation=cv2.INTER_AREA)[:first]
-    cut = crop[:, : first * width // size[0] + 2]
-    return cv2.resize(cut, None, fx=fx, fy=fy, interpolation=cv2.INTER_AREA)[:, :first]
+        rows = min(height, first * height // size[1] + 2)
+    else:
+        cols = min(width, first * width // size[0] + 2)
+    cut = crop[: ky * rows, : kx * cols]
+    if kx > 1 or ky > 1:
+        cut = cv2.resize(cut, (cols, rows), interpolation=cv2.INTER_AREA)
+    out = cv2.resize(cut, None, fx=fx, fy=fy, interpolation=cv2.INTER_AREA)
+    return out[:first] if axis == 0 else out[:, :first]
 
 
 def patches(image: np.ndarray, boxes: np.ndarray, size: tuple[int, int]) -> np.ndarray:
@@ -194,11 +217,11 @@ def lens_features(image: np.ndarray, lenses: Sequence[Candidate]) -> np.ndarray:
 
 
 def upright_housings(image: np.ndarray, boxes: np.ndarray, vertical: np.ndarray) -> np.ndarray:
-    """The housings resampled to :data:`HOUSING_SIZE` by OpenCV's area rule, long axis
-    vertical (those not ``vertical``, horizontal heads, resampled to the transposed size and
-    transposed); a box wholly outside the image gives a black patch. Only their central
-    :func:`band` is read: the columns past it are left black (:func:`area_resample`, a quarter
-    less source resampled)."""
+    """The housings resampled to :data:`HOUSING_SIZE` by OpenCV's area rule (halved first
+    where long: :data:`HALVE_FROM`), long axis vertical (those not ``vertical``, horizontal
+    heads, resampled to the transposed size and transposed); a box wholly outside the image
+    gives a black patch. Only their central :func:`band` is read: the columns past it are left
+    black (:func:`area_resample`, a quarter less source resampled)."""
     across, along = HOUSING_SIZE
     first = across - across // 4
     out = np.zeros((len(boxes), along, across, 3), np.uint8)
@@ -207,9 +230,9 @@ def upright_housings(image: np.ndarray, boxes: np.ndarray, vertical: np.ndarray)
         if x1 > x0 and y1 > y0:
             crop = image[y0:y1, x0:x1]
             if upright:
-                out[i, :, :first] = area_resample(crop, HOUSING_SIZE, first, 1)
+                out[i, :, :first] = area_resample(crop, HOUSING_SIZE, first, 1, HALVE_FROM)
             else:
-                turned = area_resample(crop, (along, across), first, 0)
+                turned = area_resample(crop, (along, across), first, 0, HALVE_FROM)
                 out[i, :, :first] = turned.transpose(1, 0, 2)
     return out
 
