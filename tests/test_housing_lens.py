@@ -18,6 +18,31 @@ def test_box_sums_are_clipped_pixel_sums():
     assert total.tolist() == [66, 11, 4, 0] and count.tolist() == [12, 2, 2, 0]
 
 
+def numpy_box_sums(table, boxes):
+    """The NumPy definition the compiled pass replaced: round half to even, clip, gather."""
+    height, width = table.shape[0] - 1, table.shape[1] - 1
+    corners = np.clip(np.rint(boxes), 0.0, [width, height, width, height]).astype(np.intp)
+    x0, y0, x1, y1 = (corners[..., k] for k in range(4))
+    x1, y1 = np.maximum(x1, x0), np.maximum(y1, y0)
+    total = table[y1, x1] - table[y0, x1] - table[y1, x0] + table[y0, x0]
+    return total, ((x1 - x0) * (y1 - y0)).astype(np.float64)
+
+
+def test_box_sums_equal_the_numpy_definition_at_ties_edges_and_any_shape():
+    rng = np.random.default_rng(3)
+    table = integral(rng.integers(0, 256, (37, 53), dtype=np.uint8))
+    # corners on half-pixels (ties round to even), far outside the frame, crossing
+    boxes = rng.integers(-40, 120, (6, 5, 7, 4)) / 2.0
+    boxes[0, 0, 0] = (0.5, 1.5, 2.5, 36.5)
+    total, count = box_sums(table, boxes)
+    want_total, want_count = numpy_box_sums(table, boxes)
+    assert total.dtype == np.int32 and count.dtype == np.float64 and total.shape == (6, 5, 7)
+    assert np.array_equal(total, want_total) and np.array_equal(count, want_count)
+    assert count[0, 0, 0] == (2 - 0) * (36 - 2)  # rint: 0.5 -> 0, 1.5 -> 2, 2.5 -> 2, 36.5 -> 36
+    empty_total, empty_count = box_sums(table, np.zeros((0, 4)))
+    assert empty_total.shape == empty_count.shape == (0,)
+
+
 @pytest.mark.parametrize("radius", [3, 5, 8, 13])
 @pytest.mark.parametrize("colour", ["red", "yellow", "green"])
 def test_the_lit_lens_is_found_from_a_wrong_radius_and_an_off_centre_start(radius, colour):

@@ -1,10 +1,17 @@
 """Box sums over an integral image: the one primitive of the housing search and the lens
-measurement (every mean a handful of look-ups, whatever the box's size)."""
+measurement (every mean a handful of look-ups, whatever the box's size).
+
+The sums are one compiled pass over the boxes (:func:`sum_boxes`): the housing stage asks for
+some 60,000 boxes per frame at 50 candidates, and NumPy's rounding, clipping and four gathers
+over them, each a temporary array, took about 1.4 of its 3.4 ms (benchmarks/RESULTS.housing.md).
+The result is the NumPy definition's to the bit (``tests/test_housing_lens.py``).
+"""
 
 from __future__ import annotations
 
 import cv2
 import numpy as np
+from numba import njit
 
 
 def integral(gray: np.ndarray) -> np.ndarray:
@@ -12,20 +19,30 @@ def integral(gray: np.ndarray) -> np.ndarray:
     return cv2.integral(gray, sdepth=cv2.CV_32S)
 
 
-def box_sums(table: np.ndarray, boxes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Sums (in the table's integer type) and pixel counts of ``boxes`` (..., 4) as
-    (x0, y0, x1, y1), rounded to pixels and clipped to the image."""
+@njit(cache=True, nogil=True)
+def sum_boxes(table: np.ndarray, boxes: np.ndarray, total: np.ndarray, count: np.ndarray) -> None:
+    """Fill ``total`` (int32) and ``count`` (float64) for the (N, 4) ``boxes``: each corner
+    rounded half to even (``np.rint``) and clipped to the image, the far edges no nearer than
+    the near ones, then the four look-ups of the int32 ``table``."""
     height, width = table.shape[0] - 1, table.shape[1] - 1
-    corners = np.rint(boxes)
-    np.clip(corners, 0.0, np.array([width, height, width, height], np.float64), out=corners)
-    corners = corners.astype(np.intp)
-    x0, y0, x1, y1 = (corners[..., k] for k in range(4))
-    np.maximum(x1, x0, out=x1)
-    np.maximum(y1, y0, out=y1)
-    flat, stride = table.ravel(), width + 1
-    top, bottom = y0 * stride, y1 * stride
-    total = flat[bottom + x1] - flat[top + x1] - flat[bottom + x0] + flat[top + x0]
-    return total, ((x1 - x0) * (y1 - y0)).astype(np.float64)
+    for i in range(boxes.shape[0]):
+        x0 = int(min(max(np.rint(boxes[i, 0]), 0.0), width))
+        y0 = int(min(max(np.rint(boxes[i, 1]), 0.0), height))
+        x1 = max(int(min(max(np.rint(boxes[i, 2]), 0.0), width)), x0)
+        y1 = max(int(min(max(np.rint(boxes[i, 3]), 0.0), height)), y0)
+        total[i] = table[y1, x1] - table[y0, x1] - table[y1, x0] + table[y0, x0]
+        count[i] = (x1 - x0) * (y1 - y0)
+
+
+def box_sums(table: np.ndarray, boxes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Sums (in the int32 table's type) and pixel counts of ``boxes`` (..., 4) as
+    (x0, y0, x1, y1), rounded to pixels and clipped to the image."""
+    flat = np.ascontiguousarray(boxes, np.float64).reshape(-1, 4)
+    total = np.empty(len(flat), table.dtype)
+    count = np.empty(len(flat), np.float64)
+    sum_boxes(table, flat, total, count)
+    shape = np.shape(boxes)[:-1]
+    return total.reshape(shape), count.reshape(shape)
 
 
 def box_means(table: np.ndarray, boxes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
