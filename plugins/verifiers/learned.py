@@ -270,12 +270,13 @@ class LearnedVerifier(Verifier):
         return self.forest.probability(candidate_features(frame.image, candidates))
 
     def scores(
-        self, frame: Frame, candidates: Sequence[Candidate]
+        self, frame: Frame, candidates: Sequence[Candidate], gate: bool = False
     ) -> tuple[list[Candidate], np.ndarray, np.ndarray]:
         """The candidates after the ``after`` stage, each one's decision score (the
         probability blended with the detector's score by ``prior``: what ``threshold`` and
         ``relative`` read) and the score it reports (the decision score, scaled by the box
-        model where ``box_rank`` > 0)."""
+        model where ``box_rank`` > 0). ``gate``: only the candidates that pass ``threshold``
+        and ``relative`` (the box model reads those only)."""
         candidates = self._stage()(frame, list(candidates))
         if not candidates:
             return candidates, np.zeros(0), np.zeros(0)
@@ -283,17 +284,21 @@ class LearnedVerifier(Verifier):
         prior = self.params["prior"]
         own = np.clip([c.score for c in candidates], 0.0, 1.0)
         decision = (1.0 - prior) * self.forest.probability(features) + prior * own
+        if gate:
+            keep = passes(decision, self.params["threshold"], self.params["relative"])
+            candidates = [c for c, k in zip(candidates, keep) if k]
+            features, decision = features[keep], decision[keep]
         weight = self.params["box_rank"]
-        if weight == 0:
+        if weight == 0 or not candidates:
             return candidates, decision, decision
         fits = self.box_forest.probability(features)
         return candidates, decision, decision * (1.0 - weight + weight * fits)
 
     def verify(self, frame: Frame, candidates: Sequence[Candidate]) -> list[Candidate]:
-        candidates, decision, score = self.scores(frame, candidates)
-        keep = passes(decision, self.params["threshold"], self.params["relative"])
-        kept = [replace(c, score=float(p)) for c, p, k in zip(candidates, score, keep) if k]
-        return sorted(kept, key=lambda c: -c.score)
+        kept, _, score = self.scores(frame, candidates, gate=True)
+        return sorted(
+            (replace(c, score=float(p)) for c, p in zip(kept, score)), key=lambda c: -c.score
+        )
 
     def _stage(self) -> Stage:
         name = self.params["after"]
