@@ -16,7 +16,8 @@ Training-time augmentation (plugins/verifiers/augment.py): ``-p verifier.augment
 candidates below keep them apart.
 Box-aware order (``-p verifier.box_rank=0.5``): the tables' thresholds and ``relative`` read each
 detection's decision score, as the verifier's own keep decision does; AP50 reads the reported
-score (the order).
+score (the order). ``--box-weights 0,0.25,0.5 --out DIR`` re-reads the models a run left in DIR
+and gives AP50 at each ``box_rank`` weight (which candidates are kept does not depend on it).
 Several detectors: ``--detector union -p "union.members=lab-frst top=15; conspicuity n_top=15"``
 (the ``union`` plugin; its default members are the loosened four of RESULTS.verifier.md).
 """
@@ -244,6 +245,45 @@ def markdown(results: dict, threshold: str = "0.5") -> str:
     return "\n".join(lines) + "\n"
 
 
+def box_weights(out: Path, weights: list[float]) -> str:
+    """AP50 (Markdown table) of the verifier models of the finished run in ``out`` on the
+    exhaustive sets' test splits, their reported scores ordered at each ``box_rank`` weight."""
+    results = json.loads((out / "results.json").read_text())
+    assigned = parse_assignments(results["params"])
+    (name,) = results["detector"]
+    detector = Memo(
+        get_registry().create(
+            "detector",
+            name,
+            {k.split(".", 1)[1]: v for k, v in assigned.items() if k.startswith(f"{name}.")},
+        )
+    )
+    lines = [
+        "| test set | verifier | " + " | ".join(f"w = {w:g}" for w in weights) + " |",
+        "|---|---|" + "---:|" * len(weights),
+    ]
+    for s in (s for s in SETS if s.exhaustive):
+        test = open_datasets([f"{s.name}:{s.test}"])
+        for mode in ("loso", "in-domain"):
+            cells = []
+            for w in weights:
+                verifier = get_registry().create(
+                    "verifier",
+                    "verifier",
+                    {
+                        "model": str(out / f"verifier_{mode}_{s.key}"),
+                        "threshold": 0.0,
+                        "after": results["housing"],
+                        "prior": assigned.get("verifier.prior", 0.0),
+                        "box_rank": w,
+                    },
+                )
+                ap, _, _ = evaluate(test, detector, Decided(verifier), s.box)
+                cells.append(f"{ap:.3f}")
+            lines.append(f"| {s.key} ({s.box}) | {mode} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--detector", action="append", default=[], help="candidate detector")
@@ -264,6 +304,11 @@ def main() -> None:
         "--tables", metavar="RESULTS_JSON", help="only print the Markdown tables of a results.json"
     )
     parser.add_argument("--threshold", default="0.5", help="verifier threshold of the tables")
+    parser.add_argument(
+        "--box-weights",
+        metavar="W,W,...",
+        help="only AP50 of the models of the finished run in --out at these box_rank weights",
+    )
     args = parser.parse_args()
     if args.tables:
         results = json.loads(Path(args.tables).read_text())
@@ -274,6 +319,9 @@ def main() -> None:
         return
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
+    if args.box_weights:
+        print(box_weights(out, [float(w) for w in args.box_weights.split(",")]))
+        return
     reg = get_registry()
     assigned = parse_assignments(args.param)
     names = args.detector or ["lab-frst"]
