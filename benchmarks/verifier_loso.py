@@ -14,6 +14,10 @@ Run: python benchmarks/verifier_loso.py [--detector lab-frst]... [-p lab-frst.KE
 Training-time augmentation (plugins/verifiers/augment.py): ``-p verifier.augment_scales=1,0.5,1.5``
 ``-p verifier.augment_colour=2``; the augmented views carry their own ``source``, so the cached
 candidates below keep them apart.
+Box-aware order (``-p verifier.box_rank=0.5``): the tables' thresholds and ``relative`` read each
+detection's decision score, as the verifier's own keep decision does; AP50 reads the reported
+score (the order). ``--box-weights 0,0.25,0.5 --out DIR`` re-reads the models a run left in DIR
+and gives AP50 at each ``box_rank`` weight (which candidates are kept does not depend on it).
 Several detectors: ``--detector union -p "union.members=lab-frst top=15; conspicuity n_top=15"``
 (the ``union`` plugin; its default members are the loosened four of RESULTS.verifier.md).
 """
@@ -28,7 +32,7 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 import argparse  # noqa: E402
 import json  # noqa: E402
 import time  # noqa: E402
-from dataclasses import dataclass  # noqa: E402
+from dataclasses import dataclass, replace  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import cv2  # noqa: E402
@@ -44,7 +48,7 @@ from tsrkit.plugin import Detector, Verifier  # noqa: E402
 from tsrkit.registry import get_registry  # noqa: E402
 from tsrkit.training import train  # noqa: E402
 from tsrkit.types import Dataset, Sample  # noqa: E402
-from tsrkit_plugins.verifiers.learned import passes  # noqa: E402
+from tsrkit_plugins.verifiers.learned import LearnedVerifier, passes  # noqa: E402
 from tsrkit_plugins.verifiers.mining import no_light_frames  # noqa: E402
 
 cv2.setNumThreads(1)
@@ -106,6 +110,37 @@ class Chain(Verifier):
         return candidates
 
 
+class Decided(Verifier):
+    """The learned verifier keeping every candidate (its threshold 0), remembering each kept
+    candidate's decision score (:meth:`LearnedVerifier.scores`) by source, centre and reported
+    score, so that the tables' thresholds read what the verifier's keep decision reads."""
+
+    name = "decided"
+
+    def __init__(self, inner: LearnedVerifier):
+        super().__init__()
+        self.inner = inner
+        self.decisions: dict[tuple, float] = {}
+
+    def verify(self, frame, candidates):
+        if not candidates:
+            return []
+        staged, decision, score = self.inner.scores(frame, candidates)
+        for c, d, s in zip(staged, decision, score):
+            self.decisions[self.key(frame.source, c.x, c.y, float(s))] = float(d)
+        kept = [replace(c, score=float(s)) for c, s in zip(staged, score)]
+        return sorted(kept, key=lambda c: -c.score)
+
+    @staticmethod
+    def key(source, x, y, score) -> tuple:
+        return source, round(x, 3), round(y, 3), score
+
+    def decision(self, record, detection) -> float:
+        """The decision score of one of ``record``'s detections."""
+        key = self.key(record.source, detection.x, detection.y, detection.score)
+        return self.decisions[key]
+
+
 def no_light_dataset(count: int) -> Dataset:
     """Synthetic 1280x720 scenes without a lit light (another seed than training's)."""
     samples = tuple(
@@ -118,7 +153,8 @@ def no_light_dataset(count: int) -> Dataset:
 def evaluate(dataset, detector, verifier, box, thresholds=(0.0,), relative=0.0):
     """One run (verifier threshold 0); Zheng figures and the share of lights some kept box
     overlaps at IoU >= 0.5 (``iou50_recall``, the set's ``box``) recomputed at every threshold
-    (with the verifier's ``relative`` gate: :func:`passes`)."""
+    (with the verifier's ``relative`` gate: :func:`passes`; on the decision scores where the
+    verifier is :class:`Decided`)."""
     run = run_benchmark(dataset, detector, verifier=verifier, cache=False, box=box)
     ap = run.report["iou50"]["ap"]
     pairs = list(run.pairs())
@@ -126,7 +162,9 @@ def evaluate(dataset, detector, verifier, box, thresholds=(0.0,), relative=0.0):
     for t in thresholds:
         scores, box_hits = [], []
         for sample, record in pairs:
-            keep = passes([d.score for d in record.detections], t, relative)
+            decide = verifier.decision if isinstance(verifier, Decided) else None
+            decisions = [decide(record, d) if decide else d.score for d in record.detections]
+            keep = passes(decisions, t, relative)
             kept = [d for d, k in zip(record.detections, keep) if k]
             truth = [a.bbox for a in sample.annotations]
             scores.append(score_frame([(d.x, d.y) for d in kept], truth))
@@ -207,6 +245,45 @@ def markdown(results: dict, threshold: str = "0.5") -> str:
     return "\n".join(lines) + "\n"
 
 
+def box_weights(out: Path, weights: list[float]) -> str:
+    """AP50 (Markdown table) of the verifier models of the finished run in ``out`` on the
+    exhaustive sets' test splits, their reported scores ordered at each ``box_rank`` weight."""
+    results = json.loads((out / "results.json").read_text())
+    assigned = parse_assignments(results["params"])
+    (name,) = results["detector"]
+    detector = Memo(
+        get_registry().create(
+            "detector",
+            name,
+            {k.split(".", 1)[1]: v for k, v in assigned.items() if k.startswith(f"{name}.")},
+        )
+    )
+    lines = [
+        "| test set | verifier | " + " | ".join(f"w = {w:g}" for w in weights) + " |",
+        "|---|---|" + "---:|" * len(weights),
+    ]
+    for s in (s for s in SETS if s.exhaustive):
+        test = open_datasets([f"{s.name}:{s.test}"])
+        for mode in ("loso", "in-domain"):
+            cells = []
+            for w in weights:
+                verifier = get_registry().create(
+                    "verifier",
+                    "verifier",
+                    {
+                        "model": str(out / f"verifier_{mode}_{s.key}"),
+                        "threshold": 0.0,
+                        "after": results["housing"],
+                        "prior": assigned.get("verifier.prior", 0.0),
+                        "box_rank": w,
+                    },
+                )
+                ap, _, _ = evaluate(test, detector, Decided(verifier), s.box)
+                cells.append(f"{ap:.3f}")
+            lines.append(f"| {s.key} ({s.box}) | {mode} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--detector", action="append", default=[], help="candidate detector")
@@ -227,6 +304,11 @@ def main() -> None:
         "--tables", metavar="RESULTS_JSON", help="only print the Markdown tables of a results.json"
     )
     parser.add_argument("--threshold", default="0.5", help="verifier threshold of the tables")
+    parser.add_argument(
+        "--box-weights",
+        metavar="W,W,...",
+        help="only AP50 of the models of the finished run in --out at these box_rank weights",
+    )
     args = parser.parse_args()
     if args.tables:
         results = json.loads(Path(args.tables).read_text())
@@ -237,6 +319,9 @@ def main() -> None:
         return
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
+    if args.box_weights:
+        print(box_weights(out, [float(w) for w in args.box_weights.split(",")]))
+        return
     reg = get_registry()
     assigned = parse_assignments(args.param)
     names = args.detector or ["lab-frst"]
@@ -298,11 +383,16 @@ def main() -> None:
                     "threshold": 0.0,
                     "after": ver_params["after"],
                     "prior": ver_params.get("prior", 0.0),
+                    "box_rank": ver_params.get("box_rank", 0.0),
                 },
             )
-            chain = Chain([verifier])  # the verifier runs its `after` stage (housing) itself
-            ap, rows, pairs = evaluate(tests[s.key], detector, chain, s.box, THRESHOLDS, relative)
-            _, nl, _ = evaluate(nolight, detector, chain, "housing", THRESHOLDS, relative)
+            # the verifier runs its `after` stage (housing) itself
+            ap, rows, pairs = evaluate(
+                tests[s.key], detector, Decided(verifier), s.box, THRESHOLDS, relative
+            )
+            _, nl, _ = evaluate(
+                nolight, detector, Decided(verifier), "housing", THRESHOLDS, relative
+            )
             folds.setdefault(s.key, {})[mode] = {
                 "train": refs,
                 "fit_seconds": round(fit_s, 1),

@@ -10,6 +10,12 @@ cameras the model never saw, where the probability drops); candidates scoring be
 ``threshold``, or below ``relative`` x the best score of their frame, are dropped. Trained by
 ``tsrkit train verifier --detector X`` on that detector's candidates labelled by Zheng's centre
 rule (5.2.1), with hard-negative mining (:mod:`mining`).
+
+``box_rank`` (weight w > 0) adds a second classifier of the same features, trained only on the
+positives that hit a housing box (housing-boxed real sets, rendered heads), which gives the
+probability that the candidate's fitted housing meets that box at IoU >= 0.5. It only orders:
+the keep decision stays on the score above (threshold, relative), and a kept candidate
+reports that score x (1 - w + w x box probability), never more than the decision score.
 """
 
 from __future__ import annotations
@@ -32,7 +38,7 @@ from tsrkit_plugins.verifiers.augment import Augmentation
 from tsrkit_plugins.verifiers.features import candidate_features, feature_names, layout
 from tsrkit_plugins.verifiers.forest import Forest
 from tsrkit_plugins.verifiers.mining import Labelled, Stage, hard_negatives, labelled_candidates
-from tsrkit_plugins.verifiers.persistence import estimator_arrays, load_estimator
+from tsrkit_plugins.verifiers.persistence import BOX_ARRAY, estimator_arrays, load_estimator
 
 if TYPE_CHECKING:  # scikit-learn loads when a model is fitted or read, not on import
     from sklearn.ensemble import HistGradientBoostingClassifier
@@ -109,6 +115,18 @@ class LearnedVerifier(Verifier):
             "whose box the features read and the records report); '' for none. A model "
             "remembers the stage it was trained after",
         ),
+        Param(
+            "box_rank",
+            "float",
+            0.0,
+            min=0.0,
+            max=1.0,
+            help="weight w of the box model in the order of the kept candidates: each reports "
+            "its score x (1 - w + w x the probability that its fitted housing meets the light's "
+            "box at IoU >= 0.5); which candidates are kept does not change (threshold and "
+            "relative read the score before it). Training with w > 0 fits the box model on "
+            "the positives hitting housing boxes (not lens boxes); 0: off",
+        ),
         Param("iterations", "int", 150, min=10, max=2000, help="training: boosting iterations"),
         Param("leaves", "int", 15, min=4, max=255, help="training: leaves per tree"),
         Param("learning_rate", "float", 0.1, min=0.001, max=1.0, help="training: learning rate"),
@@ -181,6 +199,7 @@ class LearnedVerifier(Verifier):
         )
         self._estimator: HistGradientBoostingClassifier | None = None
         self._forest: Forest | None = None
+        self._box_forest: Forest | None = None
 
     @property
     def estimator(self) -> HistGradientBoostingClassifier:
@@ -192,7 +211,7 @@ class LearnedVerifier(Verifier):
             A missing, corrupt or foreign model, or one trained on another feature layout.
         """
         if self._estimator is None:
-            where = str(self.params["model"] or DEFAULT_MODEL)
+            where = self._where()
             model = load_model(where, plugin=self.name)
             trained_on = model.info.get("layout")
             if trained_on != layout():
@@ -209,14 +228,39 @@ class LearnedVerifier(Verifier):
                     f"after {self.params['after']!r}; set -p after={after} or retrain"
                 )
             self._estimator = load_estimator(model, where)
+            if self.params["box_rank"] > 0:
+                if BOX_ARRAY not in model.arrays:
+                    raise ModelError(
+                        f"model {where}: has no box model; retrain it with -p box_rank=W "
+                        "(W > 0) or set -p box_rank=0"
+                    )
+                box = load_estimator(model, where, name=BOX_ARRAY)
+                self._box_forest = Forest.of(box, where)
         return self._estimator
+
+    def _where(self) -> str:
+        return str(self.params["model"] or DEFAULT_MODEL)
 
     @property
     def forest(self) -> Forest:
         """The estimator's trees as flat arrays (:mod:`forest`), for one-pass prediction."""
         if self._forest is None:
-            self._forest = Forest.of(self.estimator, str(self.params["model"] or DEFAULT_MODEL))
+            self._forest = Forest.of(self.estimator, self._where())
         return self._forest
+
+    @property
+    def box_forest(self) -> Forest:
+        """The box model's trees (loaded with the estimator when ``box_rank`` > 0).
+
+        Raises
+        ------
+        tsrkit.models.ModelError
+            ``box_rank`` is 0 (no box model is read).
+        """
+        self.estimator  # noqa: B018 (loads both models)
+        if self._box_forest is None:
+            raise ModelError("verifier: box_rank is 0; no box model is read")
+        return self._box_forest
 
     def probabilities(self, frame: Frame, candidates: Sequence[Candidate]) -> np.ndarray:
         """The probability that each candidate is a lit traffic light (the estimator's
@@ -225,14 +269,36 @@ class LearnedVerifier(Verifier):
             return np.zeros(0)
         return self.forest.probability(candidate_features(frame.image, candidates))
 
-    def verify(self, frame: Frame, candidates: Sequence[Candidate]) -> list[Candidate]:
+    def scores(
+        self, frame: Frame, candidates: Sequence[Candidate], gate: bool = False
+    ) -> tuple[list[Candidate], np.ndarray, np.ndarray]:
+        """The candidates after the ``after`` stage, each one's decision score (the
+        probability blended with the detector's score by ``prior``: what ``threshold`` and
+        ``relative`` read) and the score it reports (the decision score, scaled by the box
+        model where ``box_rank`` > 0). ``gate``: only the candidates that pass ``threshold``
+        and ``relative`` (the box model reads those only)."""
         candidates = self._stage()(frame, list(candidates))
+        if not candidates:
+            return candidates, np.zeros(0), np.zeros(0)
+        features = candidate_features(frame.image, candidates)
         prior = self.params["prior"]
         own = np.clip([c.score for c in candidates], 0.0, 1.0)
-        score = (1.0 - prior) * self.probabilities(frame, candidates) + prior * own
-        keep = passes(score, self.params["threshold"], self.params["relative"])
-        kept = [replace(c, score=float(p)) for c, p, k in zip(candidates, score, keep) if k]
-        return sorted(kept, key=lambda c: -c.score)
+        decision = (1.0 - prior) * self.forest.probability(features) + prior * own
+        if gate:
+            keep = passes(decision, self.params["threshold"], self.params["relative"])
+            candidates = [c for c, k in zip(candidates, keep) if k]
+            features, decision = features[keep], decision[keep]
+        weight = self.params["box_rank"]
+        if weight == 0 or not candidates:
+            return candidates, decision, decision
+        fits = self.box_forest.probability(features)
+        return candidates, decision, decision * (1.0 - weight + weight * fits)
+
+    def verify(self, frame: Frame, candidates: Sequence[Candidate]) -> list[Candidate]:
+        kept, _, score = self.scores(frame, candidates, gate=True)
+        return sorted(
+            (replace(c, score=float(p)) for c, p in zip(kept, score)), key=lambda c: -c.score
+        )
 
     def _stage(self) -> Stage:
         name = self.params["after"]
@@ -289,7 +355,7 @@ class LearnedVerifier(Verifier):
         rng = np.random.default_rng(self.params["seed"])
         step = int(round(self.params["negative_ratio"] * len(positives)))
         chosen = np.sort(rng.permutation(negatives)[:step])
-        estimator = self._fit_once(data, np.concatenate([positives, chosen]))
+        estimator = self._fit_once(data.features, data.labels, np.concatenate([positives, chosen]))
         for _ in range(self.params["mining_rounds"]):
             rest = np.setdiff1d(negatives, chosen)
             if not len(rest):
@@ -297,20 +363,45 @@ class LearnedVerifier(Verifier):
             probability = estimator.predict_proba(data.features[rest])[:, 1]
             hard = rest[hard_negatives(probability, data.labels[rest], step)]
             chosen = np.union1d(chosen, hard)
-            estimator = self._fit_once(data, np.concatenate([positives, chosen]))
-        return Model(
-            arrays=estimator_arrays(estimator),
-            info={
-                "layout": layout(),
-                "after": self.params["after"],
-                "positives": int(len(positives)),
-                "negatives": int(len(negatives)),
-                "negatives_used": int(len(chosen)),
-                "frames": int(data.frames.max() + 1) if len(data.frames) else 0,
-            },
-        )
+            estimator = self._fit_once(
+                data.features, data.labels, np.concatenate([positives, chosen])
+            )
+        arrays = estimator_arrays(estimator)
+        info = {
+            "layout": layout(),
+            "after": self.params["after"],
+            "positives": int(len(positives)),
+            "negatives": int(len(negatives)),
+            "negatives_used": int(len(chosen)),
+            "frames": int(data.frames.max() + 1) if len(data.frames) else 0,
+        }
+        if self.params["box_rank"] > 0:
+            arrays |= self._fit_box(data)
+            info["box_fits"] = int(np.count_nonzero(data.boxes == 1))
+            info["box_misfits"] = int(np.count_nonzero(data.boxes == 0))
+        return Model(arrays=arrays, info=info)
 
-    def _fit_once(self, data: Labelled, rows: np.ndarray) -> HistGradientBoostingClassifier:
+    def _fit_box(self, data: Labelled) -> dict[str, np.ndarray]:
+        """The box model's arrays: fitted on every candidate with a box label.
+
+        Raises
+        ------
+        TsrkitError
+            No candidate whose housing fits, or none whose housing misses.
+        """
+        rows = np.flatnonzero(data.boxes >= 0)
+        fits = int(np.count_nonzero(data.boxes[rows] == 1))
+        if not fits or fits == len(rows):
+            raise TsrkitError(
+                f"verifier: box_rank needs candidates on housing boxes whose housing fits and "
+                f"others whose housing misses; got {fits} and {len(rows) - fits} (train on "
+                "housing-boxed data or rendered heads, or set box_rank=0)"
+            )
+        return estimator_arrays(self._fit_once(data.features, data.boxes, rows), BOX_ARRAY)
+
+    def _fit_once(
+        self, features: np.ndarray, labels: np.ndarray, rows: np.ndarray
+    ) -> HistGradientBoostingClassifier:
         from sklearn.ensemble import HistGradientBoostingClassifier
 
         rows = np.sort(rows)
@@ -322,7 +413,7 @@ class LearnedVerifier(Verifier):
             early_stopping=False,
             random_state=self.params["seed"],
         )
-        return estimator.fit(data.features[rows], data.labels[rows])
+        return estimator.fit(features[rows], labels[rows])
 
 
 @hookimpl

@@ -4,7 +4,9 @@ hard negatives.
 A candidate is positive when its centre lies in the minimum enclosing circle of a ground-truth
 box of its frame (Zheng 2016, 5.2.1, :func:`tsrkit.eval.matching.centre_hits`), negative
 otherwise. Negatives also come from synthetic road scenes without any lit light
-(:mod:`tsrkit.synth`: dark housings, lamps, headlights, windows).
+(:mod:`tsrkit.synth`: dark housings, lamps, headlights, windows). A positive hitting a housing
+box (elongated: real housing-boxed sets, rendered heads) also gets a box label, whether its
+fitted housing meets that box (the ``box_rank`` model's target, :func:`box_labels`).
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ from itertools import chain
 import numpy as np
 
 from tsrkit.eval.matching import centre_hits
+from tsrkit.geometry import iou_matrix
 from tsrkit.plugin import Detector
 from tsrkit.synth import SynthOptions, render_frame
 from tsrkit.synth.heads import scatter_heads
@@ -29,25 +32,32 @@ SYNTH_SIZE = (1280, 720)
 SYNTH_SEED = 1011
 #: Seed of the synthetic scenes with rendered lit heads (positives).
 HEADS_SEED = 77
+#: A box whose long side is at least this many times its short side boxes a housing (a lens
+#: box, as KR's, is about square): only those give box labels.
+HOUSING_ASPECT = 1.5
 
 
 @dataclass
 class Labelled:
-    """Feature rows of candidates, their labels and the index of the frame they came from."""
+    """Feature rows of candidates, their labels, the index of the frame they came from and
+    their box labels (:func:`box_labels`: 1 / 0, or -1 where there is none)."""
 
     features: np.ndarray
     labels: np.ndarray
     frames: np.ndarray
+    boxes: np.ndarray
 
     @classmethod
     def concat(cls, parts: Sequence[Labelled], width: int) -> Labelled:
         """All parts stacked (an empty set of ``width`` columns when there are none)."""
         if not parts:
-            return cls(np.zeros((0, width), np.float32), np.zeros(0, np.int8), np.zeros(0, int))
+            empty = np.zeros(0, np.int8)
+            return cls(np.zeros((0, width), np.float32), empty, np.zeros(0, int), empty)
         return cls(
             np.concatenate([p.features for p in parts]),
             np.concatenate([p.labels for p in parts]),
             np.concatenate([p.frames for p in parts]),
+            np.concatenate([p.boxes for p in parts]),
         )
 
 
@@ -67,6 +77,38 @@ def centre_labels(candidates: Sequence[Candidate], boxes: Sequence[Sequence[floa
         return np.zeros(len(candidates), np.int8)
     hits = centre_hits([(c.x, c.y) for c in candidates], boxes)
     return hits.any(axis=1).astype(np.int8)
+
+
+def box_labels(candidates: Sequence[Candidate], boxes: Sequence[Sequence[float]]) -> np.ndarray:
+    """For each candidate whose centre hits housing boxes (Zheng 5.2.1; boxes at least
+    :data:`HOUSING_ASPECT` times as long as wide): 1 when its reported box (the fitted housing,
+    ``object_bbox``) has IoU >= 0.5 with one of them, else 0; -1 for every other candidate (a
+    negative, or a hit on lens boxes only).
+
+    Examples
+    --------
+    >>> from dataclasses import replace
+    >>> from tsrkit.types import Candidate
+    >>> on = replace(Candidate.from_circle(10, 5, 2, 1.0), housing=(6, 0, 14, 21))
+    >>> off = replace(Candidate.from_circle(10, 15, 2, 1.0), housing=(0, 13, 30, 21))
+    >>> far = Candidate.from_circle(90, 5, 2, 1.0)
+    >>> box_labels([on, off, far], [(6, 0, 14, 20)]).tolist()
+    [1, 0, -1]
+    >>> box_labels([on], [(6, 0, 14, 10)]).tolist()  # a lens box: no box label
+    [-1]
+    """
+    labels = np.full(len(candidates), -1, np.int8)
+    box = np.asarray(boxes, float).reshape(-1, 4)
+    sides = np.stack([box[:, 2] - box[:, 0], box[:, 3] - box[:, 1]], axis=1)
+    housing = sides.max(axis=1) >= HOUSING_ASPECT * sides.min(axis=1)
+    if not candidates or not housing.any():
+        return labels
+    box = box[housing]
+    hits = centre_hits([(c.x, c.y) for c in candidates], box)
+    fits = iou_matrix([c.object_bbox for c in candidates], box) >= 0.5
+    hit = hits.any(axis=1)
+    labels[hit] = (hits & fits).any(axis=1)[hit]
+    return labels
 
 
 def no_light_frames(count: int, seed: int = SYNTH_SEED) -> Iterator[Frame]:
@@ -112,7 +154,7 @@ def labelled_candidates(
     views: :mod:`augment`), on ``no_light`` synthetic frames (and their camera looks) and on
     ``heads`` synthetic frames
     with rendered lit heads (:func:`head_frames`); return every candidate's features, its Zheng
-    label and its frame index."""
+    label, its frame index and its box label (:func:`box_labels`)."""
     parts = []
     views = augmentation or Augmentation()
     frames: Iterator[tuple[Frame, Sequence[Sequence[float]]]] = (
@@ -130,6 +172,7 @@ def labelled_candidates(
                 features(frame.image, candidates),
                 centre_labels(candidates, boxes),
                 np.full(len(candidates), index),
+                box_labels(candidates, boxes),
             )
         )
     return Labelled.concat(parts, width)

@@ -25,6 +25,8 @@ if TYPE_CHECKING:  # skops and scikit-learn load when a model is saved or read, 
 #: The only non-builtin types a verifier model may contain (skops refuses every other one).
 TRUSTED_TYPES = ["sklearn.ensemble._hist_gradient_boosting.predictor.TreePredictor"]
 ARRAY = "estimator_skops"
+#: The array of the verifier's optional second estimator (``box_rank``: does the housing fit).
+BOX_ARRAY = "box_estimator_skops"
 
 
 _ID = re.compile(r'"__id__": (\d+)')
@@ -56,17 +58,20 @@ def canonical_skops(data: bytes) -> bytes:
     return out.getvalue()
 
 
-def estimator_arrays(estimator: HistGradientBoostingClassifier) -> dict[str, np.ndarray]:
-    """The model arrays holding ``estimator`` (canonical skops bytes as uint8)."""
+def estimator_arrays(
+    estimator: HistGradientBoostingClassifier, name: str = ARRAY
+) -> dict[str, np.ndarray]:
+    """The model arrays holding ``estimator`` (canonical skops bytes as uint8) as ``name``."""
     import skops.io as sio
 
-    return {ARRAY: np.frombuffer(canonical_skops(sio.dumps(estimator)), dtype=np.uint8)}
+    return {name: np.frombuffer(canonical_skops(sio.dumps(estimator)), dtype=np.uint8)}
 
 
 def load_estimator(
-    model: Model, where: str, classes: Sequence | None = (0, 1)
+    model: Model, where: str, classes: Sequence | None = (0, 1), name: str = ARRAY
 ) -> HistGradientBoostingClassifier:
-    """The estimator stored by :func:`estimator_arrays` in ``model`` (read from ``where``).
+    """The estimator stored by :func:`estimator_arrays` as ``name`` in ``model`` (read from
+    ``where``).
 
     ``classes`` are the labels the estimator must have been fitted on (the verifier's 0 / 1;
     another plugin's own labels; None accepts any).
@@ -80,9 +85,9 @@ def load_estimator(
     import skops.io as sio
     from sklearn.ensemble import HistGradientBoostingClassifier
 
-    data = model.arrays.get(ARRAY)
+    data = model.arrays.get(name)
     if data is None or data.dtype != np.uint8 or data.ndim != 1:
-        raise ModelError(f"model {where}: no '{ARRAY}' byte array (not a verifier model)")
+        raise ModelError(f"model {where}: no '{name}' byte array (not a verifier model)")
     try:
         untrusted = [
             t for t in sio.get_untrusted_types(data=data.tobytes()) if t not in TRUSTED_TYPES
