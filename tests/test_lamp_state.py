@@ -208,22 +208,28 @@ def test_two_lit_needs_two_lamps_and_a_red_top():
 
 
 @pytest.mark.parametrize(
-    ("size", "first", "axis"), [((12, 36), 9, 1), ((36, 12), 9, 0), ((16, 16), 16, 1)]
+    ("size", "first", "axis"),
+    [((12, 36), 9, 1), ((36, 12), 9, 0), ((16, 16), 16, 1), ((12, 36), 12, 1)],
 )
-def test_area_resample_equals_opencv_whole_resampling(size, first, axis):
+@pytest.mark.parametrize(("halve_from", "longest"), [(0, 1280), (2, 600), (4, 600)])
+def test_area_resample_equals_opencv_whole_resampling(size, first, axis, halve_from, longest):
     """The wanted rows or columns (a housing's first 9 across, its band and a bit) equal those
-    of OpenCV's whole resampling, bit for bit, at every length of the cut side up to a frame's
-    width (integer and fractional scales, enlarging and shrinking) and other sides short,
-    long, fractional and integer multiples of the output."""
-    rng = np.random.default_rng(3)
-    image = rng.integers(0, 256, (1281, 1281, 3), np.uint8)
-    for length in range(1, 1281):
-        for other in (1, 35, 36, 72, int(rng.integers(37, 300))):
+    of OpenCV's whole resampling of the crop, bit for bit, at every length of the cut side up to
+    ``longest`` (integer and fractional scales, enlarging and shrinking) and other sides short,
+    long, even, odd, fractional and integer multiples of the output. Halved (``halve_from``
+    > 0), the crop is first halved as ``tests/oracles/lamp_state_oracle.py``'s ``halved`` does
+    (trimmed in numpy, averaged by OpenCV)."""
+    rng = np.random.default_rng(3 + halve_from)
+    image = rng.integers(0, 256, (longest + 1, longest + 1, 3), np.uint8)
+    for length in range(1, longest + 1):
+        for other in (1, 35, 36, 72, 73, int(rng.integers(37, longest))):
             shape = (length, other) if axis == 0 else (other, length)
             crop = image[: shape[0], : shape[1]]
-            whole = cv2.resize(crop, size, interpolation=cv2.INTER_AREA)
+            source = halved(crop, size, halve_from) if halve_from else crop
+            whole = cv2.resize(source, size, interpolation=cv2.INTER_AREA)
             wanted = whole[:first] if axis == 0 else whole[:, :first]
-            assert np.array_equal(area_resample(crop, size, first, axis), wanted), shape
+            got = area_resample(crop, size, first, axis, halve_from)
+            assert np.array_equal(got, wanted), shape
 
 
 def test_area_resample_halving_averages_pixel_pairs_and_drops_an_odd_last_one():
@@ -249,23 +255,3 @@ def test_opencv_integer_area_resampling_is_the_block_mean(factors):
     means = crop.reshape(36, ky, 12, kx, 3).sum(axis=(1, 3)) / (kx * ky)
     got = cv2.resize(crop, (12, 36), interpolation=cv2.INTER_AREA)
     assert np.abs(got - means).max() <= 0.5
-
-
-@pytest.mark.parametrize(
-    ("size", "first", "axis"), [((12, 36), 9, 1), ((36, 12), 9, 0), ((12, 36), 12, 1)]
-)
-@pytest.mark.parametrize("halve_from", [2, 4])
-def test_area_resample_halved_equals_halving_then_area(size, first, axis, halve_from):
-    """Halved, the wanted rows or columns equal the whole crop halved
-    (``tests/oracles/lamp_state_oracle.py``'s ``halved``: trimmed in numpy, averaged by
-    OpenCV) and resampled whole by OpenCV's area rule, bit for bit, at every length of the cut
-    side up to 600 and other sides short, even and odd."""
-    rng = np.random.default_rng(4)
-    image = rng.integers(0, 256, (601, 601, 3), np.uint8)
-    for length in range(1, 601):
-        for other in (1, 35, 72, 73, int(rng.integers(37, 600))):
-            shape = (length, other) if axis == 0 else (other, length)
-            crop = image[: shape[0], : shape[1]]
-            whole = cv2.resize(halved(crop, size, halve_from), size, interpolation=cv2.INTER_AREA)
-            wanted = whole[:first] if axis == 0 else whole[:, :first]
-            assert np.array_equal(area_resample(crop, size, first, axis, halve_from), wanted)
