@@ -15,7 +15,11 @@ ab-hist there is the shipped model, trained on MIT train. lamp-state's red+amber
 (``red_yellow_ratio``, on housings and on boxes taller than wide too square to be read as
 housings, as its ``classify`` reads them) and its red prior (``red_prior``) apply to all three.
 
-    python benchmarks/state_loso.py
+    python benchmarks/state_loso.py [--seed N]
+
+``--seed`` (default 0, the shipped model's) seeds the colour jitter of the training copies and
+the boosting: a change of lamp-state's outputs is judged against the spread of several seeds,
+as one light can move a set's figures.
 """
 
 from __future__ import annotations
@@ -25,6 +29,7 @@ import os
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ[_var] = "1"
 
+import argparse  # noqa: E402
 import hashlib  # noqa: E402
 import time  # noqa: E402
 from collections import Counter  # noqa: E402
@@ -141,11 +146,16 @@ def read(probability: np.ndarray, states: list[str], rule: np.ndarray, params) -
 
 
 def main() -> None:
-    params = get_registry().create("classifier", "lamp-state").params
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seed", type=int, default=0, help="jitter and boosting seed")
+    args = parser.parse_args()
+    params = get_registry().create("classifier", "lamp-state", {"seed": args.seed}).params
     data = parts()
     copies = params["copies"]
     features = {
-        (group, key): labelled_features(ds, copies if key in ("train", "own") else 0)
+        (group, key): labelled_features(
+            ds, copies if key in ("train", "own") else 0, seed=params["seed"]
+        )
         for group, sets in data.items()
         for key, ds in sets.items()
     }
