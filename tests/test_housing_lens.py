@@ -39,6 +39,9 @@ def test_box_sums_equal_the_numpy_definition_at_ties_edges_and_any_shape():
     assert total.dtype == np.int32 and count.dtype == np.float64 and total.shape == (6, 5, 7)
     assert np.array_equal(total, want_total) and np.array_equal(count, want_count)
     assert count[0, 0, 0] == (2 - 0) * (36 - 2)  # rint: 0.5 -> 0, 1.5 -> 2, 2.5 -> 2, 36.5 -> 36
+    # NaN and infinite corners stay inside the table: NaN and -inf at 0, +inf at the far edge
+    odd = box_sums(table, np.array([[np.nan, 0, 4, 4], [-np.inf, 0, np.inf, 2], [3, 3, np.nan, 9]]))
+    assert odd[0].tolist() == [table[4, 4], table[2, 53], 0] and odd[1].tolist() == [16, 106, 0]
     empty_total, empty_count = box_sums(table, np.zeros((0, 4)))
     assert empty_total.shape == empty_count.shape == (0,)
 

@@ -19,17 +19,28 @@ def integral(gray: np.ndarray) -> np.ndarray:
     return cv2.integral(gray, sdepth=cv2.CV_32S)
 
 
+@njit(cache=True, nogil=True, inline="always")
+def pixel(value: float, limit: int) -> int:
+    """``value`` rounded half to even (``np.rint``) and clipped to ``[0, limit]``; NaN gives 0
+    (the compiled look-ups have no bounds check: a box a plugin got wrong must not read
+    outside the table)."""
+    rounded = np.rint(value)
+    if not rounded > 0.0:  # also NaN
+        return 0
+    return limit if rounded >= limit else int(rounded)
+
+
 @njit(cache=True, nogil=True)
 def sum_boxes(table: np.ndarray, boxes: np.ndarray, total: np.ndarray, count: np.ndarray) -> None:
     """Fill ``total`` (int32) and ``count`` (float64) for the (N, 4) ``boxes``: each corner
-    rounded half to even (``np.rint``) and clipped to the image, the far edges no nearer than
-    the near ones, then the four look-ups of the int32 ``table``."""
+    rounded and clipped to the image (:func:`pixel`), the far edges no nearer than the near
+    ones, then the four look-ups of the int32 ``table``."""
     height, width = table.shape[0] - 1, table.shape[1] - 1
     for i in range(boxes.shape[0]):
-        x0 = int(min(max(np.rint(boxes[i, 0]), 0.0), width))
-        y0 = int(min(max(np.rint(boxes[i, 1]), 0.0), height))
-        x1 = max(int(min(max(np.rint(boxes[i, 2]), 0.0), width)), x0)
-        y1 = max(int(min(max(np.rint(boxes[i, 3]), 0.0), height)), y0)
+        x0 = pixel(boxes[i, 0], width)
+        y0 = pixel(boxes[i, 1], height)
+        x1 = max(pixel(boxes[i, 2], width), x0)
+        y1 = max(pixel(boxes[i, 3], height), y0)
         total[i] = table[y1, x1] - table[y0, x1] - table[y1, x0] + table[y0, x0]
         count[i] = (x1 - x0) * (y1 - y0)
 
