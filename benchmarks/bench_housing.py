@@ -5,11 +5,16 @@ the real housing boxes given their lit lens, and housing AP50 / recall after the
     python benchmarks/bench_housing.py --stages    # only: where the fit is lost, stage by stage
     python benchmarks/bench_housing.py --fit       # only: speed and fit quality
     python benchmarks/bench_housing.py --select roboflow_cinta_v2_id:valid dtld_fridtjofs:train
+    python benchmarks/bench_housing.py --pads 0 0.5 1 1.5 2 3   # only: fits after a pixel pad
 
 ``--stages`` fits each test housing from four starts and gives the share at IoU >= 0.5: the
 true lit lens (centre and radius from the box, :func:`find_lens`), the ``union`` detector's
 best-scored candidate whose centre lies in the box's circle (Zheng's rule), and the two mixed
 (true centre with the candidate's radius, the candidate's centre with the true radius).
+
+``--pads P...`` gives the share of housings fitted at IoU >= 0.5 from their lit lens after the
+fit is widened by P pixels on every side (the stage's ``pad``), on each housing set's training
+and test split, with the median slack per side between the fit and the annotated box.
 
 ``--select SET:SPLIT...`` asks which of the ``union`` candidates on one light gives its box: the
 share of annotated boxes (housings; lenses on lens-boxed sets) met at IoU >= 0.5 by the
@@ -104,6 +109,36 @@ def fit_quality(name: str) -> str:
         f"{TRAIN_SPLIT[name]} {margin:.2f}, then IoU >= 0.5: "
         f"{(np.array(widened) >= 0.5).mean():.2f}"
     )
+
+
+def lens_fits(name: str, split: str) -> tuple[np.ndarray, np.ndarray]:
+    """The annotated housings of a split and the fits from their lit lens (unwidened)."""
+    truth, fits = [], []
+    for sample in open_dataset(name).split(split):
+        boxes = [a.bbox for a in sample.annotations]
+        if not boxes:
+            continue
+        image = sample.load().image
+        lenses = [find_lens(image, b) for b in boxes]
+        fitted, _, _ = fit_housings(
+            cv2.cvtColor(image, cv2.COLOR_BGR2GRAY), [(c.x, c.y, c.radius) for c in lenses]
+        )
+        truth += boxes
+        fits += list(fitted)
+    return np.asarray(truth, float), np.asarray(fits, float)
+
+
+def pad_row(name: str, split: str, pads: list[float]) -> str:
+    """One row of the ``--pads`` table."""
+    truth, fits = lens_fits(name, split)
+    shares = []
+    for pad in pads:
+        grown = widen(fits, 0.0, pad)
+        iou = np.array([iou_matrix([t], [g])[0, 0] for t, g in zip(truth, grown)])
+        shares.append(f"{np.mean(iou >= 0.5):.3f}")
+    slack = np.median((fits - truth) * [1, 1, -1, -1], axis=0)
+    sides = " / ".join(f"{v:.1f}" for v in slack)
+    return f"| {name} | {split} | {len(truth)} | {' | '.join(shares)} | {sides} |"
 
 
 def stage_starts(name: str) -> str:
@@ -222,7 +257,19 @@ def main() -> None:
     parser.add_argument("--stages", action="store_true", help="only the stage-by-stage table")
     parser.add_argument("--fit", action="store_true", help="only the speed and fit quality")
     parser.add_argument("--select", nargs="+", metavar="SET:SPLIT", help="only: which candidate")
+    parser.add_argument("--pads", nargs="+", type=float, metavar="P", help="only: fits + P px")
     args = parser.parse_args()
+    if args.pads:
+        print(
+            "| set | split | housings | "
+            + " | ".join(f"pad {p:g} px" for p in args.pads)
+            + " | median slack l / t / r / b (px) |"
+        )
+        print("|---|---|---:|" + "---:|" * len(args.pads) + "---|")
+        for name, train in TRAIN_SPLIT.items():
+            for split in (train, "test"):
+                print(pad_row(name, split, args.pads), flush=True)
+        return
     if args.select:
         print(
             "| set | boxes | best-scored hitting | stage's first hitting | any hitting | any kept "

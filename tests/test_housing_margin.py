@@ -38,13 +38,25 @@ def test_the_margin_of_a_set_is_learned_from_its_boxes(margin):
     assert learn_margin(rendered_set(margin)) == pytest.approx(margin, abs=0.06)
 
 
-def test_the_stage_widens_its_housings_by_its_margin():
+@pytest.mark.parametrize(("margin", "pad"), [(0.25, 0.0), (0.0, 1.0), (0.25, 1.5)])
+def test_the_stage_widens_its_housings_by_its_margin_and_pad(margin, pad):
     image = background(200, 300)
     render_head(image, (150, 100), 8)
     lens = [Candidate.from_circle(150, 100, 8, 0.9)]
+    stage = get_registry().create
     plain, wide = (
-        get_registry().create("verifier", "housing", {"margin": m}).verify(Frame(image, "x"), lens)
-        for m in (0.0, 0.25)
+        stage("verifier", "housing", params).verify(Frame(image, "x"), lens)
+        for params in ({"margin": 0.0, "pad": 0.0}, {"margin": margin, "pad": pad})
     )
-    assert np.allclose(wide[0].housing, widen(np.array([plain[0].housing]), 0.25)[0])
+    assert np.allclose(wide[0].housing, widen(np.array([plain[0].housing]), margin, pad)[0])
     assert wide[0].bbox == plain[0].bbox  # the margin widens the housing, not the lens
+
+
+def test_the_default_pad_is_one_pixel_per_side():
+    image = background(200, 300)
+    render_head(image, (150, 100), 8)
+    lens = [Candidate.from_circle(150, 100, 8, 0.9)]
+    stage = get_registry().create
+    plain = stage("verifier", "housing", {"pad": 0.0}).verify(Frame(image, "x"), lens)
+    default = stage("verifier", "housing").verify(Frame(image, "x"), lens)
+    assert np.allclose(np.subtract(default[0].housing, plain[0].housing), [-1, -1, 1, 1])

@@ -30,10 +30,17 @@ MAX_MARGIN = 0.25
 MARGINS = np.linspace(-MAX_MARGIN, MAX_MARGIN, 11)
 
 
-def widen(boxes: np.ndarray, margin: float) -> np.ndarray:
-    """``boxes`` (N, 4) grown on every side by ``margin`` x their short side."""
+def widen(boxes: np.ndarray, margin: float, pad: float = 0.0) -> np.ndarray:
+    """``boxes`` (N, 4) grown on every side by ``margin`` x their short side plus ``pad``
+    pixels.
+
+    Examples
+    --------
+    >>> widen(np.array([[0.0, 0.0, 10.0, 20.0]]), 0.1, pad=1.0).tolist()
+    [[-2.0, -2.0, 12.0, 22.0]]
+    """
     short = np.minimum(boxes[:, 2] - boxes[:, 0], boxes[:, 3] - boxes[:, 1])
-    return boxes + np.outer(margin * short, [-1.0, -1.0, 1.0, 1.0])
+    return boxes + np.outer(margin * short + pad, [-1.0, -1.0, 1.0, 1.0])
 
 
 def margin_free_iou(truth, fit) -> float:
