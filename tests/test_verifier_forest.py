@@ -57,7 +57,7 @@ def test_missing_values_follow_the_learned_side():
     with threadpool_limits(1):  # two OpenMP threads on a loaded machine take seconds
         model = HistGradientBoostingClassifier(max_iter=30, random_state=0).fit(x, y)
     forest = Forest.of(model, "memory")
-    assert forest.nan_left.any() and not forest.nan_left.all()
+    assert forest.nan_right.any() and not forest.nan_right.all()
     test = rng.normal(size=(100, 4))
     test[rng.random(test.shape) < 0.3] = np.nan
     assert np.array_equal(forest.probability(test), model.predict_proba(test)[:, 1])
