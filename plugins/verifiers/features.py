@@ -13,6 +13,7 @@ from collections.abc import Sequence
 
 import cv2
 import numpy as np
+from numba import njit
 from skimage.feature._hoghistogram import hog_histograms
 
 from tsrkit.types import Candidate
@@ -189,41 +190,60 @@ def stacked_hog(lightness: np.ndarray, rows: int) -> np.ndarray:
     return blocks.reshape(n, -1)
 
 
-#: Cosine and sine of every OpenCV 8-bit hue (0-179, 2 degrees a step).
-_HUE_COS = np.cos(np.arange(180) * (np.pi / 90.0)).astype(np.float32)
-_HUE_SIN = np.sin(np.arange(180) * (np.pi / 90.0)).astype(np.float32)
+#: Cosine and sine of every OpenCV 8-bit hue (0-179, 2 degrees a step; 0 past 179, where
+#: OpenCV puts no hue).
+_HUE_COS = np.zeros(256, np.float32)
+_HUE_SIN = np.zeros(256, np.float32)
+_HUE_COS[:180] = np.cos(np.arange(180) * (np.pi / 90.0))
+_HUE_SIN[:180] = np.sin(np.arange(180) * (np.pi / 90.0))
 
 
-def colour_planes(*patches: np.ndarray) -> list[np.ndarray]:
-    """Per-pixel L, a, b, S, V, saturation-weighted hue cosine and sine, and chroma of each
-    BGR stack in ``patches`` (one Lab and one HSV conversion for all of them).
+@njit(cache=True, nogil=True)
+def fill_planes(lab: np.ndarray, hsv: np.ndarray, out: np.ndarray) -> None:
+    """The :data:`COLOUR_NAMES` planes of the 8-bit ``lab`` and ``hsv`` pixels (P, 3) of a
+    (K, N, 8) ``out``'s N samples of K pixels each, sample after sample, into ``out`` pixel
+    after pixel, sample inside; every value in float32 as numpy computes it on float32 arrays
+    (the saturation a float32 quotient by 255, the chroma the float32 root of a float32
+    ``a * a + b * b``)."""
+    pixels, samples = out.shape[0], out.shape[1]
+    for i in range(samples):
+        for p in range(pixels):
+            at = i * pixels + p
+            a = np.float32(lab[at, 1]) - np.float32(128.0)
+            b = np.float32(lab[at, 2]) - np.float32(128.0)
+            saturation = np.float32(hsv[at, 1]) / np.float32(255.0)
+            row = out[p, i]
+            row[0], row[1], row[2] = lab[at, 0], lab[at, 1], lab[at, 2]
+            row[3], row[4] = hsv[at, 1], hsv[at, 2]
+            row[5] = _HUE_COS[hsv[at, 0]] * saturation
+            row[6] = _HUE_SIN[hsv[at, 0]] * saturation
+            row[7] = np.sqrt(a * a + b * b)
+
+
+def colour_planes(points: np.ndarray, samples: int, sizes: Sequence[int]) -> list[np.ndarray]:
+    """Per-pixel L, a, b, S, V, saturation-weighted hue cosine and sine, and chroma of BGR
+    ``points`` (P, 3): one block per entry ``K`` of ``sizes``, of ``samples`` samples of ``K``
+    pixels each, sample after sample (one Lab and one HSV conversion for all of them, the
+    planes by :func:`fill_planes`).
 
     Returns
     -------
     list of ndarray
-        One float32 array per input, shaped like it with 8 channels (:data:`COLOUR_NAMES`).
+        One float32 (K, ``samples``, 8) array per block, pixel after pixel with the samples
+        inside (:data:`COLOUR_NAMES`).
     """
-    flat = np.concatenate([p.reshape(-1, 3) for p in patches])[None]  # one row: fastest
-    lab = cv2.cvtColor(flat, cv2.COLOR_BGR2LAB)[0].T.astype(np.float32)
-    hsv = cv2.cvtColor(flat, cv2.COLOR_BGR2HSV)[0].T
-    hue, saturation = hsv[0], hsv[1].astype(np.float32) / 255.0
-    a, b = lab[1] - 128.0, lab[2] - 128.0
-    planes = np.stack(
-        [
-            *lab,
-            hsv[1].astype(np.float32),
-            hsv[2].astype(np.float32),
-            _HUE_COS[hue] * saturation,
-            _HUE_SIN[hue] * saturation,
-            np.sqrt(a * a + b * b),
-        ],
-        axis=-1,
-    )
-    ends = np.cumsum([0] + [p.size // 3 for p in patches])
-    return [
-        planes[start:end].reshape(*p.shape[:-1], len(COLOUR_NAMES))
-        for p, start, end in zip(patches, ends[:-1], ends[1:])
-    ]
+    row = np.ascontiguousarray(points, np.uint8)[None]  # one row: fastest
+    lab = cv2.cvtColor(row, cv2.COLOR_BGR2LAB)[0]
+    hsv = cv2.cvtColor(row, cv2.COLOR_BGR2HSV)[0]
+    out = []
+    start = 0
+    for size in sizes:
+        planes = np.empty((size, samples, len(COLOUR_NAMES)), np.float32)
+        end = start + size * samples
+        fill_planes(lab[start:end], hsv[start:end], planes)
+        out.append(planes)
+        start = end
+    return out
 
 
 #: The pixels of each of :data:`RING_MASKS`, as flat indices into the lens context (row-major).
@@ -343,10 +363,7 @@ def candidate_features(image: np.ndarray, candidates: Sequence[Candidate]) -> np
     points = remap_points(
         image, np.concatenate([lens_x, house_x]), np.concatenate([lens_y, house_y])
     )
-    lens, housing = colour_planes(
-        points[: len(lens_x)].reshape(n, -1, 3).transpose(1, 0, 2),
-        points[len(lens_x) :].reshape(n, -1, 3).transpose(1, 0, 2),
-    )
+    lens, housing = colour_planes(points, n, (LENS_PX * LENS_PX, HOUSING_PX[0] * HOUSING_PX[1]))
     height, width = image.shape[:2]
     return np.column_stack(
         [

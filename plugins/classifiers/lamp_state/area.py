@@ -27,9 +27,7 @@ EPSILON = float(np.finfo(np.float64).eps)
 
 
 @njit(cache=True, nogil=True)
-def area_table(
-    source: int, target: int, scale: float
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def area_table(source: int, target: int, scale: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """OpenCV's ``computeResizeAreaTab``: for ``source`` pixels resampled to ``target`` at
     ``scale`` source pixels per output pixel, the entries (output index, source index, float32
     weight), output after output."""
@@ -177,7 +175,8 @@ def decimate_blocks(
 @njit(cache=True, nogil=True)
 def whole_scales(scale: tuple[float, float]) -> bool:
     """Whether OpenCV takes its integer path for ``scale`` (x, y): both whole numbers."""
-    return abs(scale[0] - np.rint(scale[0])) < EPSILON and abs(scale[1] - np.rint(scale[1])) < EPSILON
+    x, y = scale
+    return abs(x - np.rint(x)) < EPSILON and abs(y - np.rint(y)) < EPSILON
 
 
 @njit(cache=True, nogil=True)
