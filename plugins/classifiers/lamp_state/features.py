@@ -33,15 +33,8 @@ from collections.abc import Sequence
 
 import cv2
 import numpy as np
-from numba import njit
 
 from tsrkit.types import Candidate
-from tsrkit_plugins.classifiers.lamp_state.area import (
-    decimate,
-    decimate_blocks,
-    decimate_general,
-    whole_scales,
-)
 
 #: OpenCV hue (0-180) bin edges: reds split off at both ends, orange, amber, yellow, greens, blues.
 HUE_EDGES = np.array([0, 6, 12, 18, 24, 32, 45, 70, 95, 130, 165, 181])
@@ -130,111 +123,56 @@ def pixel_bounds(boxes: np.ndarray, width: int, height: int) -> np.ndarray:
     return np.concatenate([low, high], axis=1).astype(np.int64)
 
 
-@njit(cache=True, nogil=True)
-def shrink(
-    src: np.ndarray,
-    window: tuple[int, int, int, int],
-    size: tuple[int, int],
-    span: tuple[int, int],
-    axis: int,
-    halve_from: int,
-    dst: np.ndarray,
-) -> None:
-    """:func:`area_resample` of the crop ``window`` (top, left, height, width) of ``src``, no
-    side of which enlarges, into ``dst`` (the wanted rows or columns), compiled (:mod:`.area`:
-    OpenCV's arithmetic, to the bit)."""
-    top, left, height, width = window
-    kx = 2 if halve_from > 0 and width >= halve_from * size[0] else 1
-    ky = 2 if halve_from > 0 and height >= halve_from * size[1] else 1
-    width, height = width // kx, height // ky
-    fx, fy = size[0] / width, size[1] / height
-    rows, cols = height, width
-    if axis == 0:
-        rows = min(height, span[1] * height // size[1] + 2)
-    else:
-        cols = min(width, span[1] * width // size[0] + 2)
-    # cv2.resize with fx, fy: the size rounded (ties to even), the scale 1 / fx
-    target = (int(np.rint(cols * fx)), int(np.rint(rows * fy)))
-    scale = (1.0 / fx, 1.0 / fy)
-    corner = (span[0], 0) if axis == 0 else (0, span[0])
-    if kx == 1 and ky == 1:
-        decimate(src, (top, left, rows, cols), target, scale, corner, dst)
-    elif not whole_scales(scale):  # the halving fused into the area rule
-        decimate_general(src, (top, left, rows, cols), (kx, ky), target, scale, corner, dst)
-    else:  # OpenCV's integer path on the halved pixels the span reads (from one before)
-        skip = max(int(span[0] * scale[1 - axis]) - 1, 0)
-        y0, x0 = (skip, 0) if axis == 0 else (0, skip)
-        halved = np.empty((rows - y0, cols - x0, 3), np.uint8)
-        block = (top + ky * y0, left + kx * x0, ky * (rows - y0), kx * (cols - x0))
-        decimate_blocks(src, block, (kx, ky), (0, 0), halved)
-        decimate(halved, (-y0, -x0, rows, cols), target, scale, corner, dst)
-
-
 def area_resample(
-    crop: np.ndarray, size: tuple[int, int], span: tuple[int, int], axis: int, halve_from: int = 0
+    crop: np.ndarray, size: tuple[int, int], first: int, axis: int, halve_from: int = 0
 ) -> np.ndarray:
-    """The rows (``axis`` 0) or columns (``axis`` 1) ``span`` = (first, end) of ``crop``
-    resampled to ``size`` = (width, height) by OpenCV's area rule (``cv2.INTER_AREA``): the
-    mean colour of each cell of a ``size`` grid over the crop.
+    """The first ``first`` rows (``axis`` 0) or columns (``axis`` 1) of ``crop`` resampled to
+    ``size`` = (width, height) by OpenCV's area rule (``cv2.INTER_AREA``): the mean colour of
+    each cell of a ``size`` grid over the crop.
 
     When both sides shrink (OpenCV's area decimation), each output row or column is summed from
     its own source cells, with weights set by its index times the scale factor alone (clamped
     only at the far edge): the crop is cut two source pixels past the wanted ones and resampled
     with the whole crop's scale factors (``fx``, ``fy``: the quotients OpenCV takes of the
-    sizes), and only the wanted output pixels are computed, so less source is read for the same
-    values (``tests/test_lamp_state.py`` compares them with whole resamplings at every crop
-    length up to a frame's width). That case is computed by :func:`shrink`, compiled; an
-    enlarging crop by OpenCV.
+    sizes), so less source is read for the same values (``tests/test_lamp_state.py`` compares
+    them with whole resamplings at every crop length up to a frame's width).
 
     ``halve_from`` > 1 first halves each side at least ``halve_from`` times its output length:
     the crop is trimmed to an even length there (the last pixel dropped from an odd one) and
-    each 2 x 2 (or 2 x 1) block averaged, OpenCV's integer-scale area path (a box average;
-    with the area rule on the halved crop after it, about half the time of the area rule alone
-    on a frame's housings: ``benchmarks/RESULTS.state.md``). The cells keep their meaning (a
-    cell's mean colour), with the far edge moved by at most a pixel and the colours rounded
-    twice. ``halve_from`` 0: the area rule alone, on the whole crop.
+    each 2 x 2 (or 2 x 1) block averaged, OpenCV's integer-scale area path (a box average,
+    vectorised for 2 x 2; with the area rule on the halved crop after it, about half the time
+    of the area rule alone on a frame's housings: ``benchmarks/RESULTS.state.md``). The cells
+    keep their meaning (a cell's mean colour), with the far edge moved by at most a pixel and
+    the colours rounded twice. ``halve_from`` 0: the area rule alone, on the whole crop.
     """
     height, width = crop.shape[:2]
-    first, end = span
     if width < size[0] or height < size[1]:  # enlarging: OpenCV's area rule is then linear
         whole = cv2.resize(crop, size, interpolation=cv2.INTER_AREA)
-        return whole[first:end] if axis == 0 else whole[:, first:end]
-    wanted = end - first
-    out = np.empty((wanted, size[0], 3) if axis == 0 else (size[1], wanted, 3), np.uint8)
-    src = np.ascontiguousarray(crop)
-    shrink(src, (0, 0, height, width), size, span, axis, halve_from, out)
-    return out
-
-
-@njit(cache=True, nogil=True)
-def shrink_patches(image: np.ndarray, bounds: np.ndarray, out: np.ndarray) -> np.ndarray:
-    """Each crop ``bounds`` (N, 4: x0, y0, x1, y1, inside ``image``) resampled to the size of
-    ``out`` (N, height, width, 3) by OpenCV's area rule, where no side enlarges (compiled,
-    :mod:`.area`); returns which crops were left (some side enlarges)."""
-    height, width = out.shape[1], out.shape[2]
-    left = np.zeros(len(bounds), np.bool_)
-    for i in range(len(bounds)):
-        x0, y0, x1, y1 = bounds[i, 0], bounds[i, 1], bounds[i, 2], bounds[i, 3]
-        if x1 <= x0 or y1 <= y0:
-            continue
-        if x1 - x0 < width or y1 - y0 < height:
-            left[i] = True
-            continue
-        # cv2.resize to a size: the scale is 1 / (size / crop size)
-        scale = (1.0 / (width / (x1 - x0)), 1.0 / (height / (y1 - y0)))
-        decimate(image, (y0, x0, y1 - y0, x1 - x0), (width, height), scale, (0, 0), out[i])
-    return left
+        return whole[:first] if axis == 0 else whole[:, :first]
+    kx = 2 if halve_from and width >= halve_from * size[0] else 1
+    ky = 2 if halve_from and height >= halve_from * size[1] else 1
+    width, height = width // kx, height // ky
+    fx, fy = size[0] / width, size[1] / height
+    rows, cols = height, width
+    if axis == 0:
+        rows = min(height, first * height // size[1] + 2)
+    else:
+        cols = min(width, first * width // size[0] + 2)
+    cut = crop[: ky * rows, : kx * cols]
+    if kx > 1 or ky > 1:
+        cut = cv2.resize(cut, (cols, rows), interpolation=cv2.INTER_AREA)
+    out = cv2.resize(cut, None, fx=fx, fy=fy, interpolation=cv2.INTER_AREA)
+    return out[:first] if axis == 0 else out[:, :first]
 
 
 def patches(image: np.ndarray, boxes: np.ndarray, size: tuple[int, int]) -> np.ndarray:
     """The (N, height, width, 3) stack of ``boxes`` resampled to ``size`` = (width, height) by
-    OpenCV's area rule (compiled where no side enlarges: :func:`shrink_patches`); a box wholly
-    outside the image gives a black patch."""
+    OpenCV's area rule; a box wholly outside the image gives a black patch."""
     out = np.zeros((len(boxes), size[1], size[0], 3), np.uint8)
-    bounds = pixel_bounds(boxes, image.shape[1], image.shape[0])
-    for i in np.flatnonzero(shrink_patches(image, bounds, out)).tolist():
-        x0, y0, x1, y1 = bounds[i].tolist()
-        out[i] = cv2.resize(image[y0:y1, x0:x1], size, interpolation=cv2.INTER_AREA)
+    bounds = pixel_bounds(boxes, image.shape[1], image.shape[0]).tolist()
+    for i, (x0, y0, x1, y1) in enumerate(bounds):
+        if x1 > x0 and y1 > y0:
+            out[i] = cv2.resize(image[y0:y1, x0:x1], size, interpolation=cv2.INTER_AREA)
     return out
 
 
@@ -278,53 +216,24 @@ def lens_features(image: np.ndarray, lenses: Sequence[Candidate]) -> np.ndarray:
     ).reshape(n, -1)
 
 
-@njit(cache=True, nogil=True)
-def shrink_housings(
-    image: np.ndarray, bounds: np.ndarray, vertical: np.ndarray, out: np.ndarray
-) -> np.ndarray:
-    """The central :func:`band` of each housing of ``bounds`` (N, 4, inside ``image``)
-    resampled upright into ``out`` (N, along, across, 3), as :func:`upright_housings` defines
-    it, where no side enlarges (compiled, :func:`shrink`); returns which housings were left
-    (some side enlarges)."""
-    along, across = out.shape[1], out.shape[2]
-    span = (across // 4, across - across // 4)
-    left = np.zeros(len(bounds), np.bool_)
-    for i in range(len(bounds)):
-        x0, y0, x1, y1 = bounds[i, 0], bounds[i, 1], bounds[i, 2], bounds[i, 3]
-        if x1 <= x0 or y1 <= y0:
-            continue
-        size = (across, along) if vertical[i] else (along, across)
-        window = (y0, x0, y1 - y0, x1 - x0)
-        band = out[i, :, span[0] : span[1]]
-        if x1 - x0 < size[0] or y1 - y0 < size[1]:
-            left[i] = True
-        elif vertical[i]:
-            shrink(image, window, size, span, 1, HALVE_FROM, band)
-        else:
-            shrink(image, window, size, span, 0, HALVE_FROM, band.transpose(1, 0, 2))
-    return left
-
-
 def upright_housings(image: np.ndarray, boxes: np.ndarray, vertical: np.ndarray) -> np.ndarray:
     """The housings resampled to :data:`HOUSING_SIZE` by OpenCV's area rule (halved first
     where long: :data:`HALVE_FROM`), long axis vertical (those not ``vertical``, horizontal
     heads, resampled to the transposed size and transposed); a box wholly outside the image
-    gives a black patch. Only their central :func:`band` is read, and resampled: the columns
-    beside it are left black (:func:`area_resample`, half the source resampled). Housings no
-    side of which enlarges are resampled in one compiled pass (:func:`shrink_housings`), the
-    others by OpenCV."""
+    gives a black patch. Only their central :func:`band` is read: the columns past it are left
+    black (:func:`area_resample`, a quarter less source resampled)."""
     across, along = HOUSING_SIZE
-    span = (across // 4, across - across // 4)
+    first = across - across // 4
     out = np.zeros((len(boxes), along, across, 3), np.uint8)
-    bounds = pixel_bounds(boxes, image.shape[1], image.shape[0])
-    for i in np.flatnonzero(shrink_housings(image, bounds, vertical, out)).tolist():
-        x0, y0, x1, y1 = bounds[i].tolist()
-        crop = image[y0:y1, x0:x1]
-        if vertical[i]:
-            out[i, :, span[0] : span[1]] = area_resample(crop, HOUSING_SIZE, span, 1, HALVE_FROM)
-        else:
-            turned = area_resample(crop, (along, across), span, 0, HALVE_FROM)
-            out[i, :, span[0] : span[1]] = turned.transpose(1, 0, 2)
+    bounds = pixel_bounds(boxes, image.shape[1], image.shape[0]).tolist()
+    for i, ((x0, y0, x1, y1), upright) in enumerate(zip(bounds, vertical.tolist())):
+        if x1 > x0 and y1 > y0:
+            crop = image[y0:y1, x0:x1]
+            if upright:
+                out[i, :, :first] = area_resample(crop, HOUSING_SIZE, first, 1, HALVE_FROM)
+            else:
+                turned = area_resample(crop, (along, across), first, 0, HALVE_FROM)
+                out[i, :, :first] = turned.transpose(1, 0, 2)
     return out
 
 
