@@ -87,28 +87,40 @@ def context_boxes(table: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 REMAP_ROW = 32000
 
 
+@njit(cache=True, nogil=True)
+def fill_maps(
+    boxes: np.ndarray, width: int, height: int, upright: bool, map_x: np.ndarray, map_y: np.ndarray
+) -> None:
+    """:func:`box_maps` into ``map_x`` and ``map_y`` (N, height, width), in float32 as numpy
+    computes them on float32 arrays: ``x0 + u * (x1 - x0) / width - 0.5``, left to right."""
+    w, h, half = np.float32(width), np.float32(height), np.float32(0.5)
+    for i in range(len(boxes)):
+        x0, y0, x1, y1 = boxes[i, 0], boxes[i, 1], boxes[i, 2], boxes[i, 3]
+        wide = upright and x1 - x0 > y1 - y0
+        for row in range(height):
+            v = np.float32(row) + half
+            for col in range(width):
+                u = np.float32(col) + half
+                if wide:
+                    map_x[i, row, col] = x0 + v * (x1 - x0) / h - half
+                    map_y[i, row, col] = y0 + u * (y1 - y0) / w - half
+                else:
+                    map_x[i, row, col] = x0 + u * (x1 - x0) / w - half
+                    map_y[i, row, col] = y0 + v * (y1 - y0) / h - half
+
+
 def box_maps(
     boxes: np.ndarray, size: tuple[int, int], upright: bool = False
 ) -> tuple[np.ndarray, np.ndarray]:
-    """The sample points (x, y), flat float32, of every box of ``boxes`` at ``size`` (width,
-    height), box after box, row by row: pixel centres of the box scaled to ``size``. With
-    ``upright``, a box wider than tall is read transposed, so its long side runs down."""
+    """The sample points (x, y), flat float32, of every box of ``boxes`` (float32) at ``size``
+    (width, height), box after box, row by row: pixel centres of the box scaled to ``size``
+    (one compiled pass, :func:`fill_maps`). With ``upright``, a box wider than tall is read
+    transposed, so its long side runs down."""
     width, height = size
-    x0, y0, x1, y1 = (boxes[:, k, None, None] for k in range(4))
-    # a column's x and a row's y, computed once per box and spread over the sample
-    u = np.arange(width, dtype=np.float32)[None, None, :] + 0.5
-    v = np.arange(height, dtype=np.float32)[None, :, None] + 0.5
-    map_x = x0 + u * (x1 - x0) / width - 0.5
-    map_y = y0 + v * (y1 - y0) / height - 0.5
-    if upright:
-        wide = (boxes[:, 2] - boxes[:, 0] > boxes[:, 3] - boxes[:, 1])[:, None, None]
-        map_x = np.where(wide, x0 + v * (x1 - x0) / height - 0.5, map_x)
-        map_y = np.where(wide, y0 + u * (y1 - y0) / width - 0.5, map_y)
-    shape = (len(boxes), height, width)
-    return (
-        np.broadcast_to(map_x, shape).astype(np.float32).ravel(),
-        np.broadcast_to(map_y, shape).astype(np.float32).ravel(),
-    )
+    map_x = np.empty((len(boxes), height, width), np.float32)
+    map_y = np.empty_like(map_x)
+    fill_maps(np.ascontiguousarray(boxes, np.float32), width, height, upright, map_x, map_y)
+    return map_x.ravel(), map_y.ravel()
 
 
 def remap_points(image: np.ndarray, map_x: np.ndarray, map_y: np.ndarray) -> np.ndarray:
