@@ -82,27 +82,29 @@ COARSE = LAYOUTS[(LAYOUTS[:, 3] == 2.8) & (LAYOUTS[:, 4] == 0.8)]
 
 @njit(cache=True, nogil=True, inline="always")
 def box_contrast(
-    table: np.ndarray, box: tuple[float, float, float, float], lens: tuple, band: float
+    table: np.ndarray,
+    box: tuple[float, float, float, float],
+    lens: tuple[np.int32, float],
+    band: float,
 ) -> float:
-    """``(outside - inside) / outside`` of ``box``: inside without the ``lens`` box, outside a
-    ``band`` wide frame around the box."""
+    """``(outside - inside) / outside`` of ``box``: inside without the lens (its sum and pixel
+    count, ``lens``), outside a ``band`` wide frame around the box."""
     x0, y0, x1, y1 = box
     inner, inner_n = box_sum(table, x0, y0, x1, y1)
-    lens_sum, lens_n = box_sum(table, lens[0], lens[1], lens[2], lens[3])
     outer, outer_n = box_sum(table, x0 - band, y0 - band, x1 + band, y1 + band)
-    inside = (inner - lens_sum) / max(inner_n - lens_n, 1.0)
+    inside = (inner - lens[0]) / max(inner_n - lens[1], 1.0)
     outside = (outer - inner) / max(outer_n - inner_n, 1.0)
     return (outside - inside) / max(outside, 1.0)
 
 
 @njit(cache=True, nogil=True)
 def contrasts(table: np.ndarray, boxes: np.ndarray, lens: np.ndarray, band: np.ndarray):
-    """:func:`box_contrast` of each box of ``boxes`` (N, 4) with its ``lens`` (N, 4) and
+    """:func:`box_contrast` of each box of ``boxes`` (N, 4) with its ``lens`` box (N, 4) and
     ``band`` (N,)."""
     out = np.empty(len(boxes))
     for i in range(len(boxes)):
         box = (boxes[i, 0], boxes[i, 1], boxes[i, 2], boxes[i, 3])
-        around = (lens[i, 0], lens[i, 1], lens[i, 2], lens[i, 3])
+        around = box_sum(table, lens[i, 0], lens[i, 1], lens[i, 2], lens[i, 3])
         out[i] = box_contrast(table, box, around, band[i])
     return out
 
@@ -137,7 +139,7 @@ def score_layouts(
     its index into ``best[i]``, its contrast into ``score[i]``."""
     for i in range(len(lenses)):
         x, y, r = lenses[i, 0], lenses[i, 1], lenses[i, 2]
-        lens = (x - r, y - r, x + r, y + r)
+        lens = box_sum(table, x - r, y - r, x + r, y + r)  # the same for every layout
         band = max(BAND * r, 1.0)
         rows = layouts[group[i]]
         for k in range(rows.shape[0]):
