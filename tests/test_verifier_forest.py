@@ -46,6 +46,16 @@ def test_shipped_model_probabilities_are_sklearns_to_the_bit(features):
     )
 
 
+def test_a_single_row_is_sklearns_to_the_bit(features):
+    """A frame with one candidate: its leaves are added one after the other, as scikit-learn
+    adds them (a NumPy reduction of a lone row's leaves would add them pairwise: the form before
+    this one differed from scikit-learn in the last bits on most single rows)."""
+    verifier = get_registry().create("verifier", "verifier")
+    for row in features[:40]:
+        expected = verifier.estimator.predict_proba(row[None])[:, 1]
+        assert np.array_equal(verifier.forest.probability(row[None]), expected)
+
+
 def test_missing_values_follow_the_learned_side():
     from sklearn.ensemble import HistGradientBoostingClassifier
 
