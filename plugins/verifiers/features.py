@@ -259,7 +259,7 @@ def colour_planes(points: np.ndarray, samples: int, sizes: Sequence[int]) -> lis
 
 
 #: The pixels of each of :data:`RING_MASKS`, as flat indices into the lens context (row-major).
-RING_AT = [np.flatnonzero(m) for m in RING_MASKS]
+RING_AT = tuple(np.flatnonzero(m) for m in RING_MASKS)
 
 
 def row_percentile(values: np.ndarray, q: float) -> np.ndarray:
@@ -285,41 +285,105 @@ def row_percentile(values: np.ndarray, q: float) -> np.ndarray:
     return b - (b - a) * kind(1 - t) if t >= 0.5 else a + (b - a) * kind(t)
 
 
+@njit(cache=True, nogil=True)
+def pairwise_sum(values: np.ndarray) -> np.float32:
+    """numpy's float32 sum of a contiguous run (its ``pairwise_sum``): under 8 values one after
+    the other; up to 128 in eight interleaved sums, combined as ``((0 + 1) + (2 + 3)) + ((4 + 5)
+    + (6 + 7))``, then the rest one after the other; above that the two halves (the first a
+    multiple of 8 long) summed so and added."""
+    n = len(values)
+    if n < 8:
+        total = np.float32(0.0)
+        for i in range(n):
+            total += values[i]
+        return total
+    if n > 128:
+        half = n // 2 - (n // 2) % 8
+        return pairwise_sum(values[:half]) + pairwise_sum(values[half:])
+    r = values[:8].copy()
+    end = n - n % 8
+    for i in range(8, end, 8):
+        for j in range(8):
+            r[j] += values[i + j]
+    total = ((r[0] + r[1]) + (r[2] + r[3])) + ((r[4] + r[5]) + (r[6] + r[7]))
+    for i in range(end, n):
+        total += values[i]
+    return total
+
+
+@njit(cache=True, nogil=True)
+def deviation(values: np.ndarray, pairwise: bool) -> np.float32:
+    """The float32 standard deviation of ``values`` as numpy's ``std`` takes it along an axis:
+    the mean, the squared deviations and their mean, each sum :func:`pairwise_sum` where numpy
+    reduces a contiguous run (``pairwise``), else one value after the other."""
+    n = np.float32(len(values))
+    if pairwise:
+        mean = pairwise_sum(values) / n
+        squares = (values - mean) * (values - mean)
+        return np.sqrt(pairwise_sum(squares) / n)
+    total = np.float32(0.0)
+    for v in values:
+        total += v
+    mean = total / n
+    total = np.float32(0.0)
+    for v in values:
+        total += (v - mean) * (v - mean)
+    return np.sqrt(total / n)
+
+
+@njit(cache=True, nogil=True)
+def pixel_means(planes: np.ndarray, at: np.ndarray) -> np.ndarray:
+    """The (N, 8) float32 mean over the pixels ``at`` of ``planes`` (pixels, N, 8), adding them
+    one after the other as numpy adds along an outer axis (whole rows of candidates)."""
+    total = np.zeros(planes.shape[1:], np.float32)
+    for p in at:
+        total += planes[p]
+    return total / np.float32(len(at))
+
+
+@njit(cache=True, nogil=True)
+def fill_colour(lens: np.ndarray, housing: np.ndarray, rings: tuple, out: np.ndarray) -> None:
+    """:func:`colour_features` into ``out`` (N, 42), but for the housing's lower-quartile
+    lightness (column 36): each value by numpy's float operations in numpy's order (see there).
+    """
+    for k, at in enumerate(rings):
+        out[:, 8 * k : 8 * k + 8] = pixel_means(lens, at)
+    out[:, 27:35] = pixel_means(housing, np.arange(housing.shape[0]))
+    disk = rings[0]
+    for i in range(lens.shape[1]):
+        light = lens[disk, i, 0].copy()
+        out[i, 24] = light.max()
+        # one candidate: numpy reduces the lone column as a contiguous run (pairwise)
+        out[i, 25] = deviation(light, lens.shape[1] == 1)
+        out[i, 26] = np.count_nonzero(lens[disk, i, 4] > 240) / len(disk)
+        out[i, 35] = deviation(housing[:, i, 0].copy(), True)
+        out[i, 37] = np.count_nonzero(housing[:, i, 4] < 60) / housing.shape[0]
+        lens_mean_l = out[i, 0] + np.float32(1.0)
+        out[i, 38] = out[i, 0] - out[i, 8]
+        out[i, 39] = out[i, 0] - out[i, 16]
+        out[i, 40] = (out[i, 16] + np.float32(1.0)) / lens_mean_l
+        # the housing's mean lightness is a float64 column there: float64 arithmetic
+        out[i, 41] = (np.float64(out[i, 27]) + 1.0) / np.float64(lens_mean_l)
+
+
 def colour_features(lens: np.ndarray, housing: np.ndarray) -> np.ndarray:
     """Lab / HSV statistics of lens, annulus, surround and housing, and surround darkness.
 
     ``lens`` (256, N, 8) and ``housing`` (264, N, 8) are :func:`colour_planes` of the samples,
-    pixel after pixel (row-major in the 16 x 16 and 22 x 12 samples), candidate inside. A mean
-    over the pixels adds whole rows of candidates pixel after pixel (numpy adds along an outer
-    axis in order): the sums of the patch-by-patch layout, in a fraction of its time. The
-    lightness deviations are taken on the memory layouts the patch-by-patch computation had
-    (lens: candidate innermost; housing: a row per candidate, summed pairwise by numpy), so
-    every value is the same to the bit (``tests/test_verifier_features_oracle.py``). Hue
-    enters as its cosine and sine weighted by saturation, so red near 0 and 180 is one colour.
+    pixel after pixel (row-major in the 16 x 16 and 22 x 12 samples), candidate inside. The
+    values are those of numpy's means, deviations and shares over the pixels (the
+    patch-by-patch computation before it), to the bit (``tests/test_verifier_features_oracle.py``),
+    in one compiled pass (:func:`fill_colour`): a mean over the pixels adds them one after the
+    other, as numpy adds along an outer axis; the lightness deviations follow numpy's
+    reductions of the layouts the patch-by-patch computation had (lens: candidate innermost,
+    so pixel after pixel, but pairwise for a single candidate; housing: a row per candidate,
+    summed pairwise). Hue enters as its cosine and sine weighted by saturation, so red near 0
+    and 180 is one colour.
     """
-    rings = [lens[at].mean(axis=0) for at in RING_AT]
-    lens_l = np.ascontiguousarray(lens[RING_AT[0], :, 0])
-    lens_v = lens[RING_AT[0], :, 4]
-    peak = np.column_stack([lens_l.max(axis=0), lens_l.std(axis=0), (lens_v > 240).mean(axis=0)])
-    light = np.ascontiguousarray(housing[:, :, 0].T)
-    house_stats = np.column_stack(
-        [
-            housing.mean(axis=0),
-            light.std(axis=1),
-            row_percentile(light, 25),
-            (housing[:, :, 4] < 60).mean(axis=0),
-        ]
-    )
-    lens_mean_l = rings[0][:, 0] + 1.0
-    darkness = np.column_stack(
-        [
-            rings[0][:, 0] - rings[1][:, 0],
-            rings[0][:, 0] - rings[2][:, 0],
-            (rings[2][:, 0] + 1.0) / lens_mean_l,
-            (house_stats[:, 0] + 1.0) / lens_mean_l,
-        ]
-    )
-    return np.column_stack([*rings, peak, house_stats, darkness]).astype(np.float32)
+    out = np.empty((lens.shape[1], 42), np.float32)
+    fill_colour(lens, housing, RING_AT, out)
+    out[:, 36] = row_percentile(np.ascontiguousarray(housing[:, :, 0].T), 25)
+    return out
 
 
 def geometry_features(table: np.ndarray, boxes: np.ndarray, width: int, height: int) -> np.ndarray:

@@ -8,10 +8,11 @@ of all trees are one set of flat arrays, and one compiled pass (:func:`descend`)
 The leaf values are added tree after tree onto the baseline, in scikit-learn's order, and the
 probability is the same ``scipy.special.expit``, so the probabilities equal scikit-learn's to
 the bit (``tests/test_verifier_forest.py``), also for a single row (the NumPy form before this
-one summed a lone row's leaves pairwise, off scikit-learn's sum in the last bits). The trees are read from the estimator's
-``_predictors`` and ``_baseline_prediction`` (scikit-learn's own arrays; that test would catch
-a change of them). A multiclass classifier (one tree per class per iteration, ``lamp-state``'s)
-is read too: :meth:`Forest.raw` gives each class's sum, as scikit-learn's ``_raw_predict``.
+one summed a lone row's leaves pairwise, off scikit-learn's sum in the last bits). The trees
+are read from the estimator's ``_predictors`` and ``_baseline_prediction`` (scikit-learn's own
+arrays; that test would catch a change of them). A multiclass classifier (one tree per class
+per iteration, ``lamp-state``'s) is read too: :meth:`Forest.raw` gives each class's sum, as
+scikit-learn's ``_raw_predict``.
 """
 
 from __future__ import annotations
