@@ -17,6 +17,7 @@ from numba import njit
 from skimage.feature._hoghistogram import hog_histograms
 
 from tsrkit.types import Candidate
+from tsrkit_plugins.verifiers.reductions import pairwise_sum
 
 #: Side of the lens context, in lens radii (lens disk: 1 radius, annulus 1-2, surround 2-3).
 CONTEXT = 6.0
@@ -283,32 +284,6 @@ def row_percentile(values: np.ndarray, q: float) -> np.ndarray:
     a, b = ordered[:, low], ordered[:, high]
     kind = values.dtype.type
     return b - (b - a) * kind(1 - t) if t >= 0.5 else a + (b - a) * kind(t)
-
-
-@njit(cache=True, nogil=True)
-def pairwise_sum(values: np.ndarray) -> np.float32:
-    """numpy's float32 sum of a contiguous run (its ``pairwise_sum``): under 8 values one after
-    the other; up to 128 in eight interleaved sums, combined as ``((0 + 1) + (2 + 3)) + ((4 + 5)
-    + (6 + 7))``, then the rest one after the other; above that the two halves (the first a
-    multiple of 8 long) summed so and added."""
-    n = len(values)
-    if n < 8:
-        total = np.float32(0.0)
-        for i in range(n):
-            total += values[i]
-        return total
-    if n > 128:
-        half = n // 2 - (n // 2) % 8
-        return pairwise_sum(values[:half]) + pairwise_sum(values[half:])
-    r = values[:8].copy()
-    end = n - n % 8
-    for i in range(8, end, 8):
-        for j in range(8):
-            r[j] += values[i + j]
-    total = ((r[0] + r[1]) + (r[2] + r[3])) + ((r[4] + r[5]) + (r[6] + r[7]))
-    for i in range(end, n):
-        total += values[i]
-    return total
 
 
 @njit(cache=True, nogil=True)
