@@ -21,7 +21,7 @@ the three documents outputs a lens. For each candidate lens ``(x, y, r)`` the fi
 Every box sum is four look-ups in one integral image of the frame (:mod:`.boxes`), and all
 hypotheses of all candidates are scored in one compiled pass (:func:`score_layouts`; each
 value computed by the same float64 operations, in the same order, as the NumPy form before it:
-``tests/test_housing.py`` compares them).
+``tests/test_housing_oracle.py`` compares them).
 """
 
 from __future__ import annotations
@@ -56,6 +56,8 @@ REFINE = 0.5
 REFINE_ALONG = 3.2
 #: Offsets tried per edge, evenly over its range.
 REFINE_STEPS = 13
+#: Those offsets, in units of the range.
+STEPS = np.linspace(-1.0, 1.0, REFINE_STEPS)
 #: Width of the band outside the box and of the edge strips, in lens radii (at least 1 px).
 BAND = 0.6
 #: Shortest head after refinement, in housing widths: the shortest layout searched (three lenses
@@ -186,7 +188,6 @@ def strip_mean(
 def refine_edges(table: np.ndarray, boxes: np.ndarray, r: np.ndarray, out: np.ndarray) -> None:
     """:func:`refine` into ``out`` (N, 4): for each side of each box the first of the
     :data:`REFINE_STEPS` offsets where the outer strip's mean is most above the inner one's."""
-    steps = np.linspace(-1.0, 1.0, REFINE_STEPS)
     for i in range(len(boxes)):
         width = max(BAND * r[i], 1.0)
         vertical = (boxes[i, 3] - boxes[i, 1]) >= (boxes[i, 2] - boxes[i, 0])
@@ -198,7 +199,7 @@ def refine_edges(table: np.ndarray, boxes: np.ndarray, r: np.ndarray, out: np.nd
             low, high = boxes[i, 1 - axis], boxes[i, 3 - axis]
             best = 0.0
             for k in range(REFINE_STEPS):
-                edge = boxes[i, side] + steps[k] * reach
+                edge = boxes[i, side] + STEPS[k] * reach
                 outside = strip_mean(table, axis, edge, outward, low, high)
                 gain = outside - strip_mean(table, axis, edge, -outward, low, high)
                 if k == 0 or gain > best:
