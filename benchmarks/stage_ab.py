@@ -9,7 +9,9 @@ the spread between processes (20 % and more) hides what a change saves, the rati
 process does not. The outputs are compared for equality on every frame (a speed-up must not
 change them; ``--changed``, for a change of outputs by design: the frames that differ are
 counted instead). Only those three files are taken from ``--base``: what they import comes from
-this tree.
+this tree. numba caches compiled functions in a temporary folder for the run (unless
+``NUMBA_CACHE_DIR`` is set): a file loaded here under another module name would otherwise leave
+a cache entry beside it that its checkout cannot load.
 
 Run: python benchmarks/stage_ab.py --base /tmp/old-checkout [--frames 10] [--repeats 5] [--changed]
 (an old checkout: ``git worktree add /tmp/old-checkout <commit>``)
@@ -18,9 +20,13 @@ Run: python benchmarks/stage_ab.py --base /tmp/old-checkout [--frames 10] [--rep
 from __future__ import annotations
 
 import os
+import tempfile
 
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ[_var] = "1"
+if "NUMBA_CACHE_DIR" not in os.environ:  # removed at exit
+    _NUMBA_CACHE = tempfile.TemporaryDirectory(prefix="stage_ab_numba_")
+    os.environ["NUMBA_CACHE_DIR"] = _NUMBA_CACHE.name
 
 import argparse  # noqa: E402
 import importlib.util  # noqa: E402

@@ -69,9 +69,9 @@ def test_stacked_hog_is_skimage_hog_of_the_stack_on_real_patches(shared_datasets
         Candidate.from_circle(rng.uniform(0, image.shape[1]), rng.uniform(0, image.shape[0]), r, 1)
         for r in rng.uniform(1, 20, 60)
     ]
-    lens = F.colour_planes(
-        sample_boxes(image, F.context_boxes(F.candidate_table(candidates))[0], (16, 16))
-    )[0][..., 0]
+    samples = sample_boxes(image, F.context_boxes(F.candidate_table(candidates))[0], (16, 16))
+    planes = F.colour_planes(samples.reshape(-1, 3), len(samples), [16 * 16])[0]
+    lens = planes[..., 0].T.reshape(-1, 16, 16)
     for rows, patches in ((1, lens), (3, lens[:, :, 2:14].repeat(2, axis=1)[:, :22])):
         n, height, width = patches.shape
         small = cv2.resize(

@@ -86,12 +86,11 @@ def split(feature: int, at: float, low: float, high: float) -> Forest:
         baseline=np.zeros(1),
         roots=np.array([0]),
         depths=np.array([1]),
-        order=np.array([0]),
-        feature=np.repeat([feature, 0, 0], 2),
-        threshold=np.repeat([at, 0.0, 0.0], 2),
-        nan_left=np.ones(6, bool),
-        children=np.array([2, 4, 2, 2, 4, 4]),  # node 0 -> nodes 1 (slot 2), 2 (slot 4); leaves
-        value=np.repeat([0.0, logit(low), logit(high)], 2),
+        feature=np.array([feature, 0, 0]),
+        threshold=np.array([at, 0.0, 0.0]),
+        nan_right=np.zeros(3, bool),
+        children=np.array([[1, 2], [1, 1], [2, 2]]),  # node 0 -> nodes 1, 2; leaves
+        value=np.array([0.0, logit(low), logit(high)]),
     )
 
 

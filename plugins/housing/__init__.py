@@ -28,6 +28,7 @@ from collections.abc import Sequence
 from dataclasses import replace
 
 import cv2
+import numpy as np
 
 from tsrkit.geometry import circle_box, iou_matrix
 from tsrkit.hookspecs import hookimpl
@@ -39,16 +40,18 @@ from tsrkit_plugins.housing.margin import widen
 
 
 def suppress(candidates: list[Candidate], threshold: float) -> list[Candidate]:
-    """Greedy non-maximum suppression on the housings of score-ordered ``candidates``."""
+    """Greedy non-maximum suppression on the housings of score-ordered ``candidates``: each
+    kept one drops the later ones its housing overlaps (IoU is symmetric, to the bit), taken
+    in order over those that overlap any later one."""
     if threshold >= 1.0 or len(candidates) < 2:
         return candidates
     housings = [c.housing for c in candidates]
-    overlap = (iou_matrix(housings, housings) > threshold).tolist()
-    kept: list[int] = []
-    for i, row in enumerate(overlap):
-        if not any(row[j] for j in kept):
-            kept.append(i)
-    return [candidates[i] for i in kept]
+    later = np.triu(iou_matrix(housings, housings) > threshold, 1)
+    kept = np.ones(len(candidates), bool)
+    for i in np.flatnonzero(later.any(axis=1)).tolist():
+        if kept[i]:
+            kept &= ~later[i]
+    return [c for c, keep in zip(candidates, kept.tolist()) if keep]
 
 
 class Housing(Verifier):

@@ -1,10 +1,12 @@
 """Box sums over an integral image: the one primitive of the housing search and the lens
 measurement (every mean a handful of look-ups, whatever the box's size).
 
-The sums are one compiled pass over the boxes (:func:`sum_boxes`): the housing stage asks for
-some 60,000 boxes per frame at 50 candidates, and NumPy's rounding, clipping and four gathers
-over them, each a temporary array, took about 1.4 of its 3.4 ms (benchmarks/RESULTS.housing.md).
-The result is the NumPy definition's to the bit (``tests/test_housing_lens.py``).
+A box's sum is compiled (:func:`box_sum`), called box by box from the compiled searches of
+:mod:`.fit` and :mod:`.lens` (the housing stage asks for some 60,000 boxes per frame at 50
+candidates: NumPy's rounding, clipping and four gathers over them, each a temporary array,
+took about 1.4 of its 3.4 ms, benchmarks/RESULTS.housing.md), or for an array of boxes at once
+(:func:`box_sums`). The result is the NumPy definition's to the bit
+(``tests/test_housing_lens.py``).
 """
 
 from __future__ import annotations
@@ -30,19 +32,35 @@ def pixel(value: float, limit: int) -> int:
     return limit if rounded >= limit else int(rounded)
 
 
+@njit(cache=True, nogil=True, inline="always")
+def box_sum(
+    table: np.ndarray, x0: float, y0: float, x1: float, y1: float
+) -> tuple[np.int32, float]:
+    """The sum (int32) and pixel count (float64) of one box: each corner rounded and clipped
+    to the image (:func:`pixel`), the far edges no nearer than the near ones, then the four
+    look-ups of the int32 ``table``."""
+    height, width = table.shape[0] - 1, table.shape[1] - 1
+    left = pixel(x0, width)
+    top = pixel(y0, height)
+    right = max(pixel(x1, width), left)
+    bottom = max(pixel(y1, height), top)
+    total = table[bottom, right] - table[top, right] - table[bottom, left] + table[top, left]
+    return np.int32(total), float((right - left) * (bottom - top))
+
+
+@njit(cache=True, nogil=True, inline="always")
+def box_mean(table: np.ndarray, x0: float, y0: float, x1: float, y1: float) -> float:
+    """The mean grey level of one box (0 for an empty box; see :func:`box_sum`)."""
+    total, count = box_sum(table, x0, y0, x1, y1)
+    return total / max(count, 1.0)
+
+
 @njit(cache=True, nogil=True)
 def sum_boxes(table: np.ndarray, boxes: np.ndarray, total: np.ndarray, count: np.ndarray) -> None:
-    """Fill ``total`` (int32) and ``count`` (float64) for the (N, 4) ``boxes``: each corner
-    rounded and clipped to the image (:func:`pixel`), the far edges no nearer than the near
-    ones, then the four look-ups of the int32 ``table``."""
-    height, width = table.shape[0] - 1, table.shape[1] - 1
+    """Fill ``total`` (int32) and ``count`` (float64) for the (N, 4) ``boxes``
+    (:func:`box_sum` each)."""
     for i in range(boxes.shape[0]):
-        x0 = pixel(boxes[i, 0], width)
-        y0 = pixel(boxes[i, 1], height)
-        x1 = max(pixel(boxes[i, 2], width), x0)
-        y1 = max(pixel(boxes[i, 3], height), y0)
-        total[i] = table[y1, x1] - table[y0, x1] - table[y1, x0] + table[y0, x0]
-        count[i] = (x1 - x0) * (y1 - y0)
+        total[i], count[i] = box_sum(table, boxes[i, 0], boxes[i, 1], boxes[i, 2], boxes[i, 3])
 
 
 def box_sums(table: np.ndarray, boxes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -54,10 +72,3 @@ def box_sums(table: np.ndarray, boxes: np.ndarray) -> tuple[np.ndarray, np.ndarr
     sum_boxes(table, flat, total, count)
     shape = np.shape(boxes)[:-1]
     return total.reshape(shape), count.reshape(shape)
-
-
-def box_means(table: np.ndarray, boxes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Mean grey levels (0 for an empty box) and pixel counts of ``boxes`` (see
-    :func:`box_sums`)."""
-    total, count = box_sums(table, boxes)
-    return total / np.maximum(count, 1), count

@@ -19,7 +19,9 @@ the three documents outputs a lens. For each candidate lens ``(x, y, r)`` the fi
 4. **scores** the refined box by its contrast, clipped to [0, 1].
 
 Every box sum is four look-ups in one integral image of the frame (:mod:`.boxes`), and all
-hypotheses of all candidates are scored in one vectorised pass.
+hypotheses of all candidates are scored in one compiled pass (:func:`score_layouts`; each
+value computed by the same float64 operations, in the same order, as the NumPy form before it:
+``tests/test_housing_oracle.py`` compares them).
 """
 
 from __future__ import annotations
@@ -27,8 +29,9 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
+from numba import njit
 
-from tsrkit_plugins.housing.boxes import box_means, box_sums, integral
+from tsrkit_plugins.housing.boxes import box_mean, box_sum, integral
 from tsrkit_plugins.housing.lens import measure_lenses
 
 #: Lens counts of the heads searched.
@@ -53,6 +56,8 @@ REFINE = 0.5
 REFINE_ALONG = 3.2
 #: Offsets tried per edge, evenly over its range.
 REFINE_STEPS = 13
+#: Those offsets, in units of the range.
+STEPS = np.linspace(-1.0, 1.0, REFINE_STEPS)
 #: Width of the band outside the box and of the edge strips, in lens radii (at least 1 px).
 BAND = 0.6
 #: Shortest head after refinement, in housing widths: the shortest layout searched (three lenses
@@ -77,21 +82,72 @@ LAYOUTS = np.array(
 COARSE = LAYOUTS[(LAYOUTS[:, 3] == 2.8) & (LAYOUTS[:, 4] == 0.8)]
 
 
-def grow(boxes: np.ndarray, margin: np.ndarray) -> np.ndarray:
-    """``boxes`` widened by ``margin`` on every side."""
-    m = np.asarray(margin)[..., None]
-    return boxes + np.concatenate([-m, -m, m, m], axis=-1)
+@njit(cache=True, nogil=True, inline="always")
+def box_contrast(
+    table: np.ndarray,
+    box: tuple[float, float, float, float],
+    lens: tuple[np.int32, float],
+    band: float,
+) -> float:
+    """``(outside - inside) / outside`` of ``box``: inside without the lens (its sum and pixel
+    count, ``lens``), outside a ``band`` wide frame around the box."""
+    x0, y0, x1, y1 = box
+    inner, inner_n = box_sum(table, x0, y0, x1, y1)
+    outer, outer_n = box_sum(table, x0 - band, y0 - band, x1 + band, y1 + band)
+    inside = (inner - lens[0]) / max(inner_n - lens[1], 1.0)
+    outside = (outer - inner) / max(outer_n - inner_n, 1.0)
+    return (outside - inside) / max(outside, 1.0)
 
 
-def contrast(table: np.ndarray, boxes: np.ndarray, lens: np.ndarray, band: np.ndarray):
-    """``(outside - inside) / outside`` of each box: inside without the lens square, outside a
-    ``band`` wide frame around the box (``lens`` and ``band`` broadcast against ``boxes``)."""
-    inner, inner_n = box_sums(table, boxes)
-    lens_sum, lens_n = box_sums(table, lens)
-    outer, outer_n = box_sums(table, grow(boxes, band))
-    inside = (inner - lens_sum) / np.maximum(inner_n - lens_n, 1)
-    outside = (outer - inner) / np.maximum(outer_n - inner_n, 1)
-    return (outside - inside) / np.maximum(outside, 1.0)
+@njit(cache=True, nogil=True)
+def contrasts(table: np.ndarray, boxes: np.ndarray, lens: np.ndarray, band: np.ndarray):
+    """:func:`box_contrast` of each box of ``boxes`` (N, 4) with its ``lens`` box (N, 4) and
+    ``band`` (N,)."""
+    out = np.empty(len(boxes))
+    for i in range(len(boxes)):
+        box = (boxes[i, 0], boxes[i, 1], boxes[i, 2], boxes[i, 3])
+        around = box_sum(table, lens[i, 0], lens[i, 1], lens[i, 2], lens[i, 3])
+        out[i] = box_contrast(table, box, around, band[i])
+    return out
+
+
+@njit(cache=True, nogil=True, inline="always")
+def layout_box(
+    x: float, y: float, r: float, layout: np.ndarray
+) -> tuple[float, float, float, float]:
+    """The housing box of one ``layout`` (a row of :data:`LAYOUTS`) around the lens
+    ``(x, y, r)``, as :func:`layout_boxes` computes it."""
+    vertical, lenses, lit, width, pitch = layout[0], layout[1], layout[2], layout[3], layout[4]
+    half = width * r / 2
+    step = pitch * width * r
+    start = -(lit + 0.5) * step
+    end = start + lenses * step
+    if vertical != 0:
+        return x - half, y + start, x + half, y + end
+    return x + start, y - half, x + end, y + half
+
+
+@njit(cache=True, nogil=True)
+def score_layouts(
+    table: np.ndarray,
+    lenses: np.ndarray,
+    layouts: np.ndarray,
+    group: np.ndarray,
+    best: np.ndarray,
+    score: np.ndarray,
+) -> None:
+    """For each hypothesis ``i``, a lens ``lenses[i]`` (x, y, radius), the layout of
+    ``layouts[group[i]]`` (G, L, 5) whose box scores the best contrast (the first of equals):
+    its index into ``best[i]``, its contrast into ``score[i]``."""
+    for i in range(len(lenses)):
+        x, y, r = lenses[i, 0], lenses[i, 1], lenses[i, 2]
+        lens = box_sum(table, x - r, y - r, x + r, y + r)  # the same for every layout
+        band = max(BAND * r, 1.0)
+        rows = layouts[group[i]]
+        for k in range(rows.shape[0]):
+            value = box_contrast(table, layout_box(x, y, r, rows[k]), lens, band)
+            if k == 0 or value > score[i]:
+                best[i], score[i] = k, value
 
 
 def layout_boxes(x, y, r, layouts: np.ndarray) -> np.ndarray:
@@ -116,31 +172,46 @@ def layout_boxes(x, y, r, layouts: np.ndarray) -> np.ndarray:
     )
 
 
+@njit(cache=True, nogil=True, inline="always")
+def strip_mean(
+    table: np.ndarray, axis: int, edge: float, shift: float, low: float, high: float
+) -> float:
+    """The mean of the strip between ``edge`` and ``edge + shift`` across ``axis`` (0: x) and
+    from ``low`` to ``high`` along it."""
+    a, b = min(edge, edge + shift), max(edge, edge + shift)
+    if axis == 0:
+        return box_mean(table, a, low, b, high)
+    return box_mean(table, low, a, high, b)
+
+
+@njit(cache=True, nogil=True)
+def refine_edges(table: np.ndarray, boxes: np.ndarray, r: np.ndarray, out: np.ndarray) -> None:
+    """:func:`refine` into ``out`` (N, 4): for each side of each box the first of the
+    :data:`REFINE_STEPS` offsets where the outer strip's mean is most above the inner one's."""
+    for i in range(len(boxes)):
+        width = max(BAND * r[i], 1.0)
+        vertical = (boxes[i, 3] - boxes[i, 1]) >= (boxes[i, 2] - boxes[i, 0])
+        for side in range(4):
+            axis = side % 2  # 0: the edge is an x coordinate, 1: a y coordinate
+            along = vertical if axis == 1 else not vertical
+            reach = (REFINE_ALONG if along else REFINE) * r[i]
+            outward = -width if side < 2 else width
+            low, high = boxes[i, 1 - axis], boxes[i, 3 - axis]
+            best = 0.0
+            for k in range(REFINE_STEPS):
+                edge = boxes[i, side] + STEPS[k] * reach
+                outside = strip_mean(table, axis, edge, outward, low, high)
+                gain = outside - strip_mean(table, axis, edge, -outward, low, high)
+                if k == 0 or gain > best:
+                    best, out[i, side] = gain, edge
+
+
 def refine(table: np.ndarray, boxes: np.ndarray, r: np.ndarray) -> np.ndarray:
     """Move each edge of ``boxes`` (N, 4) within ``+-REFINE r`` (the ends: ``+-REFINE_ALONG r``)
     to where the strip outside it is brightest against the strip inside it (sides: 0 left,
-    1 top, 2 right, 3 bottom)."""
-    steps = np.linspace(-1.0, 1.0, REFINE_STEPS)
-    width = np.maximum(BAND * r, 1.0)[:, None]
-    rows = np.arange(len(boxes))
-    vertical = (boxes[:, 3] - boxes[:, 1]) >= (boxes[:, 2] - boxes[:, 0])
-    out = boxes.copy()
-    for side in range(4):
-        along = vertical if side % 2 == 1 else ~vertical
-        reach = np.where(along, REFINE_ALONG, REFINE) * r
-        edge = boxes[:, side][:, None] + steps[None, :] * reach[:, None]  # (N, S)
-        outward = -1.0 if side < 2 else 1.0
-        axis = side % 2  # 0: the edge is an x coordinate, 1: a y coordinate
-        span = boxes[:, [1 - axis, 3 - axis]]  # the box's extent along the edge
-        strips = []
-        for direction in (outward, -outward):  # the strip outside, then the one inside
-            a, b = edge, edge + direction * width
-            strip = np.empty(edge.shape + (4,))
-            strip[..., axis], strip[..., axis + 2] = np.minimum(a, b), np.maximum(a, b)
-            strip[..., 1 - axis] = span[:, None, 0]
-            strip[..., 3 - axis] = span[:, None, 1]
-            strips.append(box_means(table, strip)[0])
-        out[:, side] = edge[rows, np.argmax(strips[0] - strips[1], axis=1)]
+    1 top, 2 right, 3 bottom; compiled: :func:`refine_edges`)."""
+    out = np.empty_like(boxes)
+    refine_edges(table, np.ascontiguousarray(boxes, np.float64), r.astype(np.float64), out)
     return out
 
 
@@ -180,21 +251,21 @@ def best_layouts(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The best-scoring box (N, 4) over every radius of ``options`` (N, K; NaN: unused, not
     computed) and ``layouts`` ((L, 5) for all candidates, or (N, L, 5) each its own), with the
-    radius and the layout row it used."""
+    radius and the layout row it used (scored by :func:`score_layouts`)."""
     owner, option = np.nonzero(~np.isnan(options))
     radii = options[owner, option]
-    xs, ys = x[owner], y[owner]
-    rows = layouts if layouts.ndim == 2 else layouts[owner]
-    boxes = layout_boxes(xs[:, None], ys[:, None], radii[:, None], rows)  # (M, L, 4)
-    lens = np.stack([xs - radii, ys - radii, xs + radii, ys + radii], axis=1)[:, None, :]
-    band = np.maximum(BAND * radii, 1.0)[:, None]
-    scores = contrast(table, boxes, lens, band)
-    best_layout = np.argmax(scores, axis=1)
-    best_score = scores[np.arange(len(owner)), best_layout]
+    shared = layouts.ndim == 2
+    grouped = np.ascontiguousarray(layouts[None] if shared else layouts, np.float64)
+    group = np.zeros_like(owner) if shared else owner
+    best_layout = np.empty(len(owner), np.int64)
+    best_score = np.empty(len(owner))
+    lenses = np.column_stack([x[owner], y[owner], radii])
+    score_layouts(table, lenses, grouped, group, best_layout, best_score)
     order = np.lexsort((-best_score, owner))  # per owner, its best hypothesis first
     first = order[np.r_[True, owner[order][1:] != owner[order][:-1]]]
-    chosen = rows[best_layout[first]] if rows.ndim == 2 else rows[first, best_layout[first]]
-    return boxes[first, best_layout[first]], radii[first], chosen
+    chosen = grouped[group[first], best_layout[first]]
+    boxes = layout_boxes(x[owner[first]], y[owner[first]], radii[first], chosen)
+    return boxes, radii[first], chosen
 
 
 def head_variants(heads: np.ndarray) -> np.ndarray:
@@ -222,5 +293,5 @@ def fit_housings(
     refined = keep_long(refine(table, searched, chosen), searched)
     refined[:, :2] = np.minimum(refined[:, :2], lens[:, :2])
     refined[:, 2:] = np.maximum(refined[:, 2:], lens[:, 2:])
-    final = contrast(table, refined, lens, np.maximum(BAND * chosen, 1.0))
+    final = contrasts(table, refined, lens, np.maximum(BAND * chosen, 1.0))
     return refined, np.clip(final, 0.0, 1.0), np.stack([x, y, chosen], axis=1)

@@ -13,14 +13,16 @@ centre, and ``RADIUS_PER_HALF_SIDE x s`` as the radius (a lit disc's contrast pe
 ``s`` about 0.8 of its radius, calibrated on rendered heads). A candidate with no square above
 :data:`MIN_CONTRAST` keeps its own lens.
 
-Every mean is four look-ups in the frame's integral image, all candidates at once.
+Every mean is four look-ups in the frame's integral image, all candidates in one compiled pass
+(:func:`best_squares`: the float64 operations of the NumPy form before it, in its order).
 """
 
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
-from tsrkit_plugins.housing.boxes import box_means
+from tsrkit_plugins.housing.boxes import box_sum
 
 #: Half-sides (px) of the squares tried.
 SCALES = np.array([1.0, 1.4, 2.0, 2.8, 4.0, 5.6, 8.0, 11.0, 16.0, 22.0, 32.0])
@@ -34,28 +36,51 @@ MIN_CONTRAST = 0.5
 FLOOR = 8.0
 
 
+@njit(cache=True, nogil=True, inline="always")
+def square_mean(table: np.ndarray, x: float, y: float, half: float) -> tuple[float, float]:
+    """Mean grey level (0 when empty) and pixel count of the square of half-side ``half``
+    around ``(x, y)``."""
+    total, count = box_sum(table, x - half, y - half, x + half, y + half)
+    return total / max(count, 1.0), count
+
+
+@njit(cache=True, nogil=True)
+def best_squares(
+    table: np.ndarray, x: np.ndarray, y: np.ndarray, best: np.ndarray, contrast: np.ndarray
+) -> None:
+    """For each candidate centre ``(x[i], y[i])``, the square (index ``scale * len(OFFSETS) +
+    offset`` into ``best[i]``) of the highest centre-surround contrast (into ``contrast[i]``;
+    the first of equals)."""
+    for i in range(len(x)):
+        for s in range(len(SCALES)):
+            half = SCALES[s]
+            for o in range(len(OFFSETS)):
+                cx = x[i] + OFFSETS[o, 0] * half
+                cy = y[i] + OFFSETS[o, 1] * half
+                inner, inner_n = square_mean(table, cx, cy, half)
+                outer, outer_n = square_mean(table, cx, cy, 2 * half)
+                ring = (outer * outer_n - inner * inner_n) / max(outer_n - inner_n, 1.0)
+                value = (inner - ring) / max(ring, FLOOR)
+                k = s * len(OFFSETS) + o
+                if k == 0 or value > contrast[i]:
+                    best[i], contrast[i] = k, value
+
+
 def measure_lenses(
     table: np.ndarray, x: np.ndarray, y: np.ndarray, r: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The lit lens around each candidate lens ``(x, y, r)`` (arrays of N) in the grey frame
     whose integral image is ``table``: centres, radii and whether a lit lens was found (N,);
     where none was, the candidate's own lens is returned."""
-    half = SCALES[None, :, None]  # (1, S, 1)
-    cx = x[:, None, None] + OFFSETS[None, None, :, 0] * half  # (N, S, O)
-    cy = y[:, None, None] + OFFSETS[None, None, :, 1] * half
-    inner, inner_n = box_means(table, np.stack([cx - half, cy - half, cx + half, cy + half], -1))
-    outer, outer_n = box_means(
-        table, np.stack([cx - 2 * half, cy - 2 * half, cx + 2 * half, cy + 2 * half], -1)
-    )
-    ring = (outer * outer_n - inner * inner_n) / np.maximum(outer_n - inner_n, 1)
-    contrast = ((inner - ring) / np.maximum(ring, FLOOR)).reshape(len(x), -1)
-    best = np.argmax(contrast, axis=1)
-    rows = np.arange(len(x))
-    found = contrast[rows, best] >= MIN_CONTRAST
-    scale, offset = np.unravel_index(best, cx.shape[1:])
+    best = np.empty(len(x), np.int64)
+    contrast = np.empty(len(x))
+    best_squares(table, x, y, best, contrast)
+    found = contrast >= MIN_CONTRAST
+    scale, offset = np.divmod(best, len(OFFSETS))
+    half = SCALES[scale]
     return (
-        np.where(found, cx[rows, scale, offset], x),
-        np.where(found, cy[rows, scale, offset], y),
-        np.where(found, RADIUS_PER_HALF_SIDE * SCALES[scale], r),
+        np.where(found, x + OFFSETS[offset, 0] * half, x),
+        np.where(found, y + OFFSETS[offset, 1] * half, y),
+        np.where(found, RADIUS_PER_HALF_SIDE * half, r),
         found,
     )

@@ -13,9 +13,11 @@ from collections.abc import Sequence
 
 import cv2
 import numpy as np
+from numba import njit
 from skimage.feature._hoghistogram import hog_histograms
 
 from tsrkit.types import Candidate
+from tsrkit_plugins.verifiers.reductions import pairwise_sum
 
 #: Side of the lens context, in lens radii (lens disk: 1 radius, annulus 1-2, surround 2-3).
 CONTEXT = 6.0
@@ -86,28 +88,40 @@ def context_boxes(table: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 REMAP_ROW = 32000
 
 
+@njit(cache=True, nogil=True)
+def fill_maps(
+    boxes: np.ndarray, width: int, height: int, upright: bool, map_x: np.ndarray, map_y: np.ndarray
+) -> None:
+    """:func:`box_maps` into ``map_x`` and ``map_y`` (N, height, width), in float32 as numpy
+    computes them on float32 arrays: ``x0 + u * (x1 - x0) / width - 0.5``, left to right."""
+    w, h, half = np.float32(width), np.float32(height), np.float32(0.5)
+    for i in range(len(boxes)):
+        x0, y0, x1, y1 = boxes[i, 0], boxes[i, 1], boxes[i, 2], boxes[i, 3]
+        wide = upright and x1 - x0 > y1 - y0
+        for row in range(height):
+            v = np.float32(row) + half
+            for col in range(width):
+                u = np.float32(col) + half
+                if wide:
+                    map_x[i, row, col] = x0 + v * (x1 - x0) / h - half
+                    map_y[i, row, col] = y0 + u * (y1 - y0) / w - half
+                else:
+                    map_x[i, row, col] = x0 + u * (x1 - x0) / w - half
+                    map_y[i, row, col] = y0 + v * (y1 - y0) / h - half
+
+
 def box_maps(
     boxes: np.ndarray, size: tuple[int, int], upright: bool = False
 ) -> tuple[np.ndarray, np.ndarray]:
-    """The sample points (x, y), flat float32, of every box of ``boxes`` at ``size`` (width,
-    height), box after box, row by row: pixel centres of the box scaled to ``size``. With
-    ``upright``, a box wider than tall is read transposed, so its long side runs down."""
+    """The sample points (x, y), flat float32, of every box of ``boxes`` (float32) at ``size``
+    (width, height), box after box, row by row: pixel centres of the box scaled to ``size``
+    (one compiled pass, :func:`fill_maps`). With ``upright``, a box wider than tall is read
+    transposed, so its long side runs down."""
     width, height = size
-    x0, y0, x1, y1 = (boxes[:, k, None, None] for k in range(4))
-    # a column's x and a row's y, computed once per box and spread over the sample
-    u = np.arange(width, dtype=np.float32)[None, None, :] + 0.5
-    v = np.arange(height, dtype=np.float32)[None, :, None] + 0.5
-    map_x = x0 + u * (x1 - x0) / width - 0.5
-    map_y = y0 + v * (y1 - y0) / height - 0.5
-    if upright:
-        wide = (boxes[:, 2] - boxes[:, 0] > boxes[:, 3] - boxes[:, 1])[:, None, None]
-        map_x = np.where(wide, x0 + v * (x1 - x0) / height - 0.5, map_x)
-        map_y = np.where(wide, y0 + u * (y1 - y0) / width - 0.5, map_y)
-    shape = (len(boxes), height, width)
-    return (
-        np.broadcast_to(map_x, shape).astype(np.float32).ravel(),
-        np.broadcast_to(map_y, shape).astype(np.float32).ravel(),
-    )
+    map_x = np.empty((len(boxes), height, width), np.float32)
+    map_y = np.empty_like(map_x)
+    fill_maps(np.ascontiguousarray(boxes, np.float32), width, height, upright, map_x, map_y)
+    return map_x.ravel(), map_y.ravel()
 
 
 def remap_points(image: np.ndarray, map_x: np.ndarray, map_y: np.ndarray) -> np.ndarray:
@@ -189,45 +203,64 @@ def stacked_hog(lightness: np.ndarray, rows: int) -> np.ndarray:
     return blocks.reshape(n, -1)
 
 
-#: Cosine and sine of every OpenCV 8-bit hue (0-179, 2 degrees a step).
-_HUE_COS = np.cos(np.arange(180) * (np.pi / 90.0)).astype(np.float32)
-_HUE_SIN = np.sin(np.arange(180) * (np.pi / 90.0)).astype(np.float32)
+#: Cosine and sine of every OpenCV 8-bit hue (0-179, 2 degrees a step; 0 past 179, where
+#: OpenCV puts no hue).
+_HUE_COS = np.zeros(256, np.float32)
+_HUE_SIN = np.zeros(256, np.float32)
+_HUE_COS[:180] = np.cos(np.arange(180) * (np.pi / 90.0))
+_HUE_SIN[:180] = np.sin(np.arange(180) * (np.pi / 90.0))
 
 
-def colour_planes(*patches: np.ndarray) -> list[np.ndarray]:
-    """Per-pixel L, a, b, S, V, saturation-weighted hue cosine and sine, and chroma of each
-    BGR stack in ``patches`` (one Lab and one HSV conversion for all of them).
+@njit(cache=True, nogil=True)
+def fill_planes(lab: np.ndarray, hsv: np.ndarray, out: np.ndarray) -> None:
+    """The :data:`COLOUR_NAMES` planes of the 8-bit ``lab`` and ``hsv`` pixels (P, 3) of a
+    (K, N, 8) ``out``'s N samples of K pixels each, sample after sample, into ``out`` pixel
+    after pixel, sample inside; every value in float32 as numpy computes it on float32 arrays
+    (the saturation a float32 quotient by 255, the chroma the float32 root of a float32
+    ``a * a + b * b``)."""
+    pixels, samples = out.shape[0], out.shape[1]
+    for i in range(samples):
+        for p in range(pixels):
+            at = i * pixels + p
+            a = np.float32(lab[at, 1]) - np.float32(128.0)
+            b = np.float32(lab[at, 2]) - np.float32(128.0)
+            saturation = np.float32(hsv[at, 1]) / np.float32(255.0)
+            row = out[p, i]
+            row[0], row[1], row[2] = lab[at, 0], lab[at, 1], lab[at, 2]
+            row[3], row[4] = hsv[at, 1], hsv[at, 2]
+            row[5] = _HUE_COS[hsv[at, 0]] * saturation
+            row[6] = _HUE_SIN[hsv[at, 0]] * saturation
+            row[7] = np.sqrt(a * a + b * b)
+
+
+def colour_planes(points: np.ndarray, samples: int, sizes: Sequence[int]) -> list[np.ndarray]:
+    """Per-pixel L, a, b, S, V, saturation-weighted hue cosine and sine, and chroma of BGR
+    ``points`` (P, 3): one block per entry ``K`` of ``sizes``, of ``samples`` samples of ``K``
+    pixels each, sample after sample (one Lab and one HSV conversion for all of them, the
+    planes by :func:`fill_planes`).
 
     Returns
     -------
     list of ndarray
-        One float32 array per input, shaped like it with 8 channels (:data:`COLOUR_NAMES`).
+        One float32 (K, ``samples``, 8) array per block, pixel after pixel with the samples
+        inside (:data:`COLOUR_NAMES`).
     """
-    flat = np.concatenate([p.reshape(-1, 3) for p in patches])[None]  # one row: fastest
-    lab = cv2.cvtColor(flat, cv2.COLOR_BGR2LAB)[0].T.astype(np.float32)
-    hsv = cv2.cvtColor(flat, cv2.COLOR_BGR2HSV)[0].T
-    hue, saturation = hsv[0], hsv[1].astype(np.float32) / 255.0
-    a, b = lab[1] - 128.0, lab[2] - 128.0
-    planes = np.stack(
-        [
-            *lab,
-            hsv[1].astype(np.float32),
-            hsv[2].astype(np.float32),
-            _HUE_COS[hue] * saturation,
-            _HUE_SIN[hue] * saturation,
-            np.sqrt(a * a + b * b),
-        ],
-        axis=-1,
-    )
-    ends = np.cumsum([0] + [p.size // 3 for p in patches])
-    return [
-        planes[start:end].reshape(*p.shape[:-1], len(COLOUR_NAMES))
-        for p, start, end in zip(patches, ends[:-1], ends[1:])
-    ]
+    row = np.ascontiguousarray(points, np.uint8)[None]  # one row: fastest
+    lab = cv2.cvtColor(row, cv2.COLOR_BGR2LAB)[0]
+    hsv = cv2.cvtColor(row, cv2.COLOR_BGR2HSV)[0]
+    out = []
+    start = 0
+    for size in sizes:
+        planes = np.empty((size, samples, len(COLOUR_NAMES)), np.float32)
+        end = start + size * samples
+        fill_planes(lab[start:end], hsv[start:end], planes)
+        out.append(planes)
+        start = end
+    return out
 
 
 #: The pixels of each of :data:`RING_MASKS`, as flat indices into the lens context (row-major).
-RING_AT = [np.flatnonzero(m) for m in RING_MASKS]
+RING_AT = tuple(np.flatnonzero(m) for m in RING_MASKS)
 
 
 def row_percentile(values: np.ndarray, q: float) -> np.ndarray:
@@ -253,41 +286,79 @@ def row_percentile(values: np.ndarray, q: float) -> np.ndarray:
     return b - (b - a) * kind(1 - t) if t >= 0.5 else a + (b - a) * kind(t)
 
 
+@njit(cache=True, nogil=True)
+def deviation(values: np.ndarray, pairwise: bool) -> np.float32:
+    """The float32 standard deviation of ``values`` as numpy's ``std`` takes it along an axis:
+    the mean, the squared deviations and their mean, each sum :func:`pairwise_sum` where numpy
+    reduces a contiguous run (``pairwise``), else one value after the other."""
+    n = np.float32(len(values))
+    if pairwise:
+        mean = pairwise_sum(values) / n
+        squares = (values - mean) * (values - mean)
+        return np.sqrt(pairwise_sum(squares) / n)
+    total = np.float32(0.0)
+    for v in values:
+        total += v
+    mean = total / n
+    total = np.float32(0.0)
+    for v in values:
+        total += (v - mean) * (v - mean)
+    return np.sqrt(total / n)
+
+
+@njit(cache=True, nogil=True)
+def pixel_means(planes: np.ndarray, at: np.ndarray) -> np.ndarray:
+    """The (N, 8) float32 mean over the pixels ``at`` of ``planes`` (pixels, N, 8), adding them
+    one after the other as numpy adds along an outer axis (whole rows of candidates)."""
+    total = np.zeros(planes.shape[1:], np.float32)
+    for p in at:
+        total += planes[p]
+    return total / np.float32(len(at))
+
+
+@njit(cache=True, nogil=True)
+def fill_colour(lens: np.ndarray, housing: np.ndarray, rings: tuple, out: np.ndarray) -> None:
+    """:func:`colour_features` into ``out`` (N, 42), but for the housing's lower-quartile
+    lightness (column 36): each value by numpy's float operations in numpy's order (see there).
+    """
+    for k, at in enumerate(rings):
+        out[:, 8 * k : 8 * k + 8] = pixel_means(lens, at)
+    out[:, 27:35] = pixel_means(housing, np.arange(housing.shape[0]))
+    disk = rings[0]
+    for i in range(lens.shape[1]):
+        light = lens[disk, i, 0].copy()
+        out[i, 24] = light.max()
+        # one candidate: numpy reduces the lone column as a contiguous run (pairwise)
+        out[i, 25] = deviation(light, lens.shape[1] == 1)
+        out[i, 26] = np.count_nonzero(lens[disk, i, 4] > 240) / len(disk)
+        out[i, 35] = deviation(housing[:, i, 0].copy(), True)
+        out[i, 37] = np.count_nonzero(housing[:, i, 4] < 60) / housing.shape[0]
+        lens_mean_l = out[i, 0] + np.float32(1.0)
+        out[i, 38] = out[i, 0] - out[i, 8]
+        out[i, 39] = out[i, 0] - out[i, 16]
+        out[i, 40] = (out[i, 16] + np.float32(1.0)) / lens_mean_l
+        # the housing's mean lightness is a float64 column there: float64 arithmetic
+        out[i, 41] = (np.float64(out[i, 27]) + 1.0) / np.float64(lens_mean_l)
+
+
 def colour_features(lens: np.ndarray, housing: np.ndarray) -> np.ndarray:
     """Lab / HSV statistics of lens, annulus, surround and housing, and surround darkness.
 
     ``lens`` (256, N, 8) and ``housing`` (264, N, 8) are :func:`colour_planes` of the samples,
-    pixel after pixel (row-major in the 16 x 16 and 22 x 12 samples), candidate inside. A mean
-    over the pixels adds whole rows of candidates pixel after pixel (numpy adds along an outer
-    axis in order): the sums of the patch-by-patch layout, in a fraction of its time. The
-    lightness deviations are taken on the memory layouts the patch-by-patch computation had
-    (lens: candidate innermost; housing: a row per candidate, summed pairwise by numpy), so
-    every value is the same to the bit (``tests/test_verifier_features_oracle.py``). Hue
-    enters as its cosine and sine weighted by saturation, so red near 0 and 180 is one colour.
+    pixel after pixel (row-major in the 16 x 16 and 22 x 12 samples), candidate inside. The
+    values are those of numpy's means, deviations and shares over the pixels (the
+    patch-by-patch computation before it), to the bit (``tests/test_verifier_features_oracle.py``),
+    in one compiled pass (:func:`fill_colour`): a mean over the pixels adds them one after the
+    other, as numpy adds along an outer axis; the lightness deviations follow numpy's
+    reductions of the layouts the patch-by-patch computation had (lens: candidate innermost,
+    so pixel after pixel, but pairwise for a single candidate; housing: a row per candidate,
+    summed pairwise). Hue enters as its cosine and sine weighted by saturation, so red near 0
+    and 180 is one colour.
     """
-    rings = [lens[at].mean(axis=0) for at in RING_AT]
-    lens_l = np.ascontiguousarray(lens[RING_AT[0], :, 0])
-    lens_v = lens[RING_AT[0], :, 4]
-    peak = np.column_stack([lens_l.max(axis=0), lens_l.std(axis=0), (lens_v > 240).mean(axis=0)])
-    light = np.ascontiguousarray(housing[:, :, 0].T)
-    house_stats = np.column_stack(
-        [
-            housing.mean(axis=0),
-            light.std(axis=1),
-            row_percentile(light, 25),
-            (housing[:, :, 4] < 60).mean(axis=0),
-        ]
-    )
-    lens_mean_l = rings[0][:, 0] + 1.0
-    darkness = np.column_stack(
-        [
-            rings[0][:, 0] - rings[1][:, 0],
-            rings[0][:, 0] - rings[2][:, 0],
-            (rings[2][:, 0] + 1.0) / lens_mean_l,
-            (house_stats[:, 0] + 1.0) / lens_mean_l,
-        ]
-    )
-    return np.column_stack([*rings, peak, house_stats, darkness]).astype(np.float32)
+    out = np.empty((lens.shape[1], 42), np.float32)
+    fill_colour(lens, housing, RING_AT, out)
+    out[:, 36] = row_percentile(np.ascontiguousarray(housing[:, :, 0].T), 25)
+    return out
 
 
 def geometry_features(table: np.ndarray, boxes: np.ndarray, width: int, height: int) -> np.ndarray:
@@ -343,10 +414,7 @@ def candidate_features(image: np.ndarray, candidates: Sequence[Candidate]) -> np
     points = remap_points(
         image, np.concatenate([lens_x, house_x]), np.concatenate([lens_y, house_y])
     )
-    lens, housing = colour_planes(
-        points[: len(lens_x)].reshape(n, -1, 3).transpose(1, 0, 2),
-        points[len(lens_x) :].reshape(n, -1, 3).transpose(1, 0, 2),
-    )
+    lens, housing = colour_planes(points, n, (LENS_PX * LENS_PX, HOUSING_PX[0] * HOUSING_PX[1]))
     height, width = image.shape[:2]
     return np.column_stack(
         [
