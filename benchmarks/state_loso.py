@@ -15,11 +15,13 @@ ab-hist there is the shipped model, trained on MIT train. lamp-state's red+amber
 (``red_yellow_ratio``, on housings and on boxes taller than wide too square to be read as
 housings, as its ``classify`` reads them) and its red prior (``red_prior``) apply to all three.
 
-    python benchmarks/state_loso.py [--seed N]
+    python benchmarks/state_loso.py [--seed N] [--colour-weight W]
 
 ``--seed`` (default 0, the shipped model's) seeds the colour jitter of the training copies and
 the boosting: a change of lamp-state's outputs is judged against the spread of several seeds,
 as one light can move a set's figures.
+``--colour-weight`` sets lamp-state's ``colour_weight`` (its colour model's share; 0 reads the
+full model alone, as before the colour model).
 """
 
 from __future__ import annotations
@@ -42,8 +44,10 @@ from tsrkit.types import Candidate, Dataset  # noqa: E402
 from tsrkit_plugins.classifiers.lamp_state import (  # noqa: E402
     STATES,
     blend,
+    fit_colour,
     fit_estimator,
     labelled_features,
+    learned_probability,
     prefer_red,
     red_yellow,
 )
@@ -145,11 +149,31 @@ def read(probability: np.ndarray, states: list[str], rule: np.ndarray, params) -
     return [STATES[i] for i in np.argmax(table, axis=1)]
 
 
+def learned(train: list[tuple[np.ndarray, np.ndarray]], x: np.ndarray, params):
+    """lamp-state's probabilities of ``x`` (red prior applied) by the full and the colour model
+    fitted on the ``train`` parts, and the states they know."""
+    features = np.concatenate([t[0] for t in train])
+    labels = np.concatenate([t[1] for t in train])
+    estimator, states = fit_estimator(features, labels, params)
+    colour = fit_colour(features, labels, params)
+    probability = learned_probability(estimator, colour, x, params["colour_weight"])
+    return prefer_red(probability, states, params["red_prior"]), states
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seed", type=int, default=0, help="jitter and boosting seed")
+    parser.add_argument(
+        "--colour-weight",
+        type=float,
+        default=None,
+        help="lamp-state's colour_weight (default: its own)",
+    )
     args = parser.parse_args()
-    params = get_registry().create("classifier", "lamp-state", {"seed": args.seed}).params
+    chosen = {"seed": args.seed}
+    if args.colour_weight is not None:
+        chosen["colour_weight"] = args.colour_weight
+    params = get_registry().create("classifier", "lamp-state", chosen).params
     data = parts()
     copies = params["copies"]
     features = {
@@ -171,22 +195,13 @@ def main() -> None:
             x, y = features[(group, key)]
             rule = rule_rows(dataset, x)
             others = [features[(g, "train")] for g in data if g != group]
-            loso, states = fit_estimator(
-                np.concatenate([o[0] for o in others]),
-                np.concatenate([o[1] for o in others]),
-                params,
-            )
-            probability = prefer_red(loso.predict_proba(x), states, params["red_prior"])
+            probability, states = learned(others, x, params)
             predicted = read(probability, states, rule, params)
             row = {"set": key, "n": len(y), "loso": scores(y, predicted)[:2]}
             if "own" in sets and key.endswith("test"):
-                train = others + [features[(group, "own")]]
-                own, own_states = fit_estimator(
-                    np.concatenate([o[0] for o in train]),
-                    np.concatenate([o[1] for o in train]),
-                    params,
+                own_probability, own_states = learned(
+                    others + [features[(group, "own")]], x, params
                 )
-                own_probability = prefer_red(own.predict_proba(x), own_states, params["red_prior"])
                 found = read(own_probability, own_states, rule, params)
                 row["in-domain"] = scores(y, found)[:2]
             for name in ("ab-hist", "hsi-backprojection"):

@@ -15,6 +15,7 @@ import numpy as np
 
 from tsrkit.geometry import clip_box
 from tsrkit_plugins.classifiers.lamp_state import STATES, blend, prefer_red, red_yellow
+from tsrkit_plugins.classifiers.lamp_state.colour import COLOUR, mix
 from tsrkit_plugins.classifiers.lamp_state.features import (
     DISK,
     HALVE_FROM,
@@ -187,13 +188,16 @@ def lamp_features(image, candidates):
 
 def classify(classifier, frame, candidates):
     """``(state, state_scores)`` of each candidate as ``classifier`` (a lamp-state) read them
-    before: the old features, scikit-learn's ``predict_proba``, then the same fusion."""
+    before: the old features, scikit-learn's ``predict_proba`` (of the colour model too, mixed
+    in by ``colour_weight``), then the same fusion."""
     estimator = classifier.estimator
     features = lamp_features(frame.image, candidates)
     states = classifier._states
-    probability = prefer_red(
-        estimator.predict_proba(features), states, classifier.params["red_prior"]
-    )
+    probability = estimator.predict_proba(features)
+    if classifier._colour is not None:  # the colour model's share, by scikit-learn as well
+        colour = classifier._colour[0].predict_proba(features[:, COLOUR])
+        probability = mix(probability, colour, classifier.params["colour_weight"])
+    probability = prefer_red(probability, states, classifier.params["red_prior"])
     weight = classifier.params["ab_hist_weight"]
     known = set(states)
     other = np.zeros((len(candidates), len(STATES)))

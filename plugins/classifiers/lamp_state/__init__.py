@@ -13,6 +13,8 @@ read so too (:func:`~.features.red_amber_rows`).
 The classes are not reweighted, and the learned red probability counts ``red_prior`` times
 (:func:`prefer_red`): red is the most common state of every set and the costly one to miss, so
 a lamp whose colour sits between red and amber (orange-red LEDs, white cores) reads red.
+``colour_weight`` mixes in a second model learned from the lamp's CIELab colour alone
+(:mod:`.colour`: the full model's hue histograms let another camera's halo outweigh the core).
 ``ab_hist_weight`` mixes ab-hist's normalised scores into the learned probabilities (a late
 fusion, :func:`blend`; measured in ``benchmarks/RESULTS.state.md``).
 The model's trees are evaluated for all of a frame's candidates in one pass
@@ -37,6 +39,12 @@ from tsrkit.plugin import Classifier, Detector
 from tsrkit.registry import get_registry
 from tsrkit.types import Candidate, Detection, Frame, Sample
 from tsrkit_plugins.classifiers.ab_hist import AbHist
+from tsrkit_plugins.classifiers.lamp_state.colour import (
+    COLOUR,
+    COLOUR_ARRAY,
+    colour_columns,
+    mix,
+)
 from tsrkit_plugins.classifiers.lamp_state.features import (
     N_FEATURES,
     TWO_LIT,
@@ -162,6 +170,24 @@ def fit_estimator(
     return estimator, [STATES[i] for i in present]
 
 
+def fit_colour(features: np.ndarray, labels: np.ndarray, params) -> HistGradientBoostingClassifier:
+    """The colour model (:mod:`.colour`) of ``labels``: :func:`fit_estimator` on the lamp's
+    CIELab columns of ``features``."""
+    return fit_estimator(colour_columns(features), labels, params)[0]
+
+
+def learned_probability(
+    estimator: HistGradientBoostingClassifier,
+    colour: HistGradientBoostingClassifier,
+    features: np.ndarray,
+    weight: float,
+) -> np.ndarray:
+    """The full model's and the colour model's ``predict_proba`` of ``features`` mixed with
+    the colour model's ``weight`` (:func:`~.colour.mix`), as ``classify`` reads them."""
+    colour_probability = colour.predict_proba(colour_columns(features))
+    return mix(estimator.predict_proba(features), colour_probability, weight)
+
+
 class LampState(Classifier):
     """Lit-lamp colour, rim colour and position in the housing, gradient boosted."""
 
@@ -189,6 +215,15 @@ class LampState(Classifier):
             "response), for states that carry over to unseen cameras",
         ),
         Param("seed", "int", 0, min=0, help="training: seed of the jitter and the trees"),
+        Param(
+            "colour_weight",
+            "float",
+            0.3,
+            min=0.0,
+            max=1.0,
+            help="weight of the second model, learned from the lamp's CIELab colour alone (core "
+            "and rim), mixed with the full model's probabilities; 0 reads the full model alone",
+        ),
         Param(
             "ab_hist_weight",
             "float",
@@ -224,6 +259,7 @@ class LampState(Classifier):
         super().__init__(**params)
         self._estimator: HistGradientBoostingClassifier | None = None
         self._forest: Forest | None = None
+        self._colour: tuple[HistGradientBoostingClassifier, Forest] | None = None
         self._states: tuple[str, ...] = ()
         self._ab_hist: Classifier | None = None
 
@@ -253,8 +289,25 @@ class LampState(Classifier):
                     f"model {where}: {estimator.n_features_in_} features, this lamp-state "
                     f"reads {N_FEATURES}; retrain it (tsrkit train lamp-state)"
                 )
+            self._colour = self._colour_model(model, where, len(states))
             self._estimator, self._states = estimator, tuple(states)
         return self._estimator
+
+    @staticmethod
+    def _colour_model(
+        model: Model, where: str, states: int
+    ) -> tuple[HistGradientBoostingClassifier, Forest] | None:
+        """The colour model of ``model`` and its trees, or None when it holds none (a model
+        trained before it: the full model is read alone)."""
+        if COLOUR_ARRAY not in model.arrays:
+            return None
+        colour = load_estimator(model, where, classes=list(range(states)), name=COLOUR_ARRAY)
+        if colour.n_features_in_ != COLOUR.stop - COLOUR.start:
+            raise ModelError(
+                f"model {where}: its colour model reads {colour.n_features_in_} features, "
+                f"not the {COLOUR.stop - COLOUR.start} Lab means; retrain it"
+            )
+        return colour, Forest.of(colour, where, binary=False)
 
     @property
     def forest(self) -> Forest:
@@ -265,10 +318,16 @@ class LampState(Classifier):
         return self._forest
 
     def probability(self, features: np.ndarray) -> np.ndarray:
-        """The estimator's ``predict_proba`` of ``features``, to the bit: one pass over its
-        trees (:attr:`forest`), the sums turned into probabilities by the estimator's own
-        loss."""
-        return self.estimator._loss.predict_proba(self.forest.raw(features))
+        """The estimator's ``predict_proba`` of ``features`` mixed with its colour model's
+        (``colour_weight``, :func:`learned_probability`), to the bit: one pass over each
+        model's trees (:attr:`forest`), the sums turned into probabilities by the estimator's
+        own loss."""
+        full = self.estimator._loss.predict_proba(self.forest.raw(features))
+        weight = self.params["colour_weight"]
+        if self._colour is None or weight == 0:
+            return full
+        colour, trees = self._colour
+        return mix(full, colour._loss.predict_proba(trees.raw(colour_columns(features))), weight)
 
     def classify(self, frame: Frame, candidates: Sequence[Candidate]) -> list[Detection]:
         if not candidates:
@@ -300,7 +359,8 @@ class LampState(Classifier):
 
     def fit(self, samples: Iterable[Sample], *, detector: Detector | None = None) -> Model:
         """Learn the states of the annotated lights of ``samples`` and of ``copies``
-        colour-jittered views of each (deterministic for a given ``seed``).
+        colour-jittered views of each (deterministic for a given ``seed``): the full model and
+        the colour model (:mod:`.colour`), both from the same rows.
 
         Raises
         ------
@@ -316,8 +376,9 @@ class LampState(Classifier):
             )
         estimator, states = fit_estimator(features, labels, self.params)
         counts = np.bincount(np.searchsorted(present, labels), minlength=len(states))
+        colour = fit_colour(features, labels, self.params)
         return Model(
-            arrays=estimator_arrays(estimator),
+            arrays={**estimator_arrays(estimator), **estimator_arrays(colour, COLOUR_ARRAY)},
             info={
                 "layout": VERSION,
                 "states": states,
