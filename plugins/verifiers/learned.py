@@ -167,6 +167,16 @@ class LearnedVerifier(Verifier):
             "scale, colour, blur and exposure), whose candidates on a head are positives",
         ),
         Param(
+            "crop_frames",
+            "int",
+            0,
+            min=0,
+            max=10000,
+            help="training: synthetic 1280x720 no-light scenes with 5 real head crops each "
+            "(udacity_mit_tl_crops train, housing height 10-110 px, feathered edge: "
+            "pasting.py), whose candidates on a crop are positives; needs that dataset",
+        ),
+        Param(
             "augment_scales",
             "floats",
             (1.0,),
@@ -314,14 +324,16 @@ class LearnedVerifier(Verifier):
         ``augment_colour`` camera looks (:mod:`augment`). Every candidate is labelled by
         Zheng's centre rule; candidates of
         ``synthetic_frames`` no-light scenes are negatives, and those of ``head_frames`` scenes
-        with rendered lit heads are labelled by the heads' housings. The first round draws
+        with rendered lit heads and ``crop_frames`` scenes with pasted real heads
+        (:mod:`pasting`) are labelled by the heads' housings. The first round draws
         ``negative_ratio`` negatives per positive (seeded); each mining round adds as many of
         the remaining negatives the current model scores highest, and refits.
 
         Raises
         ------
         TsrkitError
-            No detector, or no positive or no negative candidate to learn from.
+            No detector, no positive or no negative candidate to learn from, or
+            ``crop_frames`` > 0 without the crop set.
         """
         if detector is None:
             raise TsrkitError("verifier: fit needs the detector whose candidates it verifies")
@@ -334,6 +346,7 @@ class LearnedVerifier(Verifier):
             self.params["synthetic_frames"],
             self.params["head_frames"],
             self._augmentation,
+            self.params["crop_frames"],
         )
         return self.fit_labelled(data)
 
