@@ -10,7 +10,7 @@ from tsrkit.errors import TsrkitError
 from tsrkit.models import load_model
 from tsrkit.registry import get_registry
 from tsrkit.training import train
-from tsrkit.types import Candidate, Sample
+from tsrkit.types import Annotation, Candidate, Sample
 from tsrkit_plugins.verifiers.mining import centre_labels
 from tsrkit_plugins.verifiers.pasting import (
     CROP_SET,
@@ -18,6 +18,7 @@ from tsrkit_plugins.verifiers.pasting import (
     crop_frames,
     crop_samples,
     feathered_alpha,
+    framed_scenes,
     paste,
     paste_crops,
     pasted_scenes,
@@ -118,3 +119,29 @@ def test_training_reads_the_pasted_scenes(shared_datasets, tmp_path):
     ]
     assert models[1].info["frames"] == models[0].info["frames"] + 2
     assert models[1].info["positives"] > models[0].info["positives"]
+
+
+def test_real_backgrounds_keep_their_boxes_and_take_crops_clear_of_them():
+    own = (100.0, 100.0, 130.0, 180.0)
+    backgrounds = [
+        Sample(
+            f"frame{k}",
+            (Annotation(own, "red"),),
+            416,
+            416,
+            "train",
+            image=np.zeros((416, 416, 3), np.uint8),
+        )
+        for k in range(2)
+    ]
+    scenes = list(framed_scenes(4, crops(), backgrounds, seed=5))
+    again = list(framed_scenes(4, crops(), backgrounds, seed=5))
+    assert [f.source.rsplit(":", 1)[1] for f, _ in scenes] == ["frame0"] * 2 + ["frame1"] * 2
+    for (frame, boxes), (same, boxes_again) in zip(scenes, again):
+        assert np.array_equal(frame.image, same.image) and boxes == boxes_again
+        assert boxes[0] == own and len(boxes) == 6
+        assert not frame.image[100:180, 100:130].any()  # the frame's own light is untouched
+        for x0, y0, x1, y1 in boxes[1:]:
+            assert 6 <= y1 - y0 <= 64  # heights scaled to the 416 px frame
+            assert x1 <= own[0] or own[2] <= x0 or y1 <= own[1] or own[3] <= y0
+    assert not backgrounds[0].image.any()  # pasted into a copy

@@ -177,6 +177,14 @@ class LearnedVerifier(Verifier):
             "pasting.py), whose candidates on a crop are positives; needs that dataset",
         ),
         Param(
+            "crop_backgrounds",
+            "str",
+            "synthetic",
+            choices=("synthetic", "real"),
+            help="training: what crop_frames paste into: synthetic daylight no-light scenes, "
+            "or the real training frames (spread evenly, clear of their boxes)",
+        ),
+        Param(
             "augment_scales",
             "floats",
             (1.0,),
@@ -347,6 +355,7 @@ class LearnedVerifier(Verifier):
             self.params["head_frames"],
             self._augmentation,
             self.params["crop_frames"],
+            self.params["crop_backgrounds"] == "real",
         )
         return self.fit_labelled(data)
 

@@ -151,14 +151,17 @@ def labelled_candidates(
     heads: int = 0,
     augmentation: Augmentation | None = None,
     crops: int = 0,
+    crops_on_real: bool = False,
 ) -> Labelled:
     """Run ``detector`` (then ``stage``) on every sample (on each of its ``augmentation``
     views: :mod:`augment`), on ``no_light`` synthetic frames (and their camera looks), on
     ``heads`` synthetic frames with rendered lit heads (:func:`head_frames`) and on ``crops``
     synthetic frames with pasted real heads (:func:`tsrkit_plugins.verifiers.pasting.crop_frames`,
-    whose crop set is read first); return every candidate's features, its Zheng label, its frame
-    index and its box label (:func:`box_labels`)."""
-    pasted = crop_frames(crops)
+    whose crop set is read first; ``crops_on_real``: pasted into the samples rather than into
+    synthetic scenes); return every candidate's features, its Zheng label, its frame index and its
+    box label (:func:`box_labels`)."""
+    samples = list(samples)
+    pasted = crop_frames(crops, samples if crops_on_real else ())
     parts = []
     views = augmentation or Augmentation()
     frames: Iterator[tuple[Frame, Sequence[Sequence[float]]]] = (

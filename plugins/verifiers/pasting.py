@@ -10,6 +10,7 @@ candidates on them are labelled as those of the training sets (Zheng's centre ru
 
 from __future__ import annotations
 
+import zlib
 from collections.abc import Iterator, Sequence
 
 import cv2
@@ -90,13 +91,17 @@ def place(
 
 
 def paste_crops(
-    image: np.ndarray, crops: Sequence[Sample], rng: np.random.Generator, count: int = PER_SCENE
+    image: np.ndarray,
+    crops: Sequence[Sample],
+    rng: np.random.Generator,
+    count: int = PER_SCENE,
+    taken: Sequence[Box] = (),
 ) -> list[Box]:
     """Paste ``count`` crops drawn from ``crops`` into ``image`` (in place), each with a housing
     height log-uniform in :data:`HEIGHTS` (scaled to the frame's height against 720 px) and its
-    own aspect ratio, and return their boxes (x0, y0, x1, y1)."""
+    own aspect ratio, clear of the ``taken`` boxes, and return their boxes (x0, y0, x1, y1)."""
     scale = image.shape[0] / SCENE_SIZE[1]
-    boxes: list[Box] = []
+    boxes: list[Box] = list(taken)
     for _ in range(count):
         crop = crops[int(rng.integers(0, len(crops)))].load().image
         height = max(4, int(round(scale * np.exp(rng.uniform(*np.log(HEIGHTS))))))
@@ -106,7 +111,7 @@ def paste_crops(
             continue
         paste(image, crop[:, :, :3], box)
         boxes.append(tuple(float(v) for v in box))  # type: ignore[arg-type]
-    return boxes
+    return boxes[len(taken) :]
 
 
 def pasted_scenes(
@@ -130,6 +135,23 @@ def pasted_scenes(
         yield Frame(image, f"pasted-crops:{seed}:{index - 1}"), boxes
 
 
+def framed_scenes(
+    count: int, crops: Sequence[Sample], backgrounds: Sequence[Sample], seed: int = CROPS_SEED
+) -> Iterator[tuple[Frame, list[Box]]]:
+    """``count`` real training frames (``backgrounds``, spread evenly over them, each kept
+    whole) with :data:`PER_SCENE` ``crops`` pasted clear of their own boxes, and all their
+    boxes (their own, then the pasted ones). A scene's pasting is seeded by ``seed``, its
+    index and its frame's source, so that its source names one image.
+    """
+    for k in range(count):
+        sample = backgrounds[k * len(backgrounds) // count]
+        image = sample.load().image.copy()
+        own = [tuple(float(v) for v in a.bbox) for a in sample.annotations]
+        rng = np.random.default_rng([seed, k, zlib.crc32(sample.source.encode())])
+        boxes = paste_crops(image, crops, rng, taken=own)  # type: ignore[arg-type]
+        yield Frame(image, f"pasted-crops:{seed}:{k}:{sample.source}"), own + boxes
+
+
 def crop_samples() -> list[Sample]:
     """The train crops of :data:`CROP_SET` (through the dataset registry), in source order.
 
@@ -151,9 +173,13 @@ def crop_samples() -> list[Sample]:
     return sorted(samples, key=lambda s: s.source)
 
 
-def crop_frames(count: int, seed: int = CROPS_SEED) -> Iterator[tuple[Frame, list[Box]]]:
-    """``count`` scenes with pasted real crops (:func:`pasted_scenes`); the crop set is read
-    now (not when the first scene is drawn), so a missing set fails before any training work.
+def crop_frames(
+    count: int, backgrounds: Sequence[Sample] = (), seed: int = CROPS_SEED
+) -> Iterator[tuple[Frame, list[Box]]]:
+    """``count`` scenes with pasted real crops: synthetic (:func:`pasted_scenes`), or real
+    training frames when ``backgrounds`` are given (:func:`framed_scenes`). The crop set is
+    read now (not when the first scene is drawn), so a missing set fails before any training
+    work.
 
     Raises
     ------
@@ -162,4 +188,6 @@ def crop_frames(count: int, seed: int = CROPS_SEED) -> Iterator[tuple[Frame, lis
     """
     if count <= 0:
         return iter(())
+    if backgrounds:
+        return framed_scenes(count, crop_samples(), backgrounds, seed)
     return pasted_scenes(count, crop_samples(), seed)
