@@ -103,22 +103,32 @@ def test_a_missing_crop_set_fails_training_at_once_with_one_clear_error(tmp_path
     assert list(crop_frames(0)) == []  # never read when no scene is asked for
     detector = get_registry().create("detector", "gray-tophat")
     with pytest.raises(TsrkitError, match=f"crop_frames > 0 pastes the train crops of {CROP_SET}"):
-        make(**FAST, crop_frames=1).fit(tiny_dataset(1), detector=detector)
+        make(**dict(FAST, crop_frames=1)).fit(tiny_dataset(1), detector=detector)
 
 
-def test_training_reads_the_pasted_scenes(shared_datasets, tmp_path):
+@pytest.mark.parametrize("backgrounds", ["synthetic", "real"])
+def test_training_reads_the_pasted_scenes(shared_datasets, tmp_path, backgrounds):
     detector = get_registry().create("detector", "gray-tophat")
-    models = [
+    infos = [
         load_model(
             train(
-                "verifier", tiny_dataset(), tmp_path / f"m{n}", dict(FAST, crop_frames=n), detector
+                "verifier",
+                tiny_dataset(),
+                tmp_path / f"m{n}",
+                dict(FAST, crop_frames=n, crop_backgrounds=backgrounds),
+                detector,
             ),
             "verifier",
-        )
+        ).info
         for n in (0, 2)
     ]
-    assert models[1].info["frames"] == models[0].info["frames"] + 2
-    assert models[1].info["positives"] > models[0].info["positives"]
+    assert infos[1]["frames"] == infos[0]["frames"] + 2
+    assert infos[1]["positives"] > infos[0]["positives"]
+
+
+def test_the_defaults_are_the_measured_ones():
+    params = make().params
+    assert params["crop_frames"] == 80 and params["crop_backgrounds"] == "real"
 
 
 def test_real_backgrounds_keep_their_boxes_and_take_crops_clear_of_them():

@@ -2,10 +2,12 @@
 
 The verifier's training sets show few cameras; held out, a camera whose housings look otherwise
 (cinTA's veiled grey heads) gets low probabilities (issue 11). The train crops of
-``udacity_mit_tl_crops`` (whole heads, red / yellow / green, many veiled grey) are pasted into
-synthetic no-light road scenes at dash-cam sizes, each crop's box its housing box; the
-candidates on them are labelled as those of the training sets (Zheng's centre rule,
-:mod:`mining`). The crop's edge is feathered so that the paste border is no cue.
+``udacity_mit_tl_crops`` (whole heads, red / yellow / green, many veiled grey) are pasted at
+dash-cam sizes into the real training frames (clear of their boxes) or into synthetic daylight
+no-light road scenes, each crop's box its housing box; the candidates on them are labelled as
+those of the training sets (Zheng's centre rule, :mod:`mining`). The crop's edge is feathered
+so that the paste border is no cue. Measured leave-one-dataset-out in
+``benchmarks/RESULTS.verifier.md``.
 """
 
 from __future__ import annotations
