@@ -150,7 +150,7 @@ def make(**params):
     return get_registry().create("verifier", "verifier", params)
 
 
-FAST = dict(iterations=20, synthetic_frames=1, head_frames=1, negative_ratio=2.0)
+FAST = dict(iterations=20, synthetic_frames=1, head_frames=1, crop_frames=0, negative_ratio=2.0)
 
 
 @pytest.fixture(scope="module")
@@ -311,7 +311,7 @@ def test_fit_needs_a_detector_and_both_classes():
     )
     detector = get_registry().create("detector", "gray-tophat")
     with pytest.raises(TsrkitError, match="positive"):
-        make(synthetic_frames=0, head_frames=0).fit(empty, detector=detector)
+        make(synthetic_frames=0, head_frames=0, crop_frames=0).fit(empty, detector=detector)
 
 
 def test_a_annotation_is_used_by_its_box():

@@ -24,6 +24,7 @@ from tsrkit.synth import SynthOptions, render_frame
 from tsrkit.synth.heads import scatter_heads
 from tsrkit.types import Candidate, Frame, Sample
 from tsrkit_plugins.verifiers.augment import Augmentation
+from tsrkit_plugins.verifiers.pasting import crop_frames
 
 #: Candidates of one frame -> the candidates the verifier will see (e.g. after a housing stage).
 Stage = Callable[[Frame, list[Candidate]], list[Candidate]]
@@ -149,12 +150,18 @@ def labelled_candidates(
     no_light: int,
     heads: int = 0,
     augmentation: Augmentation | None = None,
+    crops: int = 0,
+    crops_on_real: bool = False,
 ) -> Labelled:
     """Run ``detector`` (then ``stage``) on every sample (on each of its ``augmentation``
-    views: :mod:`augment`), on ``no_light`` synthetic frames (and their camera looks) and on
-    ``heads`` synthetic frames
-    with rendered lit heads (:func:`head_frames`); return every candidate's features, its Zheng
-    label, its frame index and its box label (:func:`box_labels`)."""
+    views: :mod:`augment`), on ``no_light`` synthetic frames (and their camera looks), on
+    ``heads`` synthetic frames with rendered lit heads (:func:`head_frames`) and on ``crops``
+    synthetic frames with pasted real heads (:func:`tsrkit_plugins.verifiers.pasting.crop_frames`,
+    whose crop set is read first; ``crops_on_real``: pasted into the samples rather than into
+    synthetic scenes); return every candidate's features, its Zheng label, its frame index and its
+    box label (:func:`box_labels`)."""
+    samples = list(samples)
+    pasted = crop_frames(crops, samples if crops_on_real else ())
     parts = []
     views = augmentation or Augmentation()
     frames: Iterator[tuple[Frame, Sequence[Sequence[float]]]] = (
@@ -163,7 +170,7 @@ def labelled_candidates(
     synthetic = (
         view for f in no_light_frames(no_light) for view in chain([(f, [])], views.looked(f, []))
     )
-    for index, (frame, boxes) in enumerate(chain(frames, synthetic, head_frames(heads))):
+    for index, (frame, boxes) in enumerate(chain(frames, synthetic, head_frames(heads), pasted)):
         candidates = stage(frame, detector.detect(frame))
         if not candidates:
             continue
