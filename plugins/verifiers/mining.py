@@ -20,17 +20,14 @@ import numpy as np
 from tsrkit.eval.matching import centre_hits
 from tsrkit.geometry import iou_matrix
 from tsrkit.plugin import Detector
-from tsrkit.synth import SynthOptions, render_frame
 from tsrkit.synth.heads import scatter_heads
 from tsrkit.types import Candidate, Frame, Sample
 from tsrkit_plugins.verifiers.augment import Augmentation
 from tsrkit_plugins.verifiers.pasting import crop_frames
+from tsrkit_plugins.verifiers.unlit import no_light_frames
 
 #: Candidates of one frame -> the candidates the verifier will see (e.g. after a housing stage).
 Stage = Callable[[Frame, list[Candidate]], list[Candidate]]
-#: Frame size of the synthetic no-light frames (a dash-cam's).
-SYNTH_SIZE = (1280, 720)
-SYNTH_SEED = 1011
 #: Seed of the synthetic scenes with rendered lit heads (positives).
 HEADS_SEED = 77
 #: A box whose long side is at least this many times its short side boxes a housing (a lens
@@ -110,24 +107,6 @@ def box_labels(candidates: Sequence[Candidate], boxes: Sequence[Sequence[float]]
     hit = hits.any(axis=1)
     labels[hit] = (hits & fits).any(axis=1)[hit]
     return labels
-
-
-def no_light_frames(count: int, seed: int = SYNTH_SEED) -> Iterator[Frame]:
-    """``count`` synthetic 1280x720 road scenes in which no light is lit.
-
-    Housings are drawn dark (``off_fraction`` near 1); a scene that still drew a lit light is
-    skipped, so the frames are a deterministic function of ``count`` and ``seed``.
-    """
-    options = SynthOptions(off_fraction=0.999)
-    index = 0
-    made = 0
-    while made < count:
-        image, annotations, condition = render_frame(index, seed, *SYNTH_SIZE, options)
-        index += 1
-        if annotations:
-            continue
-        made += 1
-        yield Frame(image, f"synth-no-light:{seed}:{index - 1}", metadata={"lighting": condition})
 
 
 def head_frames(count: int, seed: int = HEADS_SEED) -> Iterator[tuple[Frame, list]]:

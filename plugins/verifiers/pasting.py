@@ -20,16 +20,15 @@ import numpy as np
 
 from tsrkit.datasets import open_datasets
 from tsrkit.errors import TsrkitError
-from tsrkit.synth import SynthOptions, render_frame
 from tsrkit.types import Frame, Sample
+from tsrkit_plugins.verifiers.unlit import SYNTH_SIZE, no_light_frames
 
 #: The registry name of the crop set and the split pasted.
 CROP_SET = "udacity_mit_tl_crops"
 CROP_SPLIT = "train"
 #: Seed of the scenes' backgrounds and of the pasting.
 CROPS_SEED = 313
-#: Frame size of the scenes, and the range of housing heights (px, log-uniform) in it.
-SCENE_SIZE = (1280, 720)
+#: The range of housing heights (px, log-uniform) in a 1280x720 scene (:data:`SYNTH_SIZE`).
 HEIGHTS = (10.0, 110.0)
 #: Pasted heads per scene; the fraction of the frame height they stay above (their bottom).
 PER_SCENE = 5
@@ -102,7 +101,7 @@ def paste_crops(
     """Paste ``count`` crops drawn from ``crops`` into ``image`` (in place), each with a housing
     height log-uniform in :data:`HEIGHTS` (scaled to the frame's height against 720 px) and its
     own aspect ratio, clear of the ``taken`` boxes, and return their boxes (x0, y0, x1, y1)."""
-    scale = image.shape[0] / SCENE_SIZE[1]
+    scale = image.shape[0] / SYNTH_SIZE[1]
     boxes: list[Box] = list(taken)
     for _ in range(count):
         crop = crops[int(rng.integers(0, len(crops)))].load().image
@@ -125,16 +124,9 @@ def pasted_scenes(
     deterministic function of the arguments.
     """
     rng = np.random.default_rng(seed)
-    options = SynthOptions(lighting=("day",), off_fraction=0.999)
-    index = made = 0
-    while made < count:
-        image, annotations, _ = render_frame(index, seed, *SCENE_SIZE, options)
-        index += 1
-        if annotations:
-            continue
-        made += 1
-        boxes = paste_crops(image, crops, rng)
-        yield Frame(image, f"pasted-crops:{seed}:{index - 1}"), boxes
+    for frame in no_light_frames(count, seed, lighting=("day",), name="pasted-crops"):
+        boxes = paste_crops(frame.image, crops, rng)
+        yield frame, boxes
 
 
 def framed_scenes(
