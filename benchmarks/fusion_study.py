@@ -129,7 +129,9 @@ def tables(out: Path, relative: float) -> None:
         s.key: {part: dict(np.load(out / f"{s.key}_{part}.npz")) for part in ("test", "nolight")}
         for s in SETS
     }
-    print("| rule | t | " + " | ".join(f"{s.key} hit/rec/prec/FP" for s in SETS) + " | no-light FP |")
+    print(
+        "| rule | t | " + " | ".join(f"{s.key} hit/rec/prec/FP" for s in SETS) + " | no-light FP |"
+    )
     print("|---|---|" + "---|" * (len(SETS) + 1))
     for name, rule in RULES.items():
         for t in THRESHOLDS:
