@@ -159,8 +159,7 @@ def crop_samples() -> list[Sample]:
     except TsrkitError as exc:
         raise TsrkitError(
             f"verifier: crop_frames > 0 pastes the {CROP_SPLIT} crops of {CROP_SET}, which "
-            f"could not be read ({exc}); set TSRKIT_DATA_DIR to the folder holding it, or "
-            "set crop_frames=0"
+            f"could not be read ({exc}); or set crop_frames=0"
         ) from None
     if not samples:
         raise TsrkitError(f"verifier: {CROP_SET} has no {CROP_SPLIT} crop; set crop_frames=0")
