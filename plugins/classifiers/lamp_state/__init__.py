@@ -222,7 +222,8 @@ class LampState(Classifier):
             min=0.0,
             max=1.0,
             help="weight of the second model, learned from the lamp's CIELab colour alone (core "
-            "and rim), mixed with the full model's probabilities; 0 reads the full model alone",
+            "and rim), mixed with the full model's probabilities; 0 reads the full model alone, "
+            "as does a model trained without a colour model (older models keep their outputs)",
         ),
         Param(
             "ab_hist_weight",
