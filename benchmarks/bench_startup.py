@@ -17,6 +17,8 @@ import subprocess
 import sys
 import time
 
+import harness
+
 COMMANDS = {
     "python -c pass (bare interpreter)": [sys.executable, "-c", "pass"],
     "tsrkit --help": [sys.executable, "-m", "tsrkit", "--help"],
@@ -43,6 +45,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=7)
     args = parser.parse_args()
+    harness.announce()
     print(f"load average before: {os.getloadavg()[0]:.2f}; {args.runs} runs each")
     for label, command in COMMANDS.items():
         median_seconds(command, 1)  # warm the file cache

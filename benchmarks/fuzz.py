@@ -30,6 +30,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 import cv2
+import harness
 import numpy as np
 
 from tsrkit.datasets import open_dataset
@@ -265,6 +266,7 @@ def main() -> None:
         "--only", default=None, help="Comma-separated surfaces to run (default all)."
     )
     args = parser.parse_args()
+    harness.announce()
     rng = np.random.default_rng(args.seed)
     folder = Path(tempfile.mkdtemp(prefix="tsrkit-fuzz-"))
     try:

@@ -18,15 +18,13 @@ Run::
 
 from __future__ import annotations
 
-import os
+import harness
 
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ[_var] = "1"
+harness.single_thread()
 
 import tempfile  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 from bench_classifiers import STATES, benchmark_sets, evaluate  # noqa: E402
 from cv_classifier_defaults import grid_parser, grid_points  # noqa: E402
@@ -50,7 +48,7 @@ def describe(result: dict) -> str:
 
 def main() -> None:
     args = grid_parser(__doc__).parse_args()
-    cv2.setNumThreads(1)
+    harness.announce()
     registry = get_registry()
     train, sets = benchmark_sets()
     points = grid_points(args.grid) or [{}]

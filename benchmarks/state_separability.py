@@ -27,10 +27,9 @@ KR, cinTA, DTLD test), beside the others' training parts that leave-one-set-out 
 
 from __future__ import annotations
 
-import os
+import harness
 
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ[_var] = "1"
+harness.single_thread(opencv=False)
 
 import argparse  # noqa: E402
 
@@ -236,6 +235,7 @@ def main() -> None:
     parser.add_argument("--folds", type=int, default=5, help="folds of the in-set CV")
     parser.add_argument("--neighbours", type=int, default=15, help="colour neighbours counted")
     args = parser.parse_args()
+    harness.announce()
     params = get_registry().create("classifier", "lamp-state", {"seed": args.seed}).params
     data = parts()
     features = {
