@@ -1,5 +1,5 @@
 """Throughput of ``tsrkit.benchmark`` with 1..N worker processes, and its memory at 200 vs 2,000
-frames, on synthetic 1280x720 frames (issue 16: efficiency >= 0.8, memory ratio <= 1.5).
+frames, on synthetic 1280x720 frames (targets: efficiency >= 0.8, memory ratio <= 1.5).
 
 Each run is a child process (``--child``) that benchmarks the first F frames of one generated
 set (no cache, report writers ``json`` only, so the frame loop and the evaluation are timed, not

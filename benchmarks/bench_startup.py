@@ -1,4 +1,4 @@
-"""Start-up time of the command line (issue 15): ``tsrkit --help`` and ``tsrkit plugins``.
+"""Start-up time of the command line: ``tsrkit --help`` and ``tsrkit plugins``.
 
 Each command runs ``--runs`` times in a fresh interpreter (``python -m tsrkit``); the median
 wall time is printed, with the bare interpreter and the old eager start-up (every plugin loaded

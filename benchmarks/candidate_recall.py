@@ -46,7 +46,7 @@ SETS = {
     "DTLD": "dtld_fridtjofs:test",
     "synthetic": "sample:test",
 }
-#: Size bins of r (px), down to the 2-3 px lenses the issue names.
+#: Size bins of r (px), down to lenses of 2-3 px.
 SIZE_BINS = ((0, 2), (2, 3), (3, 4), (4, 6), (6, 12), (12, float("inf")))
 
 

@@ -1,5 +1,5 @@
 """Can pruning make the conspicuity detector 3x faster than commit d213fc8 and keep its output?
-(issue 16, part 3; the study behind the "pruning" paragraph of RESULTS.scaling.md).
+(the study behind "Exact pruning" in RESULTS.detector_speed.md).
 
 The idea: compute the exact map (Zheng 2016, Eq. 3.1-3.12) only where a cheap per-pixel upper
 bound U says it could reach the lowest threshold the localization (3.2.2, Figure 3-10) will

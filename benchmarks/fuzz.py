@@ -1,5 +1,5 @@
 """Mutation fuzzing of tsrkit's input surfaces: counts the cases that end in an exception other
-than tsrkit's own clear errors (issue 15: the target is 0).
+than tsrkit's own clear errors (the target is 0).
 
 Surfaces:
 - ``image``: a small PNG and a small JPEG with random byte flips, insertions, deletions,

@@ -1,4 +1,4 @@
-"""Mutation fuzzing of tsrkit's GPS log and map readers (issue 13): counts the cases that end
+"""Mutation fuzzing of tsrkit's GPS log and map readers: counts the cases that end
 in an exception other than tsrkit's own clear ``GeoError`` (the target is 0).
 
 Seeds are cut from the real Seattle drive (its first 40 fixes) and the real Bellevue extract

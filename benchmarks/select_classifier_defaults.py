@@ -1,7 +1,7 @@
 """Cross-camera model selection for the state classifiers, with honest held-out numbers.
 
 Cross-validation on MIT train (``cv_classifier_defaults.py``) sees one camera and so cannot
-choose settings for the situation issue 5 measures: a model trained on MIT crops read on other
+choose settings for the situation measured here: a model trained on MIT crops read on other
 cameras. This script trains every grid point on MIT train, scores it on the five test sets of
 ``bench_classifiers.py`` and then, for each set in turn, picks the grid point with the best
 mean *balanced accuracy* (mean per-class recall over red, yellow, green) on the *other four*

@@ -1,6 +1,6 @@
 """Is a held-out camera's state separable by colour from what the other cameras show?
 
-Evidence for issue 11's target (accuracy and red recall >= 0.95 on every set, leave one set
+Evidence for the target of lamp-state (accuracy and red recall >= 0.95 on every set, leave one set
 out): for each of the six sets of ``state_loso.py`` (MIT test, VGIS day and night deduplicated,
 KR, cinTA, DTLD test), beside the others' training parts that leave-one-set-out (LOSO) trains on.
 

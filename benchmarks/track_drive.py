@@ -1,4 +1,4 @@
-"""``tsrkit track VIDEO`` on rendered drives (Zheng 2016, 3.4 and 5.4; issue 13).
+"""``tsrkit track VIDEO`` on rendered drives (Zheng 2016, 3.4 and 5.4).
 
     python benchmarks/track_drive.py                 # all stages
     python benchmarks/track_drive.py --stage short   # one of: short, flow, long
