@@ -135,9 +135,7 @@ def test_plugins_json_lists_a_failing_entry_point(tmp_path):
 class Stacked(tsrkit.Detector):
     name = "stacked"
     summary = "the candidates of the detector it is built on"
-    PARAMS = (
-        Param("inner", "detector", "dummy k=2", options=(Param("share", "float", 1.0),)),
-    )
+    PARAMS = (Param("inner", "detector", "dummy k=2", options=(Param("share", "float", 1.0),)),)
 
     def detect(self, frame):
         return self.params["inner"].plugin.detect(frame)
