@@ -1,0 +1,66 @@
+"""Never write over an input: the files a run reads are declared once, and every output path is
+checked against them before anything is written.
+
+A verb wraps its work in :func:`reading` with the files it reads (images, annotation files,
+configs, models, GPS logs); :func:`tsrkit.atomic.atomic_open` and the verbs' own output checks
+call :func:`refuse_input`, so ``train --out D/annotations`` or ``datasets convert a.json --out
+a.json`` refuse with one line instead of replacing the user's data.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import contextvars
+import os
+from collections.abc import Iterable, Iterator
+
+from tsrkit.errors import TsrkitError
+
+_INPUTS: contextvars.ContextVar[frozenset[str]] = contextvars.ContextVar(
+    "tsrkit_inputs", default=frozenset()
+)
+
+
+class OutputIsInput(TsrkitError):
+    """An output path that names one of the run's inputs."""
+
+
+def _key(path: str | os.PathLike) -> str:
+    return os.path.realpath(path)
+
+
+@contextlib.contextmanager
+def reading(paths: Iterable[str | os.PathLike]) -> Iterator[None]:
+    """Declare ``paths`` (files or folders) as inputs of the run for the block's duration."""
+    keys = {_key(p) for p in paths if p is not None and str(p)}
+    token = _INPUTS.set(_INPUTS.get() | keys)
+    try:
+        yield
+    finally:
+        _INPUTS.reset(token)
+
+
+def is_input(path: str | os.PathLike) -> bool:
+    """Whether ``path`` names a file or folder declared with :func:`reading`."""
+    return _key(path) in _INPUTS.get()
+
+
+def refuse_input(path: str | os.PathLike, option: str = "the output") -> None:
+    """Raise :class:`OutputIsInput` when ``path`` is one of the run's inputs.
+
+    Examples
+    --------
+    >>> with reading(["data/a.json"]):
+    ...     refuse_input("data/./a.json", "--out")
+    Traceback (most recent call last):
+    ...
+    tsrkit.outputs.OutputIsInput: --out data/./a.json is an input of this run; choose another path
+    """
+    if is_input(path):
+        raise OutputIsInput(f"{option} {path} is an input of this run; choose another path")
+
+
+def dataset_inputs(dataset, *files: str | os.PathLike | None) -> list[str]:
+    """The files a dataset run reads: ``files`` (its annotation file or folder) and every
+    sample's image file."""
+    return [*(str(f) for f in files if f), *(s.source for s in dataset.samples if s.source)]
