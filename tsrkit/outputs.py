@@ -1,5 +1,6 @@
-"""Never write over an input: the files a run reads are declared once, and every output path is
-checked against them before anything is written.
+"""Never write over an input, nor read an output back as one: a run declares the files it reads
+and the files it writes once, and outputs are checked against inputs before anything is
+written.
 
 A verb wraps its work in :func:`reading` with the files it reads (images, annotation files,
 configs, models, GPS logs); :func:`tsrkit.atomic.atomic_open` and the verbs' own output checks
@@ -18,6 +19,9 @@ from tsrkit.errors import TsrkitError
 
 _INPUTS: contextvars.ContextVar[frozenset[str]] = contextvars.ContextVar(
     "tsrkit_inputs", default=frozenset()
+)
+_OUTPUTS: contextvars.ContextVar[frozenset[str]] = contextvars.ContextVar(
+    "tsrkit_outputs", default=frozenset()
 )
 
 
@@ -38,6 +42,24 @@ def reading(paths: Iterable[str | os.PathLike]) -> Iterator[None]:
         yield
     finally:
         _INPUTS.reset(token)
+
+
+@contextlib.contextmanager
+def writing(paths: Iterable[str | os.PathLike | None]) -> Iterator[None]:
+    """Declare ``paths`` (files or folders) as the run's outputs for the block's duration:
+    :func:`tsrkit.inputs.expand_paths` leaves them out of the inputs it lists."""
+    keys = {_key(p) for p in paths if p is not None and str(p)}
+    token = _OUTPUTS.set(_OUTPUTS.get() | keys)
+    try:
+        yield
+    finally:
+        _OUTPUTS.reset(token)
+
+
+def is_output(path: str | os.PathLike) -> bool:
+    """Whether ``path`` is one of the run's declared outputs (:func:`writing`)."""
+    outputs = _OUTPUTS.get()
+    return bool(outputs) and _key(path) in outputs
 
 
 def is_input(path: str | os.PathLike) -> bool:

@@ -19,6 +19,7 @@ from tsrkit.errors import TsrkitError
 from tsrkit.inputs import Work, iter_frames, plan_work, read_work
 from tsrkit.pipeline import FrameResult, Pipeline
 from tsrkit.types import Frame, Skipped
+from tsrkit.workers import check_workers, end_with_parent
 
 __all__ = ["CHUNK_FRAMES", "process_frame", "run_pipeline"]
 
@@ -64,8 +65,7 @@ def run_pipeline(
         Worker processes; 1 runs here. A tracker follows a video frame by frame, so a pipeline
         with one runs here only.
     """
-    if workers < 1:
-        raise TsrkitError(f"workers must be at least 1; got {workers}")
+    check_workers(workers)
     if workers == 1:
         for item in iter_frames(paths, every, start, end):
             yield (
@@ -95,6 +95,7 @@ def _init_worker(pipeline: Pipeline, every: int) -> None:
     global _WORKER
     _WORKER = (pipeline, every)
     single_thread()
+    end_with_parent()
 
 
 def _process_work(unit: Work) -> list[FrameResult | Skipped]:
