@@ -32,7 +32,7 @@ from tsrkit.plugin import Classifier, Detector, Plugin, Verifier
 from tsrkit.records import FrameRecord
 from tsrkit.registry import PluginNotFound, get_registry
 from tsrkit.types import Candidate, Frame, Sample
-from tsrkit.workers import check_workers, end_with_parent
+from tsrkit.workers import check_workers, end_with_run
 
 __all__ = [
     "ENGINES",
@@ -186,11 +186,11 @@ def classify_annotations(classifier: Classifier, frame: Frame, sample: Sample) -
 _WORKER_JOB: Job | None = None
 
 
-def _init_worker(job: Job) -> None:
+def _init_worker(job: Job, run: int) -> None:
     global _WORKER_JOB
     _WORKER_JOB = job
     single_thread()
-    end_with_parent()
+    end_with_run(run)
 
 
 def single_thread() -> None:
@@ -247,7 +247,10 @@ def run_records(
         yield from (process_sample(i, s, job) for i, s in enumerate(samples))
     else:
         with ProcessPoolExecutor(
-            workers, mp_context=pool_context(), initializer=_init_worker, initargs=(job,)
+            workers,
+            mp_context=pool_context(),
+            initializer=_init_worker,
+            initargs=(job, os.getpid()),
         ) as pool:
             yield from ordered(
                 lambda i, s: pool.submit(_run_in_worker, i, s),
