@@ -15,6 +15,7 @@ from rich.table import Table
 from tsrkit.atomic import atomic_open
 from tsrkit.cli.common import FiniteFloatRange, plugin_options
 from tsrkit.cli.errors import UserError
+from tsrkit.files import not_regular
 from tsrkit.geo.gps import EARLIEST, LATEST
 from tsrkit.outlock import locked
 from tsrkit.outputs import reading, refuse_input
@@ -179,6 +180,10 @@ def track_command(
     with reading([video, gps, osm, truth]):
         if out is not None:
             refuse_input(out, "--out")
+    for given in (video, truth):
+        problem = not_regular(given) if given is not None else None
+        if problem:
+            raise UserError(f"{given}: {problem}")
     track = read_track(gps)
     signals = read_signals(osm)
     if not len(signals):
@@ -244,6 +249,11 @@ def _track_video(
     truth_frames = read_truth(truth) if truth else None
     fps, count = video_facts(video)
     start = float(track.time[0]) if start_utc is None else start_utc
+    if start > track.time[-1] or start + count / max(fps, 1e-9) < track.time[0]:
+        raise UserError(
+            f"--start-utc {_utc(start)}: the video's {count} frames lie outside the GPS log "
+            f"({_utc(float(track.time[0]))} - {_utc(float(track.time[-1]))[11:]})"
+        )
     found = frame_traversals(
         track,
         signals,
