@@ -82,7 +82,16 @@ def refuse_input(path: str | os.PathLike, option: str = "the output") -> None:
         raise OutputIsInput(f"{option} {path} is an input of this run; choose another path")
 
 
-def dataset_inputs(dataset, *files: str | os.PathLike | None) -> list[str]:
-    """The files a dataset run reads: ``files`` (its annotation file or folder) and every
-    sample's image file."""
-    return [*(str(f) for f in files if f), *(s.source for s in dataset.samples if s.source)]
+def dataset_inputs(refs: Iterable[str], dataset) -> list[str]:
+    """What a run on ``dataset`` reads: the annotation file or folder of each reference
+    (a registered name, ``NAME:SPLIT``, or a path) and every sample's image."""
+    from tsrkit.datasets.concat import parse_reference
+    from tsrkit.datasets.registry import load_registry
+
+    registry = load_registry()
+    files = []
+    for ref in refs:
+        name, _ = parse_reference(ref, None)
+        entry = registry.get(name)
+        files.append(str(entry.annotation_path()) if entry is not None else name)
+    return [*files, *(s.source for s in dataset.samples if s.source)]

@@ -16,7 +16,7 @@ from tsrkit.cli.common import FiniteFloatRange, plugin_options
 from tsrkit.cli.completion import dataset_names, plugin_list, plugin_names, preset_or_file
 from tsrkit.cli.errors import UserError
 from tsrkit.eval.settings import BOX_OPTIONS
-from tsrkit.outputs import reading
+from tsrkit.outputs import dataset_inputs, reading
 from tsrkit.report import print_table
 from tsrkit.selection import build, build_compare
 
@@ -150,16 +150,6 @@ def load_dataset(ref: str, format_name: str | None, images: str | None, split: s
     return dataset
 
 
-def dataset_files(ref: str, dataset) -> list[str]:
-    """What a run on ``dataset`` reads (its annotation file or folder, its images): the
-    paths no output may replace."""
-    from tsrkit.datasets.registry import load_registry
-
-    entry = load_registry().get(ref)
-    annotations = entry.annotation_path() if entry is not None else ref
-    return [str(annotations), *(s.source for s in dataset.samples if s.source)]
-
-
 def check_engine(engine: str, scheduler: str | None) -> None:
     """Refuse ``--scheduler`` without ``--engine dask`` (it would be ignored)."""
     if scheduler is not None and engine != "dask":
@@ -243,7 +233,7 @@ def benchmark_command(
         with_tracker=False,
     )
     dataset = load_dataset(dataset_ref, format_name, images, split)
-    with reading(dataset_files(dataset_ref, dataset)):
+    with reading(dataset_inputs([dataset_ref], dataset)):
         report = benchmark(
             dataset,
             chosen.detector,
@@ -409,7 +399,7 @@ def run_compare(
         raise click.UsageError("--without-verifier needs a verifier (--verifier or --config)")
     dataset = load_dataset(dataset_ref, format_name, images, split)
     detectors = [run.detector for run in runs if run.detector is not None]
-    with reading(dataset_files(dataset_ref, dataset)):
+    with reading(dataset_inputs([dataset_ref], dataset)):
         comparison = compare(
             dataset,
             detectors,
