@@ -10,6 +10,8 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
+from tsrkit.outputs import refuse_input
+
 __all__ = ["atomic_open", "finite", "json_line", "write_json"]
 
 
@@ -17,9 +19,12 @@ __all__ = ["atomic_open", "finite", "json_line", "write_json"]
 def atomic_open(path: str | os.PathLike, mode: str = "w", encoding: str | None = "utf-8"):
     """Open a temporary file next to ``path``; on success it replaces ``path`` atomically.
 
-    On an exception the temporary file is removed and ``path`` is left as it was.
+    On an exception the temporary file is removed and ``path`` is left as it was. A ``path``
+    that names one of the run's inputs (:func:`tsrkit.outputs.reading`) is refused before
+    anything is written.
     """
     path = Path(path)
+    refuse_input(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:

@@ -13,6 +13,7 @@ import inspect
 import json
 import multiprocessing
 import os
+import re
 import time
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator
@@ -23,6 +24,7 @@ from typing import Any, TypeVar
 
 from tsrkit.atomic import atomic_open
 from tsrkit.errors import TsrkitError
+from tsrkit.files import InputFileError, read_json
 from tsrkit.images import ImageReadError
 from tsrkit.lighting import light_condition
 from tsrkit.pipeline import FrameResult, Pipeline
@@ -30,6 +32,7 @@ from tsrkit.plugin import Classifier, Detector, Plugin, Verifier
 from tsrkit.records import FrameRecord
 from tsrkit.registry import PluginNotFound, get_registry
 from tsrkit.types import Candidate, Frame, Sample
+from tsrkit.workers import check_workers, end_with_run
 
 __all__ = [
     "ENGINES",
@@ -114,14 +117,30 @@ def process_sample(index: int, sample: Sample, job: Job) -> FrameRecord:
     except OSError as exc:
         return FrameRecord(sample.source, index, skipped=f"cannot read: {exc.strerror or exc}")
     path = Path(job.cache_dir, key[:2], f"{key}.json") if job.cache_dir else None
-    if path is not None and path.is_file():
-        with open(path, encoding="utf-8") as fh:
-            return replace(FrameRecord.from_json(json.load(fh)), index=index, cached=True)
+    cached = read_cached(path) if path is not None else None
+    if cached is not None:
+        return replace(cached, index=index, cached=True)
     record = compute_record(index, sample, job)
     if path is not None and record.skipped is None:
         with atomic_open(path) as fh:
             json.dump(record.to_json(), fh)
     return record
+
+
+#: The largest cache entry read, in bytes (a frame's record is a few kilobytes).
+MAX_CACHE_ENTRY = 64 * 2**20
+
+
+def read_cached(path: Path) -> FrameRecord | None:
+    """The record cached at ``path``, or None when there is none or it cannot be used (not a
+    regular file, too large, not JSON, not a record): the frame is then computed again and
+    the entry replaced, so a damaged cache costs time, never the run."""
+    if not path.is_file():
+        return None
+    try:
+        return FrameRecord.from_json(read_json(path, MAX_CACHE_ENTRY))
+    except (InputFileError, KeyError, TypeError, ValueError, AttributeError, IndexError):
+        return None
 
 
 def compute_record(index: int, sample: Sample, job: Job) -> FrameRecord:
@@ -167,10 +186,11 @@ def classify_annotations(classifier: Classifier, frame: Frame, sample: Sample) -
 _WORKER_JOB: Job | None = None
 
 
-def _init_worker(job: Job) -> None:
+def _init_worker(job: Job, run: int) -> None:
     global _WORKER_JOB
     _WORKER_JOB = job
     single_thread()
+    end_with_run(run)
 
 
 def single_thread() -> None:
@@ -220,15 +240,17 @@ def run_records(
     """Frame records in dataset order, computed in this process, a process pool or on Dask."""
     if engine not in ENGINES:
         raise BenchmarkError(f"unknown engine '{engine}' (choose {' or '.join(ENGINES)})")
-    if workers < 1:
-        raise BenchmarkError(f"workers must be at least 1; got {workers}")
+    check_workers(workers)
     if engine == "dask":
         yield from _run_dask(samples, job, workers, scheduler)
     elif workers == 1:
         yield from (process_sample(i, s, job) for i, s in enumerate(samples))
     else:
         with ProcessPoolExecutor(
-            workers, mp_context=pool_context(), initializer=_init_worker, initargs=(job,)
+            workers,
+            mp_context=pool_context(),
+            initializer=_init_worker,
+            initargs=(job, os.getpid()),
         ) as pool:
             yield from ordered(
                 lambda i, s: pool.submit(_run_in_worker, i, s),
@@ -236,6 +258,10 @@ def run_records(
                 samples,
                 4 * workers,
             )
+
+
+#: A Dask scheduler address: ``host:port`` with an optional ``protocol://``.
+SCHEDULER_ADDRESS = re.compile(r"([a-z]+://)?(\[[0-9a-fA-F:]+\]|[^\s:/\[\]]+):\d{1,5}")
 
 
 def _run_dask(
@@ -248,9 +274,14 @@ def _run_dask(
         cluster = LocalCluster(n_workers=workers, threads_per_worker=1, dashboard_address=None)
         scheduler = cluster
     address = getattr(scheduler, "scheduler_address", scheduler)
+    if isinstance(address, str) and not SCHEDULER_ADDRESS.fullmatch(address):
+        raise BenchmarkError(
+            f"--scheduler {address!r}: expected HOST:PORT or PROTOCOL://HOST:PORT "
+            "(e.g. tcp://10.0.0.5:8786)"
+        )
     try:
         client = Client(address, timeout="20s", set_as_default=False)
-    except OSError as exc:
+    except (OSError, ValueError) as exc:
         raise BenchmarkError(f"cannot reach Dask scheduler {address}: {exc}") from None
     try:
         shared = client.scatter(job, broadcast=True)

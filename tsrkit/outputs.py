@@ -1,5 +1,6 @@
-"""Never write over an input: the files a run reads are declared once, and every output path is
-checked against them before anything is written.
+"""Never write over an input, nor read an output back as one: a run declares the files it reads
+and the files it writes once, and outputs are checked against inputs before anything is
+written.
 
 A verb wraps its work in :func:`reading` with the files it reads (images, annotation files,
 configs, models, GPS logs); :func:`tsrkit.atomic.atomic_open` and the verbs' own output checks
@@ -18,6 +19,9 @@ from tsrkit.errors import TsrkitError
 
 _INPUTS: contextvars.ContextVar[frozenset[str]] = contextvars.ContextVar(
     "tsrkit_inputs", default=frozenset()
+)
+_OUTPUTS: contextvars.ContextVar[frozenset[str]] = contextvars.ContextVar(
+    "tsrkit_outputs", default=frozenset()
 )
 
 
@@ -40,6 +44,24 @@ def reading(paths: Iterable[str | os.PathLike]) -> Iterator[None]:
         _INPUTS.reset(token)
 
 
+@contextlib.contextmanager
+def writing(paths: Iterable[str | os.PathLike | None]) -> Iterator[None]:
+    """Declare ``paths`` (files or folders) as the run's outputs for the block's duration:
+    :func:`tsrkit.inputs.expand_paths` leaves them out of the inputs it lists."""
+    keys = {_key(p) for p in paths if p is not None and str(p)}
+    token = _OUTPUTS.set(_OUTPUTS.get() | keys)
+    try:
+        yield
+    finally:
+        _OUTPUTS.reset(token)
+
+
+def is_output(path: str | os.PathLike) -> bool:
+    """Whether ``path`` is one of the run's declared outputs (:func:`writing`)."""
+    outputs = _OUTPUTS.get()
+    return bool(outputs) and _key(path) in outputs
+
+
 def is_input(path: str | os.PathLike) -> bool:
     """Whether ``path`` names a file or folder declared with :func:`reading`."""
     return _key(path) in _INPUTS.get()
@@ -60,7 +82,16 @@ def refuse_input(path: str | os.PathLike, option: str = "the output") -> None:
         raise OutputIsInput(f"{option} {path} is an input of this run; choose another path")
 
 
-def dataset_inputs(dataset, *files: str | os.PathLike | None) -> list[str]:
-    """The files a dataset run reads: ``files`` (its annotation file or folder) and every
-    sample's image file."""
-    return [*(str(f) for f in files if f), *(s.source for s in dataset.samples if s.source)]
+def dataset_inputs(refs: Iterable[str], dataset) -> list[str]:
+    """What a run on ``dataset`` reads: the annotation file or folder of each reference
+    (a registered name, ``NAME:SPLIT``, or a path) and every sample's image."""
+    from tsrkit.datasets.concat import parse_reference
+    from tsrkit.datasets.registry import load_registry
+
+    registry = load_registry()
+    files = []
+    for ref in refs:
+        name, _ = parse_reference(ref, None)
+        entry = registry.get(name)
+        files.append(str(entry.annotation_path()) if entry is not None else name)
+    return [*files, *(s.source for s in dataset.samples if s.source)]

@@ -19,6 +19,7 @@ from tsrkit.errors import TsrkitError
 from tsrkit.inputs import Work, iter_frames, plan_work, read_work
 from tsrkit.pipeline import FrameResult, Pipeline
 from tsrkit.types import Frame, Skipped
+from tsrkit.workers import check_workers, end_with_run
 
 __all__ = ["CHUNK_FRAMES", "process_frame", "run_pipeline"]
 
@@ -64,8 +65,7 @@ def run_pipeline(
         Worker processes; 1 runs here. A tracker follows a video frame by frame, so a pipeline
         with one runs here only.
     """
-    if workers < 1:
-        raise TsrkitError(f"workers must be at least 1; got {workers}")
+    check_workers(workers)
     if workers == 1:
         for item in iter_frames(paths, every, start, end):
             yield (
@@ -76,7 +76,10 @@ def run_pipeline(
         raise TsrkitError("a tracker follows a video frame by frame: run it with one worker")
     units = plan_work(paths, every, start, end, chunk=CHUNK_FRAMES)
     with ProcessPoolExecutor(
-        workers, mp_context=pool_context(), initializer=_init_worker, initargs=(pipeline, every)
+        workers,
+        mp_context=pool_context(),
+        initializer=_init_worker,
+        initargs=(pipeline, every, os.getpid()),
     ) as pool:
         for results in ordered(
             lambda _, unit: unit if isinstance(unit, Skipped) else pool.submit(_process_work, unit),
@@ -91,10 +94,11 @@ def run_pipeline(
 _WORKER: tuple[Pipeline, int] | None = None
 
 
-def _init_worker(pipeline: Pipeline, every: int) -> None:
+def _init_worker(pipeline: Pipeline, every: int, run: int) -> None:
     global _WORKER
     _WORKER = (pipeline, every)
     single_thread()
+    end_with_run(run)
 
 
 def _process_work(unit: Work) -> list[FrameResult | Skipped]:

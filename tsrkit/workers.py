@@ -1,14 +1,15 @@
 """Worker processes: how many a run may start, and their end when the run that started them
 ends, even by ``kill -9`` (which runs no clean-up in the run itself).
 
-Pools fork their workers from a fork server (:func:`tsrkit.engine.pool_context`), which exits
-when the run's process is gone; a worker then finds itself re-parented and ends within a second
-(:func:`end_with_parent`).
+Pools fork their workers from a fork server (:func:`tsrkit.engine.pool_context`), which does not
+notice the run's end; each worker watches the run's process and ends, with its fork server,
+within a second of it (:func:`end_with_run`).
 """
 
 from __future__ import annotations
 
 import os
+import signal
 import threading
 import time
 
@@ -40,17 +41,30 @@ def check_workers(workers: int, option: str = "--workers") -> int:
     return workers
 
 
-def end_with_parent(poll: float = 1.0) -> None:
-    """In a worker process: end it (``os._exit``) once its parent process is gone.
+def end_with_run(run: int, poll: float = 1.0) -> None:
+    """In a worker process: end it (``os._exit``) once the run's process ``run`` is gone.
 
-    The parent is the fork server or the run itself; when it ends the worker is re-parented,
-    which a daemon thread notices within ``poll`` seconds.
+    A daemon thread looks every ``poll`` seconds. The fork server the worker came from serves
+    that run only, and outlives it otherwise: while it is still this worker's parent it is
+    ended too.
     """
-    parent = os.getppid()
+    server = os.getppid()
 
     def watch() -> None:
-        while os.getppid() == parent:
+        while _alive(run):
             time.sleep(poll)
+        if server != run and os.getppid() == server:
+            os.kill(server, signal.SIGTERM)
         os._exit(1)
 
-    threading.Thread(target=watch, name="tsrkit-end-with-parent", daemon=True).start()
+    threading.Thread(target=watch, name="tsrkit-end-with-run", daemon=True).start()
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True

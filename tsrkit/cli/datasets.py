@@ -23,6 +23,8 @@ from tsrkit.datasets import (
 )
 from tsrkit.datasets.registry import GENERATED_SAMPLE
 from tsrkit.errors import TsrkitError
+from tsrkit.outlock import locked_file
+from tsrkit.outputs import dataset_inputs, reading, refuse_input
 from tsrkit.types import Dataset
 
 __all__ = [
@@ -196,7 +198,9 @@ def convert_command(
     console = Console(stderr=True, soft_wrap=True)
     with console.status(f"converting {src} to {to_format}...") if not quiet else nullcontext():
         dataset = open_dataset(src, format=src_format, images=images)
-        write_dataset(dataset, to_format, out)
+        with reading(dataset_inputs([src], dataset)), locked_file(out):
+            refuse_input(out, "--out")
+            write_dataset(dataset, to_format, out)
         changes = state_changes(dataset, open_dataset(out, format=to_format))
     boxes = sum(len(s.annotations) for s in dataset)
     click.echo(f"wrote {len(dataset)} images, {boxes} boxes as {to_format} to {out}")

@@ -16,13 +16,18 @@ from rich.console import Console
 
 from tsrkit.atomic import atomic_open, json_line
 from tsrkit.cli.common import plugin_options
+from tsrkit.cli.errors import UserError
 from tsrkit.draw import draw_detections
 from tsrkit.errors import TsrkitError
+from tsrkit.inputs import IMAGE_EXTENSIONS, VIDEO_EXTENSIONS, check_range
+from tsrkit.outlock import locked_file
+from tsrkit.outputs import reading, refuse_input, writing
 from tsrkit.pipeline import Pipeline
 from tsrkit.report import ProgressBar
 from tsrkit.selection import build
 from tsrkit.streams import run_pipeline
 from tsrkit.types import Frame, Skipped
+from tsrkit.workers import check_workers
 
 __all__ = ["default_inputs", "detect_command", "flushed_output", "run_detect"]
 
@@ -97,6 +102,17 @@ def _write_overlay(folder: Path, frame: Frame, number: int, detections) -> None:
             fh.write(encoded.tobytes())
 
 
+def printable(text: str) -> str:
+    """``text`` with control characters escaped, so that a skipped file's line stays one line.
+
+    Examples
+    --------
+    >>> printable("a\\nb.png")
+    'a\\\\nb.png'
+    """
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
+
+
 def default_inputs() -> list[str]:
     """The bundled synthetic sample's images (generated on first use)."""
     from tsrkit.synth import sample_path
@@ -166,14 +182,26 @@ def detect_command(
       tsrkit detect frames/ --config recommended --draw overlays/ -q
       tsrkit detect frames/ -d conspicuity -p weights=1,1,2 -w 2 -o d.jsonl
     """
-    pipeline = build(detector, verifier, classifier, tracker, params, config).pipeline()
+    if any(not str(p) for p in paths):
+        raise UserError("an empty path was given (quote a real file or folder)")
+    check_range(every, start, end)
+    check_workers(workers)
     inputs = list(paths) or default_inputs()
     draw_dir = Path(draw) if draw else None
+    with reading(inputs):
+        for given, option in ((out, "--out"), (draw_dir, "--draw")):
+            if given is not None:
+                refuse_input(given, option)
+        if out is not None and out.suffix.lower() in IMAGE_EXTENSIONS | VIDEO_EXTENSIONS:
+            raise UserError(f"--out {out} names an image or video; detect writes JSON Lines")
+        pipeline = build(detector, verifier, classifier, tracker, params, config).pipeline()
     if draw_dir is not None:
         draw_dir.mkdir(parents=True, exist_ok=True)
     sink = flushed_output(out) if out else nullcontext(sys.stdout)
     progress = not quiet and Console(stderr=True).is_terminal  # no bar in redirected logs
-    with sink as stream:
+    partial = out.with_name(out.name + ".partial") if out else None
+    lock = locked_file(out) if out else nullcontext()
+    with lock, writing([out, partial, draw_dir]), sink as stream:
         frames, found, skipped = run_detect(
             pipeline, inputs, stream, draw_dir, every, start, end, workers, progress
         )
@@ -183,7 +211,7 @@ def detect_command(
         f"[bold]{len(skipped)}[/bold] skipped" + (f" -> {out}" if out else "")
     )
     for item in skipped:
-        console.print(f"  skipped {item.source}: {item.reason}", markup=False)
+        console.print(f"  skipped {printable(item.source)}: {item.reason}", markup=False)
     if frames == 0 and skipped:
         console.print(f"error: all {len(skipped)} inputs were skipped", markup=False)
         raise SystemExit(1)

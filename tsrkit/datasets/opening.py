@@ -16,6 +16,7 @@ from tsrkit.datasets.errors import DatasetError
 from tsrkit.datasets.registry import DatasetEntry, load_registry
 from tsrkit.datasets.states import check_mapping, to_state
 from tsrkit.errors import TsrkitError
+from tsrkit.files import not_regular
 from tsrkit.registry import get_registry
 from tsrkit.types import Annotation, Dataset
 
@@ -111,6 +112,9 @@ def detect_format(path: Path) -> str:
     TsrkitError
         When none or several match, naming them and asking for ``--format``.
     """
+    problem = None if Path(path).is_dir() else not_regular(path)
+    if problem:
+        raise DatasetError(path, problem)
     matched = [
         info.name
         for info in get_registry().plugins("format")
