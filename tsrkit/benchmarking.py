@@ -15,6 +15,8 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import shutil
+import tempfile
 import time
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import replace
@@ -108,12 +110,26 @@ def evaluate(
     metrics = metrics_for(settings)
     kept: list[FrameRecord] = []
     skipped: list[dict[str, str]] = []
+    resized: list[str] = []
     start = time.perf_counter()
     for record in records:
         if record.skipped is not None:
             skipped.append({"source": record.source, "reason": record.skipped})
             continue
         sample = dataset.samples[record.index]
+        if (
+            sample.width
+            and sample.height
+            and (sample.width, sample.height)
+            != (
+                record.width,
+                record.height,
+            )
+        ):
+            resized.append(
+                f"{Path(sample.source).name} declares {sample.width}x{sample.height}, "
+                f"the file is {record.width}x{record.height}"
+            )
         for metric in metrics:
             metric.update(sample, record)
         kept.append(record)
@@ -131,6 +147,11 @@ def evaluate(
     notes = [] if settings.exhaustive else [not_exhaustive_note(dataset.name)]
     counted = sections.get("frame_notes", {}).get("counts", {})
     notes += [f"{n} of {len(kept)} frames: {text}" for text, n in counted.items()]
+    if resized:
+        notes.append(
+            f"{len(resized)} of {len(kept)} frames: the annotation file declares another size "
+            f"than the image's (first: {resized[0]}); their boxes are evaluated as given"
+        )
 
     def report(files: Sequence[str]) -> dict[str, Any]:
         return build_report(
@@ -144,10 +165,29 @@ def evaluate(
     run = replace(run, report=report([f for w in chosen for f in w.files(run)]))
     folder = Path(out)
     folder.mkdir(parents=True, exist_ok=True)
-    remove_stale_files(folder, {*run.report["files"], *run.report["plots"]})
-    for writer in chosen:
-        writer.write(run, folder)
+    with staged(folder) as staging:
+        for writer in chosen:
+            writer.write(run, staging)
+        remove_stale_files(folder, {*run.report["files"], *run.report["plots"]})
     return run
+
+
+@contextlib.contextmanager
+def staged(folder: Path):
+    """A hidden folder inside ``folder`` for the writers; when they all succeed, each file it
+    holds replaces its namesake in ``folder`` (renames, no copies). When one fails, the staged
+    files are removed and ``folder`` keeps the previous run whole: old and new files are never
+    mixed."""
+    staging = Path(tempfile.mkdtemp(prefix=".writing-", dir=folder))
+    try:
+        yield staging
+        for path in sorted(staging.rglob("*")):
+            if path.is_file():
+                target = folder / path.relative_to(staging)
+                target.parent.mkdir(parents=True, exist_ok=True)
+                os.replace(path, target)
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
 
 
 def remove_stale_files(folder: Path, keep: set[str]) -> list[str]:

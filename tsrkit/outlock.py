@@ -2,13 +2,15 @@
 
 A second run into the same ``--out`` while the first is alive refuses with one clear line; a
 lock left by a killed run (its process is gone) is taken over, and the temporary files a killed
-run left (``.NAME.*.tmp`` of :func:`tsrkit.atomic.atomic_open`) are removed then.
+run left (``.NAME.*.tmp`` of :func:`tsrkit.atomic.atomic_open`, the writers' ``.writing-*``
+folder of :func:`tsrkit.benchmarking.staged`) are removed then.
 """
 
 from __future__ import annotations
 
 import contextlib
 import os
+import shutil
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -49,6 +51,8 @@ def locked(folder: str | os.PathLike) -> Iterator[Path]:
     def clean() -> None:
         for leftover in folder.rglob(".*.tmp"):
             leftover.unlink(missing_ok=True)
+        for staging in folder.glob(".writing-*"):  # a killed run's unfinished report files
+            shutil.rmtree(staging, ignore_errors=True)
 
     with _held(folder / LOCK, f"{folder}: another run (process {{}}) is writing here", clean):
         yield folder

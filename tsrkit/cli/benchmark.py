@@ -253,6 +253,8 @@ def benchmark_command(
             ),
         )
     print_table([report])
+    for note in report.get("notes", []):
+        click.echo(f"note: {note}", err=True)
     click.echo(f"report: {os.path.join(out, 'report.json')}", err=True)
     if report["frames"] == 0 and report["skipped"]:
         click.echo(f"error: all {len(report['skipped'])} inputs were skipped", err=True)

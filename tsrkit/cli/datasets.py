@@ -12,6 +12,7 @@ from rich.console import Console
 from rich.table import Table
 
 from tsrkit.cli.completion import dataset_names, plugin_names
+from tsrkit.cli.drive import drive_command
 from tsrkit.cli.synth import synth_command
 from tsrkit.datasets import (
     DatasetError,
@@ -47,6 +48,7 @@ def datasets_group() -> None:
       tsrkit datasets info roboflow_traffic_light_kr
       tsrkit datasets convert roboflow_traffic_light_kr --to yolo --out kr-yolo/
       tsrkit datasets synth --out synth/ --frames 100
+      tsrkit datasets drive --out city/          # video, GPS log and map for tsrkit track
     """
 
 
@@ -242,3 +244,4 @@ def _present(entry) -> str:
 
 
 datasets_group.add_command(synth_command)
+datasets_group.add_command(drive_command)

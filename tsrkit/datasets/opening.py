@@ -83,7 +83,8 @@ def read_dataset(path: Path, format: str, images: Path | None = None) -> Dataset
     DatasetError
         A malformed file: the reader's own error, or one made here of what a reader let
         through (invalid UTF-8, values of the wrong type, a box that is not finite or has no
-        area), naming the file and the problem.
+        area, or lies wholly outside the image size its sample declares), naming the file and
+        the problem.
     """
     reader = get_registry().create("format", format)
     try:
@@ -100,6 +101,12 @@ def read_dataset(path: Path, format: str, images: Path | None = None) -> Dataset
                 where = f"{Path(sample.source).name}, box {k}"
                 raise DatasetError(
                     path, f"box {tuple(ann.bbox)} is not finite or has no area", where
+                )
+            w, h = sample.width, sample.height
+            if w and h and (x0 >= w or y0 >= h or x1 <= 0 or y1 <= 0):
+                where = f"{Path(sample.source).name}, box {k}"
+                raise DatasetError(
+                    path, f"box {tuple(ann.bbox)} lies outside the {w}x{h} image", where
                 )
     return dataset
 
