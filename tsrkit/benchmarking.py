@@ -28,6 +28,7 @@ import numpy as np
 from tsrkit.engine import BenchmarkError, Job, default_cache_dir, plugin_identity, run_records
 from tsrkit.eval.settings import EvalSettings, not_exhaustive_note, resolve_box
 from tsrkit.outlock import locked
+from tsrkit.outputs import refuse_input
 from tsrkit.plugin import Classifier, Detector, Metric, ReportWriter, Verifier
 from tsrkit.records import FrameRecord
 from tsrkit.registry import get_registry
@@ -177,15 +178,18 @@ def staged(folder: Path):
     """A hidden folder inside ``folder`` for the writers; when they all succeed, each file it
     holds replaces its namesake in ``folder`` (renames, no copies). When one fails, the staged
     files are removed and ``folder`` keeps the previous run whole: old and new files are never
-    mixed."""
+    mixed. A file that would replace one of the run's inputs (:func:`tsrkit.outputs.reading`)
+    refuses the whole move."""
     staging = Path(tempfile.mkdtemp(prefix=".writing-", dir=folder))
     try:
         yield staging
-        for path in sorted(staging.rglob("*")):
-            if path.is_file():
-                target = folder / path.relative_to(staging)
-                target.parent.mkdir(parents=True, exist_ok=True)
-                os.replace(path, target)
+        moves = [(p, folder / p.relative_to(staging)) for p in sorted(staging.rglob("*"))]
+        moves = [(source, target) for source, target in moves if source.is_file()]
+        for _, target in moves:
+            refuse_input(target, "a report file")  # before anything is replaced
+        for source, target in moves:
+            target.parent.mkdir(parents=True, exist_ok=True)
+            os.replace(source, target)
     finally:
         shutil.rmtree(staging, ignore_errors=True)
 

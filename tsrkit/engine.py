@@ -18,6 +18,7 @@ import time
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, TypeVar
@@ -32,7 +33,7 @@ from tsrkit.plugin import Classifier, Detector, Plugin, Verifier
 from tsrkit.records import FrameRecord
 from tsrkit.registry import PluginNotFound, get_registry
 from tsrkit.types import Candidate, Frame, Sample
-from tsrkit.workers import check_workers, end_with_run
+from tsrkit.workers import check_workers, end_with_run, pool_broke
 
 __all__ = [
     "ENGINES",
@@ -252,12 +253,15 @@ def run_records(
             initializer=_init_worker,
             initargs=(job, os.getpid()),
         ) as pool:
-            yield from ordered(
-                lambda i, s: pool.submit(_run_in_worker, i, s),
-                lambda f: f.result(),
-                samples,
-                4 * workers,
-            )
+            try:
+                yield from ordered(
+                    lambda i, s: pool.submit(_run_in_worker, i, s),
+                    lambda f: f.result(),
+                    samples,
+                    4 * workers,
+                )
+            except BrokenProcessPool as exc:
+                raise pool_broke(exc) from None
 
 
 #: A Dask scheduler address: ``host:port`` with an optional ``protocol://``.

@@ -26,8 +26,8 @@ MAX_TEXT_BYTES = 2 * 2**30
 MAX_CONFIG_BYTES = 2**20
 #: The deepest nesting of lists and mappings accepted in JSON and YAML.
 MAX_DEPTH = 100
-#: The most YAML alias uses accepted in one document.
-MAX_ALIASES = 100
+#: The most values (scalars and collections, aliases expanded) one YAML document may hold.
+MAX_VALUES = 1_000_000
 
 _KINDS = (
     (stat.S_ISFIFO, "a FIFO"),
@@ -206,11 +206,12 @@ class _UniqueKeyLoader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):  # type: 
 
 
 def loads_yaml(text: str, path: str | os.PathLike) -> Any:
-    """Parse a YAML document safely: no Python objects, nesting at most :data:`MAX_DEPTH`,
-    at most :data:`MAX_ALIASES` alias uses, no repeated key.
+    """Parse a YAML document safely: no Python objects, nesting at most :data:`MAX_DEPTH`, at
+    most :data:`MAX_VALUES` values once its aliases are expanded, no repeated key.
 
-    The bounds are checked on the parser's events before anything is built, so an alias bomb
-    or a deeply nested document costs one linear pass.
+    The bounds are checked on the parser's events before anything is built (each anchor's
+    expanded size is counted once), so an alias bomb or a deeply nested document costs one
+    linear pass.
 
     Raises
     ------
@@ -227,21 +228,33 @@ def loads_yaml(text: str, path: str | os.PathLike) -> Any:
     tsrkit.files.InputFileError: c.yaml: line 2: not valid YAML (key 'a' appears twice)
     """
     loader = _UniqueKeyLoader
-    depth = aliases = 0
+    depth, sizes, counts = 0, {}, [0]  # values per open collection; anchors' expanded sizes
+    anchors: list[str | None] = []
     try:
         for event in yaml.parse(text, Loader=loader):
             if isinstance(event, (yaml.MappingStartEvent, yaml.SequenceStartEvent)):
                 depth += 1
                 if depth > MAX_DEPTH:
                     raise InputFileError(path, f"nested deeper than {MAX_DEPTH} levels")
+                counts.append(0)
+                anchors.append(event.anchor)
             elif isinstance(event, (yaml.MappingEndEvent, yaml.SequenceEndEvent)):
                 depth -= 1
+                size = counts.pop() + 1
+                anchor = anchors.pop()
+                if anchor is not None:
+                    sizes[anchor] = size
+                counts[-1] += size
+            elif isinstance(event, yaml.ScalarEvent):
+                counts[-1] += 1
+                if event.anchor is not None:
+                    sizes[event.anchor] = 1
             elif isinstance(event, yaml.AliasEvent):
-                aliases += 1
-                if aliases > MAX_ALIASES:
-                    raise InputFileError(
-                        path, f"more than {MAX_ALIASES} YAML aliases (*name); expand them"
-                    )
+                counts[-1] += sizes.get(event.anchor, 1)
+            if counts[-1] > MAX_VALUES:
+                raise InputFileError(
+                    path, f"expands to more than {MAX_VALUES:,} values (through YAML aliases?)"
+                )
         return yaml.load(text, Loader=loader)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from tsrkit.errors import TsrkitError
-from tsrkit.files import InputFileError, read_yaml
+from tsrkit.files import InputFileError, not_regular, read_yaml
 
 if TYPE_CHECKING:
     from tsrkit.plugin import Plugin
@@ -257,6 +257,10 @@ def _convert(kind: str, value: Any) -> Any:
     if kind in ("str", "path"):
         if not isinstance(value, str):
             raise ValueError("not a string")
+        if kind == "path" and os.path.exists(value) and not os.path.isdir(value):
+            problem = not_regular(value)
+            if problem:  # a FIFO or device would block whatever reads it
+                raise ValueError(problem)
         return value
     element = "int" if kind == "ints" else "float"
     if isinstance(value, str):

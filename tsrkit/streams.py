@@ -13,13 +13,14 @@ from __future__ import annotations
 import os
 from collections.abc import Iterable, Iterator
 from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 
 from tsrkit.engine import ordered, pool_context, single_thread
 from tsrkit.errors import TsrkitError
 from tsrkit.inputs import Work, iter_frames, plan_work, read_work
 from tsrkit.pipeline import FrameResult, Pipeline
 from tsrkit.types import Frame, Skipped
-from tsrkit.workers import check_workers, end_with_run
+from tsrkit.workers import check_workers, end_with_run, pool_broke
 
 __all__ = ["CHUNK_FRAMES", "process_frame", "run_pipeline"]
 
@@ -81,14 +82,19 @@ def run_pipeline(
         initializer=_init_worker,
         initargs=(pipeline, every, os.getpid()),
     ) as pool:
-        for results in ordered(
-            lambda _, unit: unit if isinstance(unit, Skipped) else pool.submit(_process_work, unit),
-            lambda done: [done] if isinstance(done, Skipped) else done.result(),
-            units,
-            4 * workers,
-        ):
-            for result in results:
-                yield result, None
+        try:
+            for results in ordered(
+                lambda _, unit: (
+                    unit if isinstance(unit, Skipped) else pool.submit(_process_work, unit)
+                ),
+                lambda done: [done] if isinstance(done, Skipped) else done.result(),
+                units,
+                4 * workers,
+            ):
+                for result in results:
+                    yield result, None
+        except BrokenProcessPool as exc:
+            raise pool_broke(exc) from None
 
 
 _WORKER: tuple[Pipeline, int] | None = None

@@ -41,6 +41,15 @@ def check_workers(workers: int, option: str = "--workers") -> int:
     return workers
 
 
+def pool_broke(exc: BaseException) -> TsrkitError:
+    """The one-line error for a worker pool whose processes died (``BrokenProcessPool``): most
+    often a script that starts a run at import time, which each worker re-imports."""
+    return TsrkitError(
+        f"the worker processes died ({exc}); in a script, start the run under "
+        "'if __name__ == \"__main__\":' (each worker imports the script), or use workers=1"
+    )
+
+
 def end_with_run(run: int, poll: float = 1.0) -> None:
     """In a worker process: end it (``os._exit``) once the run's process ``run`` is gone.
 
