@@ -264,8 +264,8 @@ def run_records(
                 raise pool_broke(exc) from None
 
 
-#: A Dask scheduler address: ``host:port`` with an optional ``protocol://``.
-SCHEDULER_ADDRESS = re.compile(r"([a-z]+://)?(\[[0-9a-fA-F:]+\]|[^\s:/\[\]]+):\d{1,5}")
+#: A Dask scheduler address: ``protocol://...`` or ``host:port``.
+SCHEDULER_ADDRESS = re.compile(r"[a-z]+://\S+|(\[[0-9a-fA-F:]+\]|[^\s:/\[\]]+):\d{1,5}")
 
 
 def _run_dask(

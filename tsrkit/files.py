@@ -13,17 +13,30 @@ from __future__ import annotations
 import json
 import os
 import stat
-from pathlib import Path
 from typing import Any
 
 import yaml
 
 from tsrkit.errors import TsrkitError
 
+__all__ = [
+    "MAX_DEPTH",
+    "MAX_TEXT_BYTES",
+    "MAX_VALUES",
+    "InputFileError",
+    "deeper_than",
+    "file_size",
+    "loads_json",
+    "loads_yaml",
+    "not_regular",
+    "read_bytes",
+    "read_json",
+    "read_text",
+    "read_yaml",
+]
+
 #: The largest text file read (annotation files, GPS logs, maps), in bytes.
 MAX_TEXT_BYTES = 2 * 2**30
-#: The largest run configuration read, in bytes.
-MAX_CONFIG_BYTES = 2**20
 #: The deepest nesting of lists and mappings accepted in JSON and YAML.
 MAX_DEPTH = 100
 #: The most values (scalars and collections, aliases expanded) one YAML document may hold.
@@ -266,19 +279,3 @@ def loads_yaml(text: str, path: str | os.PathLike) -> Any:
 def read_yaml(path: str | os.PathLike, limit: int = MAX_TEXT_BYTES) -> Any:
     """:func:`read_text` then :func:`loads_yaml`."""
     return loads_yaml(read_text(path, limit), path)
-
-
-def same_file(a: str | os.PathLike, b: str | os.PathLike) -> bool:
-    """Whether two paths name one existing file or folder (hard and symbolic links included).
-
-    Examples
-    --------
-    >>> same_file("/", "/.")
-    True
-    >>> same_file("/", "/nonexistent")
-    False
-    """
-    try:
-        return os.path.samefile(a, b)
-    except OSError:
-        return Path(a).resolve() == Path(b).resolve() and Path(a).exists()

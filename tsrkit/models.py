@@ -131,10 +131,13 @@ def load_model(path: str | os.PathLike, plugin: str) -> Model:
             raise ModelError(f"model {p}: {problem}")
     try:
         file_size(npz_path, MAX_MODEL_BYTES)
-        meta = json.loads(read_text(json_path, MAX_MODEL_BYTES))
     except InputFileError as exc:
         raise ModelError(f"model {exc}") from None
-    except (OSError, json.JSONDecodeError, RecursionError) as exc:
+    try:
+        meta = json.loads(read_text(json_path, MAX_MODEL_BYTES))
+    except InputFileError as exc:
+        raise ModelError(f"model {json_path}: unreadable metadata ({exc.problem})") from None
+    except (json.JSONDecodeError, RecursionError) as exc:
         raise ModelError(f"model {json_path}: unreadable metadata ({exc})") from None
     if (
         not isinstance(meta, dict)

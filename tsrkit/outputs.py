@@ -17,6 +17,16 @@ from collections.abc import Iterable, Iterator
 
 from tsrkit.errors import TsrkitError
 
+__all__ = [
+    "OutputIsInput",
+    "dataset_inputs",
+    "is_input",
+    "is_output",
+    "reading",
+    "refuse_input",
+    "writing",
+]
+
 _INPUTS: contextvars.ContextVar[frozenset[str]] = contextvars.ContextVar(
     "tsrkit_inputs", default=frozenset()
 )

@@ -15,6 +15,8 @@ import time
 
 from tsrkit.errors import TsrkitError
 
+__all__ = ["WORKERS_PER_CORE", "check_workers", "end_with_run", "max_workers", "pool_broke"]
+
 #: Worker processes per core at most: more only adds memory and switching.
 WORKERS_PER_CORE = 4
 

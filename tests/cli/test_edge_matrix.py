@@ -126,7 +126,7 @@ SPECIAL: list[Row] = [
             f"model={fifo(tmp / 'm.npz')}",
         ],
         2,
-        "m.npz: not a regular file",
+        "not a regular file \\(a FIFO\\)",
     ),
     (
         "device-verifier-model",
@@ -139,7 +139,7 @@ SPECIAL: list[Row] = [
             f"verifier.model={link(tmp / 'v.npz', '/dev/zero')}",
         ],
         2,
-        "v.npz: not a regular file",
+        "not a regular file \\(a character device\\)",
     ),
     (
         "fifo-annotations",
@@ -390,7 +390,16 @@ PARAMS: list[Row] = [
     ),
     (
         "param-model-folder",
-        lambda tmp: ["detect", str(folder(tmp)), "-c", "ab-hist", "-p", f"model={tmp}"],
+        lambda tmp: [
+            "detect",
+            str(folder(tmp)),
+            "-d",
+            "gray-tophat",
+            "-c",
+            "ab-hist",
+            "-p",
+            f"model={tmp}",
+        ],
         2,
         "model",
     ),

@@ -11,6 +11,8 @@ import click
 from tsrkit.errors import TsrkitError
 from tsrkit.synth.drive import MOVEMENTS
 
+__all__ = ["drive_command"]
+
 
 @click.command("drive")
 @click.option(

@@ -186,8 +186,8 @@ def track_command(
             raise UserError(f"{given}: {problem}")
     track = read_track(gps)
     signals = read_signals(osm)
-    if not len(signals):
-        raise UserError(f"{osm}: no traffic signal (highway=traffic_signals node) in the map")
+    if len(track) < 2:  # one fix has no direction: no movement through an intersection
+        raise UserError(f"{gps}: one GPS fix only; a track needs at least two GPS fixes")
     console = Console()
     if video is not None:
         from tsrkit.spatiotemporal.run import TrackSettings
@@ -206,6 +206,7 @@ def track_command(
             console,
         )
         return
+    no_signals(signals, osm)
     found = traversals(track, signals, vicinity)
     table = Table(
         title=f"{len(found)} traversals of {len(signals)} intersections ({len(track)} fixes)"
@@ -248,6 +249,7 @@ def _track_video(
     selection = build(*plugins)
     truth_frames = read_truth(truth) if truth else None
     fps, count = video_facts(video)
+    no_signals(signals, signals.source)
     start = float(track.time[0]) if start_utc is None else start_utc
     if start > track.time[-1] or start + count / max(fps, 1e-9) < track.time[0]:
         raise UserError(
@@ -314,6 +316,12 @@ def _track_video(
     _print_traversals(console, records, evaluations, count, total, elapsed)
     if out is not None:
         console.print(f"-> {out}/traversals.jsonl, report.json, report.md, vicinity.png, plots/")
+
+
+def no_signals(signals, osm) -> None:
+    """Refuse a map without a signalised intersection: every run on it finds nothing."""
+    if not len(signals):
+        raise UserError(f"{osm}: no traffic signal (highway=traffic_signals node) in the map")
 
 
 def _summary_rows(records, evaluations) -> tuple[list[str], list[list[str]]]:

@@ -171,7 +171,7 @@ def read_track(path: str | os.PathLike) -> Track:
     GeoError
         Naming the file and line (GPX: track point): missing file, invalid text, wrong column
         count or tags, a value that is not a number, NaN, a time outside the years 1970-9999,
-        a latitude or longitude out of range, times not increasing, or fewer than two fixes.
+        a latitude or longitude out of range, times not increasing, or no fix at all.
     """
     path = Path(path)
     rows, _ = _rows(path)
@@ -188,7 +188,5 @@ def read_track(path: str | os.PathLike) -> Track:
         if t <= previous:
             raise GeoError(path, "times are not increasing (sort the log)", number)
         previous = t
-    if len(rows) < 2:
-        raise GeoError(path, "one GPS fix only; a track needs at least two GPS fixes")
     columns = np.array([row[1:] for row in rows], np.float64)
     return Track(str(path), columns[:, 0], columns[:, 1], columns[:, 2])
