@@ -16,6 +16,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from tsrkit.errors import TsrkitError
+from tsrkit.workers import alive
 
 __all__ = ["LOCK", "OutputBusy", "locked", "locked_file"]
 
@@ -24,16 +25,6 @@ LOCK = ".tsrkit.lock"
 
 class OutputBusy(TsrkitError):
     """Another live run is writing the same output folder."""
-
-
-def _alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    return True
 
 
 @contextlib.contextmanager
@@ -93,7 +84,7 @@ def _held(lock: Path, busy: str, clean) -> Iterator[None]:
             except OSError:
                 continue  # released meanwhile: try again
             owner = int(text) if text.isdigit() else 0
-            if (owner and owner != os.getpid() and _alive(owner)) or (not text and age < _FRESH):
+            if (owner and owner != os.getpid() and alive(owner)) or (not text and age < _FRESH):
                 raise OutputBusy(
                     busy.format(owner or "starting") + "; wait for it or choose another --out"
                 ) from None

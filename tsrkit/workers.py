@@ -12,10 +12,18 @@ import os
 import signal
 import threading
 import time
+from pathlib import Path
 
 from tsrkit.errors import TsrkitError
 
-__all__ = ["WORKERS_PER_CORE", "check_workers", "end_with_run", "max_workers", "pool_broke"]
+__all__ = [
+    "WORKERS_PER_CORE",
+    "alive",
+    "check_workers",
+    "end_with_run",
+    "max_workers",
+    "pool_broke",
+]
 
 #: Worker processes per core at most: more only adds memory and switching.
 WORKERS_PER_CORE = 4
@@ -62,7 +70,7 @@ def end_with_run(run: int, poll: float = 1.0) -> None:
     server = os.getppid()
 
     def watch() -> None:
-        while _alive(run):
+        while alive(run):
             time.sleep(poll)
         if server != run and os.getppid() == server:
             os.kill(server, signal.SIGTERM)
@@ -71,11 +79,18 @@ def end_with_run(run: int, poll: float = 1.0) -> None:
     threading.Thread(target=watch, name="tsrkit-end-with-run", daemon=True).start()
 
 
-def _alive(pid: int) -> bool:
+def alive(pid: int) -> bool:
+    """Whether process ``pid`` runs: a zombie (ended, not yet reaped by its parent) does not."""
     try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except FileNotFoundError:
         return False
-    except PermissionError:
+    except (OSError, IndexError):  # no /proc: ask the kernel
+        try:
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            return False
+        except PermissionError:
+            return True
         return True
-    return True
+    return state not in ("Z", "X")
