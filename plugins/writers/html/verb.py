@@ -3,67 +3,40 @@ a compare folder) from what the run wrote, without recomputing anything."""
 
 from __future__ import annotations
 
-import dataclasses
-import json
 from pathlib import Path
 
 import click
 
 from tsrkit.atomic import atomic_open
-from tsrkit.errors import TsrkitError
-from tsrkit.records import FrameRecord
-from tsrkit.report import RunResult, headline, title
-
-
-def load_run(folder: Path) -> RunResult:
-    """The :class:`RunResult` of a run folder: its ``report.json``, its ``detections.jsonl``
-    and the dataset re-opened by the name the report gives (``name`` or ``name:split``)."""
-    from tsrkit.benchmarking import eval_settings
-    from tsrkit.datasets import open_dataset
-
-    try:
-        report = json.loads((folder / "report.json").read_text(encoding="utf-8"))
-        lines = (folder / "detections.jsonl").read_text(encoding="utf-8").splitlines()
-    except FileNotFoundError as exc:
-        raise TsrkitError(
-            f"{folder}: not a run folder ({Path(exc.filename).name} missing)"
-        ) from None
-    except ValueError as exc:
-        raise TsrkitError(f"{folder}/report.json: not valid JSON ({exc})") from None
-    name, _, split = report["dataset"]["name"].partition(":")
-    dataset = open_dataset(name)
-    if split:
-        dataset = dataset.split(split)
-    index = {s.source: k for k, s in enumerate(dataset.samples)}
-    records = []
-    for line in lines:
-        record = FrameRecord.from_json(json.loads(line))
-        if record.skipped is None and record.source in index:
-            records.append(dataclasses.replace(record, index=index[record.source]))
-    settings = eval_settings(dataset, True, 0.5, report.get("evaluated_box") or "auto")
-    return RunResult(report, dataset, settings, tuple(records))
+from tsrkit.eval.stats import format_p
+from tsrkit.report import headline_rows, title
+from tsrkit.runfolder import load_run, read_report
 
 
 def compare_page(folder: Path) -> str:
     """``compare.html``: the runs side by side, the paired tests, links to each run's page."""
     from tsrkit_plugins.writers.html import SCRIPT, STYLE, table
 
-    data = json.loads((folder / "compare.json").read_text(encoding="utf-8"))
+    data = read_report(folder / "compare.json")
     reports = data["reports"]
-    labels = list(headline(reports[0]))
-    rows = [[title(r), *headline(r).values()] for r in reports]
+    columns, values = headline_rows(reports)
+    rows = [[title(r), *row] for r, row in zip(reports, values)]
     tests = [
-        [str(t.get(k, "")) for k in ("a", "b", "metric", "verdict", "p_value", "frames")]
-        for t in data.get("paired_tests", [])
+        [
+            *(str(t.get(k, "")) for k in ("a", "b", "metric", "verdict")),
+            format_p(t.get("p_value")),
+            str(t.get("frames", "")),
+        ]
+        for t in data.get("paired_tests", []) + data.get("verifier_tests", [])
     ]
     links = "".join(
         f'<li><a href="{d}/report.html">{d}</a></li>'
-        for d in data["detectors"]
+        for d in data.get("runs", data["detectors"])
         if (folder / d / "report.html").is_file()
     )
     body = (
         f"<h1>compare on {data['dataset']}</h1>"
-        + table("runs", ["run", *labels], rows)
+        + table("runs", ["run", *(f.label for f in columns)], rows)
         + "<h2>Paired tests</h2>"
         + table("tests", ["a", "b", "metric", "verdict", "p", "frames"], tests)
         + f"<h2>Each run</h2><ul>{links}</ul>"
