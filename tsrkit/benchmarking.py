@@ -34,6 +34,15 @@ from tsrkit.report import REPORT_KEYS, ProgressBar, RunResult, build_report, ord
 from tsrkit.runfolder import write_run
 from tsrkit.types import Dataset
 
+__all__ = [
+    "benchmark",
+    "eval_settings",
+    "evaluate",
+    "metrics_for",
+    "run_benchmark",
+    "writers_for",
+]
+
 
 def eval_settings(
     dataset: Dataset, detection: bool = True, iou_threshold: float = 0.5, box: str = "auto"

@@ -22,12 +22,36 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 
 from tsrkit.eval.guard import Failure
-from tsrkit.eval.results import Figure, MetricResult
+from tsrkit.eval.results import Figure, MetricResult, fmt
 from tsrkit.eval.runfacts import run_facts
 from tsrkit.eval.settings import EvalSettings
 from tsrkit.plugin import Metric
 from tsrkit.records import FrameRecord
 from tsrkit.types import Dataset, Sample
+
+__all__ = [
+    "LEGACY_METRICS",
+    "REPORT_KEYS",
+    "DrawnPlots",
+    "ProgressBar",
+    "RunResult",
+    "build_report",
+    "figure_notes",
+    "fmt",
+    "heading",
+    "headline",
+    "headline_rows",
+    "legacy_metrics",
+    "markdown_cell",
+    "markdown_table",
+    "ordered",
+    "print_table",
+    "report_table",
+    "run_results",
+    "title",
+    "versions",
+    "with_outputs",
+]
 
 #: The keys of ``report.json`` the core writes; no metric may write a section of these names.
 REPORT_KEYS = frozenset(

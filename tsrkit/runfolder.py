@@ -22,6 +22,17 @@ from tsrkit.records import FrameRecord
 from tsrkit.report import RunResult, run_results
 from tsrkit.types import Dataset
 
+__all__ = [
+    "ReportBuilder",
+    "load_run",
+    "read_comparison",
+    "read_records",
+    "read_report",
+    "remove_stale_files",
+    "reopen",
+    "write_run",
+]
+
 #: Builds the run's report from the files the writers write and the failures so far.
 ReportBuilder = Callable[[Sequence[str], Sequence[Failure]], dict[str, Any]]
 
@@ -156,6 +167,24 @@ def read_report(path: Path) -> dict[str, Any]:
         raise TsrkitError(f"{path}: not valid JSON ({exc})") from None
     if not isinstance(data, dict) or "dataset" not in data:
         raise TsrkitError(f"{path}: not a tsrkit report (no 'dataset' entry)")
+    return data
+
+
+def read_comparison(folder: Path) -> dict[str, Any]:
+    """A compare folder's ``compare.json``: the runs' reports side by side and the tests.
+
+    Raises
+    ------
+    TsrkitError
+        Missing, empty or not JSON, or without its ``reports`` (a list of run reports).
+    """
+    path = folder / "compare.json"
+    data = read_report(path)
+    reports = data.get("reports")
+    if not isinstance(reports, list) or not reports:
+        raise TsrkitError(f"{path}: not a tsrkit comparison (no 'reports' list)")
+    if not all(isinstance(r, dict) and isinstance(r.get("dataset"), dict) for r in reports):
+        raise TsrkitError(f"{path}: not a tsrkit comparison (a report without its dataset)")
     return data
 
 

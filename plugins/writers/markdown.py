@@ -6,9 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from tsrkit import ReportWriter, RunResult, hookimpl
-from tsrkit.atomic import atomic_open
-from tsrkit.report import heading, markdown_table
+from tsrkit.api import ReportWriter, RunResult, atomic_open, heading, hookimpl, markdown_table
 
 
 class MarkdownSummary(ReportWriter):

@@ -5,8 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from tsrkit import ReportWriter, RunResult, hookimpl
-from tsrkit.atomic import atomic_open
+from tsrkit.api import ReportWriter, RunResult, atomic_open, hookimpl
 
 
 class Plots(ReportWriter):

@@ -18,6 +18,27 @@ from tsrkit.eval.results import MetricResult, Plot, Table, fmt
 if TYPE_CHECKING:
     from matplotlib.figure import Figure as MplFigure
 
+__all__ = [
+    "CATEGORY_BARS",
+    "CELL",
+    "PRECISION_BOUNDS",
+    "RADIUS_BIN_STARTS",
+    "CategoriesResult",
+    "LightingBySize",
+    "bubble_size",
+    "category_table",
+    "counts_table",
+    "draw_bubbles",
+    "draw_category_bars",
+    "means_table",
+    "precision_bound",
+    "radius_bin",
+    "radius_label",
+    "recall_label",
+    "recall_sort_key",
+    "row_name",
+]
+
 #: Lower bounds (percent) of the precision columns; Table 5-2 uses a subset of these 5 % steps.
 PRECISION_BOUNDS = tuple(range(0, 101, 5))
 #: Lower bounds of the max-radius rows. Zheng's Table 5-2 has one row per pixel of radius (2-9 px

@@ -24,6 +24,18 @@ from tsrkit.types import Sample
 if TYPE_CHECKING:
     from matplotlib.figure import Figure as MplFigure
 
+__all__ = [
+    "ABOUT",
+    "CATEGORY",
+    "CocoAP",
+    "CocoResult",
+    "coco_ap",
+    "coco_dataset",
+    "coco_frame",
+    "coco_run",
+    "draw_pr_curve",
+]
+
 CATEGORY = {"id": 1, "name": "traffic_light", "supercategory": "traffic_signal"}
 
 

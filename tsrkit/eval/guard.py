@@ -25,6 +25,18 @@ from tsrkit.plugin import Metric, Plugin
 from tsrkit.records import FrameRecord
 from tsrkit.types import Sample
 
+__all__ = [
+    "MESSAGE_CHARS",
+    "PLOT_NAME",
+    "Failure",
+    "GuardedMetrics",
+    "MetricFault",
+    "check_rendering",
+    "checked",
+    "clashes",
+    "merge_into",
+]
+
 #: What a plot's file name may be (it is written under ``plots/``).
 PLOT_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]*\.png")
 #: Longest error message kept in a failure (a message can be a whole traceback or data dump).

@@ -12,6 +12,8 @@ from tsrkit.plugin import Metric
 from tsrkit.records import FrameRecord
 from tsrkit.types import Sample
 
+__all__ = ["FrameNotes", "FrameNotesResult"]
+
 
 @dataclass(frozen=True)
 class FrameNotesResult(MetricResult):

@@ -23,6 +23,8 @@ from typing import TYPE_CHECKING, Any, ClassVar
 if TYPE_CHECKING:
     from matplotlib.figure import Figure as MplFigure
 
+__all__ = ["Figure", "MetricResult", "Plot", "Table", "fmt", "scalar_leaves"]
+
 
 def fmt(value: Any, spec: str = ".3f") -> str:
     """A number for a table (``spec`` for floats), or a dash for a missing value.

@@ -10,6 +10,8 @@ from typing import Any, ClassVar
 
 from tsrkit.eval.results import Figure, MetricResult, Table, fmt
 
+__all__ = ["STAGES", "RunFacts", "RunTiming", "SkippedInputs", "run_facts"]
+
 #: The plugin stages of a benchmark report, in pipeline order.
 STAGES = ("detector", "verifier", "classifier")
 

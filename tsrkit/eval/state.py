@@ -24,6 +24,19 @@ from tsrkit.types import STATES, Sample
 if TYPE_CHECKING:
     from matplotlib.figure import Figure as MplFigure
 
+__all__ = [
+    "RATIO_EDGES",
+    "StateMetric",
+    "StateResult",
+    "discriminative_ratio",
+    "draw_confusion",
+    "label_order",
+    "per_class",
+    "ratio_figures",
+    "red_yellow_errors",
+    "state_metrics",
+]
+
 #: Discriminative-ratio bin edges for the misclassification-rate curve (Zheng Figure 5-15).
 RATIO_EDGES = (0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0)
 

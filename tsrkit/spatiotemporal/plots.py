@@ -13,6 +13,8 @@ import numpy as np
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
+__all__ = ["STATE_COLOURS", "draw_timeline", "draw_vicinity"]
+
 STATE_COLOURS = {"red": "#d62728", "yellow": "#e6a800", "green": "#2ca02c"}
 
 

@@ -20,6 +20,14 @@ from tsrkit.eval.runfacts import STAGES
 from tsrkit.report import RunResult, with_outputs
 from tsrkit.spatiotemporal.plots import draw_timeline, draw_vicinity
 
+__all__ = [
+    "ACCURACY_NOTE",
+    "TrackFacts",
+    "TraversalsResult",
+    "summary_rows",
+    "write_track_run",
+]
+
 #: What the accuracy column of the traversal table holds.
 ACCURACY_NOTE = (
     "acc.: temporal accuracy of the true tracks (Zheng 5.4), all candidates / detected ones"

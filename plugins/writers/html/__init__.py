@@ -14,9 +14,7 @@ import html
 from collections.abc import Sequence
 from pathlib import Path
 
-from tsrkit import ReportWriter, RunResult, hookimpl
-from tsrkit.atomic import atomic_open
-from tsrkit.report import heading
+from tsrkit.api import ReportWriter, RunResult, atomic_open, heading, hookimpl
 from tsrkit_plugins.writers.html.gallery import data_uri, gallery
 
 STYLE = """
@@ -150,14 +148,14 @@ class HtmlReport(ReportWriter):
         with atomic_open(folder / "report.html") as fh:
             fh.write(page(run))
 
+    def write_comparison(self, folder: Path) -> list[str]:
+        from tsrkit_plugins.writers.html.compare import compare_page
+
+        with atomic_open(folder / "compare.html") as fh:
+            fh.write(compare_page(folder))
+        return ["compare.html"]
+
 
 @hookimpl
 def register_report_writers(register):
     register(HtmlReport)
-
-
-@hookimpl
-def register_commands(cli):
-    from tsrkit_plugins.writers.html.verb import report_command
-
-    cli.add_command(report_command)

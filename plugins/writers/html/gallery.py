@@ -12,7 +12,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from tsrkit import RunResult
+from tsrkit.api import RunResult
 
 #: Frames shown.
 FRAMES = 8
