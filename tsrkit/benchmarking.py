@@ -13,6 +13,7 @@ them after the metrics are computed.
 from __future__ import annotations
 
 import contextlib
+import functools
 import json
 import os
 import time
@@ -60,8 +61,13 @@ def eval_settings(
 
 def metrics_for(settings: EvalSettings) -> GuardedMetrics:
     """Every registered metric, reset for a new evaluation (one that fails is left out)."""
+    registry = get_registry()
     return GuardedMetrics(
-        {info.name: info.create for info in get_registry().plugins("metric")}, settings
+        {
+            info.name: functools.partial(registry.create, "metric", info.name)
+            for info in registry.plugins("metric")
+        },
+        settings,
     )
 
 
