@@ -35,7 +35,7 @@ The names, by what they are for:
   ``compute`` returns one) with its :class:`Figure` (headline), :class:`Table` and
   :class:`Plot` parts;
 - reports: :class:`RunResult`, :func:`heading`, :func:`headline`, :func:`headline_rows`,
-  :func:`fmt`, :func:`format_p`, :func:`markdown_table`, :func:`title`,
+  :func:`figure_notes`, :func:`fmt`, :func:`format_p`, :func:`markdown_table`, :func:`title`,
   :func:`read_comparison`;
 - scene facts and synthetic scenes: :data:`PANEL_HEIGHT_M`, :func:`distance_from_height`,
   :func:`frame_facts`, :func:`sun_view`, :class:`Track`, :func:`read_track`,

@@ -112,6 +112,7 @@ from tsrkit.records import (
 )
 from tsrkit.report import (
     RunResult as RunResult,
+    figure_notes as figure_notes,
     fmt as fmt,
     heading as heading,
     headline as headline,

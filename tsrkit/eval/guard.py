@@ -117,18 +117,16 @@ class GuardedMetrics:
         entries each metric wrote (``{"name": ["section", "shared_section.key"]}``: a section
         that several metrics fill is listed key by key). ``reserved`` are the report's own keys,
         which no metric may write."""
-        sections: dict[str, Any] = dict.fromkeys(reserved)
+        sections: dict[str, Any] = {}
         results: list[MetricResult] = []
         for metric in self.metrics:
             taken = {p.name for r in results for p in r.plots()}
             ok, result = self._attempt(
-                metric.name, functools.partial(checked, metric, sections, taken)
+                metric.name, functools.partial(checked, metric, sections, taken, reserved)
             )
             if ok:
                 merge_into(sections, result)
                 results.append(result)
-        for key in reserved:
-            del sections[key]
         claims = Counter(section for r in results for section in r.sections)
         written = {
             r.metric: [
@@ -176,11 +174,14 @@ def merge_into(sections: dict[str, Any], result: MetricResult) -> None:
 
 
 def checked(
-    metric: Metric, sections: Mapping[str, Any], plots: Set[str] = frozenset()
+    metric: Metric,
+    sections: Mapping[str, Any],
+    plots: Set[str] = frozenset(),
+    reserved: Set[str] = frozenset(),
 ) -> MetricResult:
     """``metric.compute()`` as its declared result type, named, its rendering checked against
-    the writers' types, its sections against those already in ``sections`` and its plots'
-    names against ``plots`` (those of other metrics).
+    the writers' types, its sections against those already in ``sections`` and the report's
+    own keys (``reserved``), and its plots' names against ``plots`` (those of other metrics).
 
     A plain mapping is taken as the sections of the metric's ``result_type``.
 
@@ -200,6 +201,9 @@ def checked(
         )
     result = dataclasses.replace(result, metric=metric.name)
     check_rendering(result)
+    own = sorted(result.sections.keys() & reserved)
+    if own:
+        raise MetricFault(f"report section '{own[0]}' is the report's own")
     clash = clashes(sections, result)
     if clash:
         raise MetricFault(f"{clash} is already written by another metric")

@@ -7,7 +7,7 @@ from __future__ import annotations
 import html
 from pathlib import Path
 
-from tsrkit.api import fmt, format_p, headline_rows, read_comparison, title
+from tsrkit.api import figure_notes, fmt, format_p, headline_rows, read_comparison, title
 
 #: The columns of the paired-test table: (key of a test, column label).
 TEST_COLUMNS = (
@@ -36,7 +36,7 @@ def compare_page(folder: Path) -> str:
     data = read_comparison(folder)
     reports = data["reports"]
     columns, values = headline_rows(reports)
-    notes = "; ".join(dict.fromkeys(f"{f.label}: {f.about}" for f in columns if f.about))
+    notes = figure_notes(columns)
     header = [label for _, label in TEST_COLUMNS]
     runs = [str(r) for r in data.get("runs") or data.get("detectors") or []]
     name = f"Comparison on {data.get('dataset', '-')}"

@@ -126,7 +126,7 @@ def crops(image: np.ndarray, sample, errors: FrameErrors, box: str) -> list[tupl
     truth = [(a.bbox, GREEN) for a in sample.annotations]
     wanted = [
         *((a.bbox, f"missed {a.state}", []) for a in errors.missed),
-        *((d.box(box), f"false positive ({d.state})", [(d.box(box), RED)]) for d in errors.false),
+        *((d.box(box), _false_label(d.state), [(d.box(box), RED)]) for d in errors.false),
         *((a.bbox, f"{a.state} read as {d.state}", [(d.box(box), BLUE)]) for d, a in errors.wrong),
     ]
     shown = []
@@ -135,6 +135,10 @@ def crops(image: np.ndarray, sample, errors: FrameErrors, box: str) -> list[tupl
         if encoded is not None:
             shown.append((encoded, label))
     return shown
+
+
+def _false_label(state: str) -> str:
+    return "false positive" if state == "unknown" else f"false positive ({state})"
 
 
 def gallery(run: RunResult) -> str:
@@ -156,15 +160,16 @@ def gallery(run: RunResult) -> str:
             f"{Path(sample.source).name}: {len(errors.missed)} missed, {len(errors.false)} "
             f"false positives, {len(errors.hits)} found, {len(errors.wrong)} wrong states"
         )
-        parts = [
-            f'<img class="gallery" alt="{html.escape(caption)}" src="{data_uri(whole, "jpeg")}">'
-        ]
-        parts += [
+        shown = "".join(
             f'<figure class="crop"><img alt="{html.escape(label)}" src="{data_uri(png, "jpeg")}">'
             f"<figcaption>{html.escape(label)}</figcaption></figure>"
             for png, label in crops(image, sample, errors, box)
-        ]
-        figures.append(f'<div class="frame">{"".join(parts)}<p>{html.escape(caption)}</p></div>')
+        )
+        figures.append(
+            f'<div class="frame"><p>{html.escape(caption)}</p>'
+            f'<img class="gallery" alt="{html.escape(caption)}" src="{data_uri(whole, "jpeg")}">'
+            f'<div class="crops">{shown}</div></div>'
+        )
     if not figures:
         return "<p>No frame with a miss or a false positive.</p>"
     return (
