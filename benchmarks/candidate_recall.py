@@ -18,10 +18,9 @@ Run: python benchmarks/candidate_recall.py [--out benchmarks/out/candidate_recal
 
 from __future__ import annotations
 
-import os
+import harness
 
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ[_var] = "1"
+harness.single_thread()
 
 import argparse  # noqa: E402
 import json  # noqa: E402
@@ -29,20 +28,17 @@ import time  # noqa: E402
 from collections.abc import Iterable, Sequence  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
 from tsrkit.datasets import open_datasets  # noqa: E402
 from tsrkit.eval.matching import centre_hits  # noqa: E402
+from tsrkit.params import parse_parts  # noqa: E402
+from tsrkit.registry import get_registry  # noqa: E402
 from tsrkit.types import Candidate, Sample  # noqa: E402
 from tsrkit_plugins.detectors.union import (  # noqa: E402
     DEFAULT_MEMBERS,
-    create_member,
     merge,
-    parse_members,
 )
-
-cv2.setNumThreads(1)
 
 SETS = {
     "KR": "roboflow_traffic_light_kr:test",
@@ -50,7 +46,7 @@ SETS = {
     "DTLD": "dtld_fridtjofs:test",
     "synthetic": "sample:test",
 }
-#: Size bins of r (px), down to the 2-3 px lenses the issue names.
+#: Size bins of r (px), down to lenses of 2-3 px.
 SIZE_BINS = ((0, 2), (2, 3), (3, 4), (4, 6), (6, 12), (12, float("inf")))
 
 
@@ -85,7 +81,8 @@ def recall_by_size(
 
 def run_detector(name: str, params: dict, samples: Sequence[Sample]):
     """Candidates of every sample and the median ms per frame."""
-    detector = create_member(name, params)
+    detector = get_registry().create("detector", "union", {"members": detector_key(name, params)})
+    detector = detector.members[0]
     found, times = [], []
     for sample in samples:
         frame = sample.load()
@@ -116,7 +113,7 @@ def union_variants(members: list, extras: list) -> list[tuple[str, list]]:
 
 
 def measure(extras: list, quick: bool) -> dict:
-    members = parse_members(DEFAULT_MEMBERS)
+    members = parse_parts(DEFAULT_MEMBERS)
     configs = [] if quick else [(name, {}) for name in ("lab-frst", "conspicuity", "gray-tophat")]
     configs += [] if quick else [("adaboost-hsv", {}), ("tl-recognizer", {})]
     configs += [(n, v) for n, v in members if v or quick] + [("gray-tophat", {"n_top": "15"})]
@@ -189,12 +186,13 @@ def main() -> None:
         "--quick", action="store_true", help="skip the detectors at their paper defaults"
     )
     args = parser.parse_args()
+    harness.announce()
     if args.tables:
         print(markdown(json.loads(Path(args.tables).read_text())))
         return
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    extras = [member for text in args.extra for member in parse_members(text)]
+    extras = [member for text in args.extra for member in parse_parts(text)]
     results = measure(extras, args.quick)
     (out / "results.json").write_text(json.dumps(results, indent=1))
     print(markdown(results))

@@ -230,7 +230,7 @@ def _jsonable(value: Any) -> Any:
 
 def _convert(kind: str, value: Any) -> Any:
     if kind in PLUGIN_TYPES:
-        return _spec(kind, value)
+        return _spec(kind, value) or None  # '' names no plugin
     if kind == "bool":
         if isinstance(value, bool):
             return value

@@ -85,3 +85,17 @@ def test_load_config_normalises_plugin_entries(tmp_path):
     path.write_text("classifier: {params: {}}\n")
     with pytest.raises(ParamError, match="'classifier' must be a name"):
         load_config(str(path))
+
+
+def test_plugin_typed_values_are_checked_and_written_one_way():
+    schema = [
+        Param("members", "detectors", "a"),
+        Param("before", "verifier", "housing"),
+    ]
+    values = validate(schema, {"members": " a  k=1 ;b; ", "before": ""}, "p")
+    assert values == {"members": "a k=1; b", "before": None}
+    for bad in ({"members": ""}, {"members": "a k"}, {"before": "a; b"}, {"before": 3}):
+        with pytest.raises(ParamError, match="must be"):
+            validate(schema, bad, "p")
+    with pytest.raises(ValueError, match="only plugin types take options"):
+        Param("k", "int", 1, options=(Param("scale", "float", 1.0),))

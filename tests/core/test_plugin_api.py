@@ -64,9 +64,8 @@ def test_a_plugin_imports_only_its_own_kind_and_the_shared_helpers():
         kind = parts[0]
         allowed = {kind} if kind == "shared" else {kind, "shared"}
         for line, module, _ in imports(path):
-            if module.startswith("tsrkit_plugins."):
-                if module.split(".")[1] not in allowed:
-                    crossing.append(f"{path.relative_to(REPO)}:{line} {module}")
+            if module.startswith("tsrkit_plugins.") and module.split(".")[1] not in allowed:
+                crossing.append(f"{path.relative_to(REPO)}:{line} {module}")
     assert crossing == []
 
 

@@ -130,3 +130,42 @@ def test_plugins_json_lists_a_failing_entry_point(tmp_path):
     failed = [p for p in listing if p["kind"] == "failed" and p["name"] == "broken"]
     assert failed and "module_that_does_not_exist" in failed[0]["error"]
     assert failed[0]["package"] == "broken-plugin"
+
+
+class Stacked(tsrkit.Detector):
+    name = "stacked"
+    summary = "the candidates of the detector it is built on"
+    PARAMS = (Param("inner", "detector", "dummy k=2", options=(Param("share", "float", 1.0),)),)
+
+    def detect(self, frame):
+        return self.params["inner"].plugin.detect(frame)
+
+
+class OldStyle(tsrkit.Detector):
+    name = "old-style"
+    params = (Param("k", "int", 1),)  # the schema's former name
+
+    def detect(self, frame):
+        return []
+
+
+class MorePlugins:
+    @hookimpl
+    def register_detectors(register):
+        register(Stacked)
+        register(OldStyle)
+
+
+def test_a_plugin_receives_the_plugin_it_is_built_on_and_old_schemas_fail_clearly():
+    reg = Registry()
+    reg.add(DummyPlugin, "dummy-plugin")
+    reg.add(MorePlugins, "more")
+    stacked = reg.create("detector", "stacked", {"inner": "dummy k=3 share=0.5"})
+    part = stacked.params["inner"]
+    assert isinstance(part.plugin, Dummy) and part.plugin.params == {"k": 3}
+    assert part.options == {"share": 0.5} and str(part) == "dummy k=3 share=0.5"
+    with pytest.raises(ParamError, match="inner: detector 'dummy': parameter 'k'"):
+        reg.create("detector", "stacked", {"inner": "dummy k=9"})
+    with pytest.raises(ParamError, match="cannot be built on itself"):
+        reg.create("detector", "stacked", {"inner": "stacked"})
+    assert "name the tuple 'PARAMS'" in " ".join(f.error for f in reg.failures)
