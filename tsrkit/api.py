@@ -35,8 +35,8 @@ The names, by what they are for:
   ``compute`` returns one) with its :class:`Figure` (headline), :class:`Table` and
   :class:`Plot` parts;
 - reports: :class:`RunResult`, :func:`heading`, :func:`headline`, :func:`headline_rows`,
-  :func:`figure_notes`, :func:`fmt`, :func:`format_p`, :func:`markdown_table`, :func:`title`,
-  :func:`read_comparison`;
+  :func:`headline_table`, :func:`figure_notes`, :func:`fmt`, :func:`format_p`,
+  :func:`markdown_table`, :func:`title`, :func:`read_comparison`;
 - scene facts and synthetic scenes: :data:`PANEL_HEIGHT_M`, :func:`distance_from_height`,
   :func:`frame_facts`, :func:`sun_view`, :class:`Track`, :func:`read_track`,
   :class:`SynthOptions`, :func:`render_frame`, :func:`scatter_heads`.

@@ -117,6 +117,7 @@ from tsrkit.report import (
     heading as heading,
     headline as headline,
     headline_rows as headline_rows,
+    headline_table as headline_table,
     markdown_table as markdown_table,
     title as title,
 )

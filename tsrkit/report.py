@@ -41,6 +41,7 @@ __all__ = [
     "heading",
     "headline",
     "headline_rows",
+    "headline_table",
     "legacy_metrics",
     "markdown_cell",
     "markdown_table",
@@ -159,6 +160,10 @@ class RunResult:
     def headline(self) -> list[Figure]:
         """Every result's headline figures, in order."""
         return [figure for result in self.results for figure in result.headline()]
+
+    def remarks(self) -> list[str]:
+        """Every result's remarks, in order, each once (two metrics may say the same)."""
+        return list(dict.fromkeys(r for result in self.results for r in result.remarks()))
 
     def plot_images(self) -> dict[str, bytes]:
         """Every result's plots as PNG bytes, by file name, drawn once; a plot that cannot be
@@ -330,6 +335,16 @@ def headline_rows(reports: Sequence[Mapping[str, Any]]) -> tuple[list[Figure], l
             columns.setdefault(key, figure)
     rows = [[row[k].text if k in row else "-" for k in columns] for row in figures]
     return list(columns.values()), rows
+
+
+def headline_table(figures: Sequence[Figure]) -> tuple[list[str], list[list[str]]]:
+    """One run's headline figures as a table: figure, value and, when any figure has one, its
+    95 % interval."""
+    if any(f.interval for f in figures):
+        return ["figure", "value", "95 % interval"], [
+            [f.label, f.text, f.interval_text] for f in figures
+        ]
+    return ["figure", "value"], [[f.label, f.text] for f in figures]
 
 
 def title(report: Mapping[str, Any]) -> str:

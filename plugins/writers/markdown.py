@@ -6,7 +6,15 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from tsrkit.api import ReportWriter, RunResult, atomic_open, heading, hookimpl, markdown_table
+from tsrkit.api import (
+    ReportWriter,
+    RunResult,
+    atomic_open,
+    heading,
+    headline_table,
+    hookimpl,
+    markdown_table,
+)
 
 
 class MarkdownSummary(ReportWriter):
@@ -28,9 +36,8 @@ def summary_markdown(run: RunResult) -> str:
     lines = [f"# {heading(report)}", ""]
     lines += [f"**Note:** {note}\n" for note in report.get("notes", [])]
     if figures:
-        rows = [[f.label, f.text, f.interval_text] for f in figures]
-        lines += [markdown_table(["figure", "value", "95 % interval"], rows), ""]
-    lines += [f"{remark}\n" for result in run.results for remark in result.remarks()]
+        lines += [markdown_table(*headline_table(figures)), ""]
+    lines += [f"{remark}\n" for remark in run.remarks()]
     for result in run.results:
         for table in result.tables():
             lines += [f"## {table.title}", "", markdown_table(table.columns, table.rows), ""]

@@ -268,6 +268,7 @@ def _track_video(
                 "frames": count,
                 "fps": fps,
                 "clip_frames": total,
+                "traversals": len(records),
                 **json.loads(identity(selection, settings)),
                 "timing": {
                     "seconds": round(elapsed, 3),

@@ -4,13 +4,13 @@ and the inputs it skipped. They render like a metric's results, first and last."
 from __future__ import annotations
 
 import json
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
 from tsrkit.eval.results import Figure, MetricResult, Table, fmt
 
-__all__ = ["STAGES", "RunFacts", "RunTiming", "SkippedInputs", "run_facts"]
+__all__ = ["STAGES", "RunFacts", "RunTiming", "SkippedInputs", "description_tables", "run_facts"]
 
 #: The plugin stages of a benchmark report, in pipeline order.
 STAGES = ("detector", "verifier", "classifier")
@@ -35,29 +35,42 @@ class RunFacts(MetricResult):
             ("evaluated box", fmt(self.sections.get("evaluated_box"))),
             ("frames evaluated", fmt(self.sections.get("frames"))),
         ]
-        stages = [(k, self.sections[k]) for k in STAGES if self.sections.get(k)]
-        rows += [(kind, f"{p['name']} {p.get('version', '')}".strip()) for kind, p in stages]
-        parameters = tuple(
-            (kind, key, json.dumps(value))
-            for kind, plugin in stages
-            for key, value in sorted((plugin.get("params") or {}).items())
-        )
-        versions = self.sections.get("versions") or {}
-        tables = [Table("run", "Run", ("", "value"), tuple(rows))]
-        if parameters:
-            tables.append(
-                Table("params", "Parameters", ("stage", "parameter", "value"), parameters)
-            )
-        if versions:
-            tables.append(
-                Table(
-                    "versions",
-                    "Versions",
-                    ("package", "version"),
-                    tuple((k, str(v)) for k, v in versions.items()),
-                )
-            )
-        return tables
+        plugins = {k: self.sections[k] for k in STAGES if self.sections.get(k)}
+        return description_tables(rows, plugins, (), {}, self.sections.get("versions") or {})
+
+
+def description_tables(
+    rows: Sequence[tuple[str, str]],
+    plugins: Mapping[str, Mapping[str, Any]],
+    settings: Sequence[tuple[str, str, str]],
+    timing: Mapping[str, Any],
+    versions: Mapping[str, Any],
+) -> list[Table]:
+    """A run's description as tables: ``Run`` (``rows``, then each plugin's name and version),
+    ``Parameters`` (each plugin's, then ``settings`` rows), ``Timing`` and ``Versions`` (those
+    that are not empty)."""
+    rows = [
+        *rows,
+        *((k, f"{p['name']} {p.get('version', '')}".strip()) for k, p in plugins.items()),
+    ]
+    parameters = [
+        (kind, key, json.dumps(value))
+        for kind, plugin in plugins.items()
+        for key, value in sorted((plugin.get("params") or {}).items())
+    ]
+    parts: list[tuple[str, str, tuple[str, ...], list[tuple[str, ...]]]] = [
+        ("params", "Parameters", ("stage", "parameter", "value"), [*parameters, *settings]),
+        ("timing", "Timing", ("", "value"), [(k, fmt(v, ".2f")) for k, v in timing.items()]),
+        (
+            "versions",
+            "Versions",
+            ("package", "version"),
+            [(k, str(v)) for k, v in versions.items()],
+        ),
+    ]
+    return [Table("run", "Run", ("", "value"), tuple(rows))] + [
+        Table(ident, title, columns, tuple(body)) for ident, title, columns, body in parts if body
+    ]
 
 
 @dataclass(frozen=True)

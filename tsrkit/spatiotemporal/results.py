@@ -16,7 +16,7 @@ import numpy as np
 
 from tsrkit.eval.guard import Failure
 from tsrkit.eval.results import Figure, MetricResult, Plot, Table, fmt
-from tsrkit.eval.runfacts import STAGES
+from tsrkit.eval.runfacts import STAGES, description_tables
 from tsrkit.report import RunResult, with_outputs
 from tsrkit.spatiotemporal.plots import draw_timeline, draw_vicinity
 
@@ -77,43 +77,18 @@ class TrackFacts(MetricResult):
             ("frames", fmt(report.get("frames"))),
             ("frames per second", fmt(report.get("fps"), ".2f")),
             ("frames decoded (the clips)", fmt(report.get("clip_frames"))),
-            *((kind, f"{p['name']} {p.get('version', '')}".strip()) for kind, p in plugins.items()),
         ]
-        parameters = [
-            (kind, key, json.dumps(value))
-            for kind, p in plugins.items()
-            for key, value in sorted((p.get("params") or {}).items())
-        ]
-        parameters += [
+        settings = [
             ("track", key, json.dumps(value))
             for key, value in (report.get("settings") or {}).items()
         ]
-        tables = [Table("run", "Run", ("", "value"), tuple(rows))]
-        if parameters:
-            tables.append(
-                Table("params", "Parameters", ("stage", "parameter", "value"), tuple(parameters))
-            )
-        timing = report.get("timing") or {}
-        if timing:
-            tables.append(
-                Table(
-                    "timing",
-                    "Timing",
-                    ("", "value"),
-                    tuple((k, fmt(v, ".2f")) for k, v in timing.items()),
-                )
-            )
-        versions = report.get("versions") or {}
-        if versions:
-            tables.append(
-                Table(
-                    "versions",
-                    "Versions",
-                    ("package", "version"),
-                    tuple((k, str(v)) for k, v in versions.items()),
-                )
-            )
-        return tables
+        return description_tables(
+            rows,
+            plugins,
+            settings,
+            report.get("timing") or {},
+            report.get("versions") or {},
+        )
 
 
 @dataclass(frozen=True)
@@ -214,9 +189,7 @@ def write_track_run(
     from tsrkit.benchmarking import writers_for
     from tsrkit.runfolder import write_run
 
-    counted = {"traversals": len(records)}
-    if "temporal" in report:
-        counted["temporal"] = report["temporal"]
+    counted = {k: report[k] for k in ("traversals", "temporal") if k in report}
     frames, distance = profile
     traversals = TraversalsResult(counted, "traversals", tuple(records), frames, distance, vicinity)
     run = RunResult(dict(report), results=(TrackFacts(report, "run"), traversals))

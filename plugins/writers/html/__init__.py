@@ -14,7 +14,7 @@ import html
 from collections.abc import Sequence
 from pathlib import Path
 
-from tsrkit.api import ReportWriter, RunResult, atomic_open, heading, hookimpl
+from tsrkit.api import ReportWriter, RunResult, atomic_open, heading, headline_table, hookimpl
 from tsrkit_plugins.writers.html.gallery import data_uri, gallery
 
 STYLE = """
@@ -80,12 +80,8 @@ def results_html(run: RunResult) -> str:
     figures = run.headline()
     parts, idents = [], set()
     if figures:
-        rows = [[f.label, f.text, f.interval_text] for f in figures]
-        parts += [
-            "<h2>Headline</h2>",
-            table("headline", ["figure", "value", "95 % interval"], rows),
-        ]
-    parts += [f"<p>{html.escape(r)}</p>" for result in run.results for r in result.remarks()]
+        parts += ["<h2>Headline</h2>", table("headline", *headline_table(figures))]
+    parts += [f"<p>{html.escape(r)}</p>" for r in run.remarks()]
     for result in run.results:
         for t in result.tables():
             ident = t.ident if t.ident not in idents else f"{result.metric}-{t.ident}"
