@@ -22,17 +22,16 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
-import sys
 import time
 from pathlib import Path
 
-import cv2
+import harness
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+harness.single_thread()
 
 from track_drive import SHORT, rendered  # noqa: E402
 
+from tsrkit.agreement import Agreement  # noqa: E402
 from tsrkit.eval.matching import centre_hits  # noqa: E402
 from tsrkit.follow import Follower  # noqa: E402
 from tsrkit.inputs import iter_video  # noqa: E402
@@ -87,9 +86,7 @@ def score(results, truth: list[dict]) -> dict[str, float]:
             if hitting:
                 hits += 1
                 correct += any(result.detections[i].state == light["state"] for i in hitting)
-        false += sum(
-            1 for i in range(len(centres)) if matrix is None or not matrix[i].any()
-        )
+        false += sum(1 for i in range(len(centres)) if matrix is None or not matrix[i].any())
     return {
         "recall": hits / gradable if gradable else float("nan"),
         "state": correct / hits if hits else float("nan"),
@@ -104,8 +101,9 @@ def main() -> None:
     parser.add_argument("--keys", default="1,2,3,4,6")
     parser.add_argument("--drives", default=",".join(SHORT))
     parser.add_argument("--reach", type=float, default=3.0)
+    parser.add_argument("--confirm", default="1,2,3", help="temporal agreement: frames")
     args = parser.parse_args()
-    cv2.setNumThreads(1)
+    harness.announce()
     keys = [int(k) for k in args.keys.split(",")]
     drives = {}
     for name in args.drives.split(","):
@@ -113,34 +111,38 @@ def main() -> None:
         truth = [json.loads(line) for line in (folder / "truth.jsonl").open()]
         drives[name] = (frames_of(folder / "drive.mp4"), truth)
     total = sum(len(t) for _, t in drives.values())
-    print(f"drives {', '.join(drives)}: {total} frames 480x356; reach {args.reach} radii; "
-          f"load {os.getloadavg()[0]:.1f}\n")  # fmt: skip
-    print("| config | K | CPU ms/frame | speed-up | light recall | state acc. | false lights "
-          "/ frame | key / followed frames | regions |")  # fmt: skip
-    print("|---|---:|---:|---:|---:|---:|---:|---|---:|")
+    print(f"drives {', '.join(drives)}: {total} frames 480x356; reach {args.reach} radii\n")
+    confirms = [int(c) for c in args.confirm.split(",")]
+    print("| config | K | agreement frames | CPU ms/frame | speed-up | light recall | state acc. "
+          "| false lights / frame | key / followed frames | regions |")  # fmt: skip
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---|---:|")
     for config in args.config.split(","):
         base = None
         for k in keys:
-            cpu = 0.0
-            results_all, truth_all = [], []
+            cpu, per_drive = 0.0, []
             calls = {"key": 0, "followed": 0, "regions": 0}
             for frames, truth in drives.values():
                 follower = Follower(build(**CONFIGS[config]).pipeline(), k, args.reach)
                 results, seconds = run(frames, follower)
                 cpu += seconds
-                results_all += results
-                truth_all += truth[: len(results)]
+                per_drive.append((results, truth[: len(results)]))
                 calls = {key: calls[key] + follower.calls[key] for key in calls}
-            figures = score(results_all, truth_all)
-            ms = 1000 * cpu / len(results_all)
+            n = sum(len(r) for r, _ in per_drive)
+            ms = 1000 * cpu / n
             base = base or ms
-            print(
-                f"| {config} | {k} | {ms:.1f} | {base / ms:.2f}x | {figures['recall']:.3f} "
-                f"| {figures['state']:.3f} | {figures['false_per_frame']:.3f} "
-                f"| {calls['key']} / {calls['followed']} | {calls['regions']} |",
-                flush=True,
-            )
-    print(f"\nload after: {os.getloadavg()[0]:.1f}")
+            for confirm in confirms:
+                kept, truth_all = [], []
+                for results, truth in per_drive:
+                    kept += [r for r, _ in Agreement(confirm).filter((r, None) for r in results)]
+                    truth_all += truth
+                figures = score(kept, truth_all)
+                print(
+                    f"| {config} | {k} | {confirm} | {ms:.1f} | {base / ms:.2f}x "
+                    f"| {figures['recall']:.3f} | {figures['state']:.3f} "
+                    f"| {figures['false_per_frame']:.3f} | {calls['key']} / {calls['followed']} "
+                    f"| {calls['regions']} |",
+                    flush=True,
+                )
 
 
 if __name__ == "__main__":

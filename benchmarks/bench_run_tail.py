@@ -139,9 +139,7 @@ def tree_cpu(proc, seen: dict[int, float]) -> None:
         seen[p.pid] = max(seen.get(p.pid, 0.0), times.user + times.system)
 
 
-def measure(
-    tree: Path | None, dataset: Path, workers: int, out: Path, extra: list[str]
-) -> dict:
+def measure(tree: Path | None, dataset: Path, workers: int, out: Path, extra: list[str]) -> dict:
     """One run of the command: wall and CPU seconds, and the phases."""
     import psutil
 

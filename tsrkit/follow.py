@@ -119,9 +119,7 @@ class Follower:
         """
         start = time.perf_counter()
         follows = (
-            self._last is not None
-            and self._last[0] == frame.source
-            and frame.index > self._last[1]
+            self._last is not None and self._last[0] == frame.source and frame.index > self._last[1]
         )
         self._last = (frame.source, frame.index)
         if not follows or self._since_key + 1 >= self.key_every:

@@ -18,15 +18,15 @@ from tsrkit.atomic import atomic_open, json_line
 from tsrkit.cli.common import plugin_options
 from tsrkit.draw import draw_detections
 from tsrkit.errors import TsrkitError
-from tsrkit.pipeline import Pipeline
+from tsrkit.follow import Follower
 from tsrkit.report import ProgressBar
 from tsrkit.selection import build
-from tsrkit.streams import run_pipeline
+from tsrkit.streams import Runner, run_pipeline
 from tsrkit.types import Frame, Skipped
 
 
 def run_detect(
-    pipeline: Pipeline,
+    pipeline: Runner,
     paths,
     out,
     draw: Path | None = None,
@@ -130,6 +130,15 @@ def default_inputs() -> list[str]:
     help="Worker processes; each decodes its own images or 64-frame video chunks.",
 )
 @click.option(
+    "--key-every",
+    type=click.IntRange(min=1),
+    default=1,
+    show_default=True,
+    help="Videos: the whole pipeline on every K-th kept frame only; in between, only around "
+    "the lights of the frame before (a light appearing meanwhile is found at most K-1 frames "
+    "late). 1: the whole pipeline on every frame.",
+)
+@click.option(
     "--quiet",
     "-q",
     is_flag=True,
@@ -149,6 +158,7 @@ def detect_command(
     start,
     end,
     workers,
+    key_every,
     quiet,
 ) -> None:
     """Detect lit signal lenses in images, folders (recursive) or videos.
@@ -165,6 +175,9 @@ def detect_command(
       tsrkit detect frames/ -d conspicuity -p weights=1,1,2 -w 2 -o d.jsonl
     """
     pipeline = build(detector, verifier, classifier, tracker, params, config).pipeline()
+    if key_every > 1 and pipeline.tracker is not None:
+        raise click.UsageError("--key-every and --tracker both carry lights between frames")
+    runner = Follower(pipeline, key_every) if key_every > 1 else pipeline
     inputs = list(paths) or default_inputs()
     draw_dir = Path(draw) if draw else None
     if draw_dir is not None:
@@ -173,7 +186,7 @@ def detect_command(
     progress = not quiet and Console(stderr=True).is_terminal  # no bar in redirected logs
     with sink as stream:
         frames, found, skipped = run_detect(
-            pipeline, inputs, stream, draw_dir, every, start, end, workers, progress
+            runner, inputs, stream, draw_dir, every, start, end, workers, progress
         )
     console = Console(stderr=True, soft_wrap=True)  # one line per skipped input, never wrapped
     console.print(
