@@ -22,6 +22,8 @@ from typing import Any
 from tsrkit.pipeline import FrameResult
 from tsrkit.types import Detection
 
+__all__ = ["MIN_REACH_PX", "Agreement", "Chain", "Held"]
+
 #: The smallest link distance, pixels.
 MIN_REACH_PX = 4.0
 

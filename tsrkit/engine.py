@@ -31,6 +31,27 @@ from tsrkit.records import FrameRecord
 from tsrkit.registry import PluginNotFound, get_registry
 from tsrkit.types import Candidate, Frame, Sample
 
+__all__ = [
+    "ENGINES",
+    "BenchmarkError",
+    "Item",
+    "Job",
+    "Result",
+    "classify_annotations",
+    "compute_record",
+    "default_cache_dir",
+    "image_hash",
+    "ordered",
+    "plugin_identity",
+    "pool_context",
+    "process_sample",
+    "read_cached",
+    "run_records",
+    "single_thread",
+    "source_hash",
+    "start_pool_server",
+]
+
 ENGINES = ("local", "dask")
 Item = TypeVar("Item")
 Result = TypeVar("Result")
@@ -175,9 +196,9 @@ def single_thread() -> None:
 def pool_context():
     """The multiprocessing context of every worker pool: workers fork from a clean fork server
     (forking a process whose OpenCV thread pool has started can crash the child) that has
-    imported the engine and the plugins and initialised numba (:mod:`tsrkit.preload`)."""
+    imported the engine and the plugins and initialised numba (:mod:`tsrkit._preload`)."""
     context = multiprocessing.get_context("forkserver")
-    context.set_forkserver_preload(["tsrkit.engine", "tsrkit.preload"])
+    context.set_forkserver_preload(["tsrkit.engine", "tsrkit._preload"])
     return context
 
 

@@ -26,6 +26,17 @@ import numpy as np
 from tsrkit.pipeline import FrameResult, Pipeline, check_detection
 from tsrkit.types import Candidate, Detection, Frame
 
+__all__ = [
+    "CONTEXT_PX",
+    "CONTEXT_RADII",
+    "MIN_REACH_PX",
+    "Follower",
+    "Light",
+    "light_of",
+    "region",
+    "shifted",
+]
+
 #: The smallest search radius around a light's predicted centre, pixels.
 MIN_REACH_PX = 4.0
 #: Context around the searched disc, in lens radii: a three-lens head reaches about 7 radii

@@ -21,6 +21,8 @@ from tsrkit.inputs import Work, iter_frames, plan_work, read_work
 from tsrkit.pipeline import FrameResult, Pipeline
 from tsrkit.types import Frame, Skipped
 
+__all__ = ["CHUNK_FRAMES", "Runner", "chunk_frames", "process_frame", "run_pipeline"]
+
 #: What runs on each frame: a pipeline, or a follower sharing work between video frames.
 Runner = Pipeline | Follower
 
