@@ -91,6 +91,7 @@ def test_detect_writes_records_and_reports_skips(example_plugin, mixed_folder, t
         (["--param", "colour=red"], "unknown parameter 'colour'"),
         (["--param", "noequals"], "--param expects key=value"),
         (["--classifier", "nope"], "no classifier called 'nope'"),
+        (["--key-every", "3", "--tracker", "meanshift"], "--key-every and --tracker"),
     ],
 )
 def test_bad_input_is_one_line_exit_2(example_plugin, mixed_folder, args, message):

@@ -16,6 +16,7 @@ from rich.console import Console
 
 from tsrkit.atomic import atomic_open, json_line
 from tsrkit.cli.common import plugin_options
+from tsrkit.cli.errors import UserError
 from tsrkit.draw import draw_detections
 from tsrkit.errors import TsrkitError
 from tsrkit.follow import Follower
@@ -178,7 +179,7 @@ def detect_command(
     """
     pipeline = build(detector, verifier, classifier, tracker, params, config).pipeline()
     if key_every > 1 and pipeline.tracker is not None:
-        raise click.UsageError("--key-every and --tracker both carry lights between frames")
+        raise UserError("--key-every and --tracker both carry lights between frames: choose one")
     runner = Follower(pipeline, key_every) if key_every > 1 else pipeline
     inputs = list(paths) or default_inputs()
     draw_dir = Path(draw) if draw else None
