@@ -23,8 +23,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from tsrkit.pipeline import FrameResult, Pipeline, check_detection
-from tsrkit.types import Candidate, Detection, Frame
+from tsrkit.pipeline import FrameResult, Pipeline
+from tsrkit.types import Candidate, Frame
 
 __all__ = [
     "CONTEXT_PX",
@@ -39,9 +39,9 @@ __all__ = [
 
 #: The smallest search radius around a light's predicted centre, pixels.
 MIN_REACH_PX = 4.0
-#: Context around the searched disc, in lens radii: a three-lens head reaches about 7 radii
-#: from its lit lens, which the housing stage of a verifier fits.
-CONTEXT_RADII = 8.0
+#: Context around the searched disc, in lens radii (the detectors' filters reach a few radii
+#: around a lens; the verifier and classifier read the whole frame).
+CONTEXT_RADII = 3.0
 #: Context around the searched disc at least, pixels (the detectors' filters need some).
 CONTEXT_PX = 12
 
@@ -62,9 +62,8 @@ class Light:
 
     def moved_to(self, candidate: Candidate) -> Light:
         """The light found at ``candidate`` on the next frame."""
-        return Light(
-            candidate.x, candidate.y, candidate.radius, candidate.x - self.x, candidate.y - self.y
-        )
+        moved = light_of(candidate)
+        return replace(moved, dx=moved.x - self.x, dy=moved.y - self.y)
 
 
 def region(
@@ -75,9 +74,9 @@ def region(
     context, inside the image.
 
     >>> region(100.0, 50.0, 6.0, 2.0, 640, 480)
-    (78, 28, 122, 72)
+    (82, 32, 118, 68)
     >>> region(3.0, 3.0, 6.0, 2.0, 640, 480)
-    (0, 0, 25, 25)
+    (0, 0, 21, 21)
     """
     pad = reach + max(CONTEXT_RADII * radius, CONTEXT_PX)
     x0, y0 = max(int(x - pad), 0), max(int(y - pad), 0)
@@ -85,15 +84,14 @@ def region(
     return x0, y0, x1, y1
 
 
-def shifted(detection: Detection, dx: float, dy: float) -> Detection:
-    """``detection`` moved by ``(dx, dy)`` pixels (from a crop's coordinates to the frame's)."""
-    c = detection.candidate
+def shifted(candidate: Candidate, dx: float, dy: float) -> Candidate:
+    """``candidate`` moved by ``(dx, dy)`` pixels (from a crop's coordinates to the frame's)."""
 
     def move(box):
         return None if box is None else (box[0] + dx, box[1] + dy, box[2] + dx, box[3] + dy)
 
-    moved = replace(c, x=c.x + dx, y=c.y + dy, bbox=move(c.bbox), housing=move(c.housing))
-    return replace(detection, candidate=moved)
+    c = candidate
+    return replace(c, x=c.x + dx, y=c.y + dy, bbox=move(c.bbox), housing=move(c.housing))
 
 
 class Follower:
@@ -141,46 +139,58 @@ class Follower:
             return result
         self._since_key += 1
         self.calls["followed"] += 1
-        detections, lights, notes = [], [], []
+        candidates = self._search(frame)
+        result = self.pipeline.finish(frame, candidates, start)
+        detections, lights, taken = [], [], set()
         for light in self._lights:
-            found = self._search(frame, light, notes)
-            if found is not None:
-                detections.append(found)
-                lights.append(light.moved_to(found.candidate))
+            x, y = light.predicted()
+            best, best_distance = None, self._reach(light)
+            for k, detection in enumerate(result.detections):
+                distance = math.hypot(detection.candidate.x - x, detection.candidate.y - y)
+                if k not in taken and distance <= best_distance:
+                    best, best_distance = k, distance
+            if best is not None:
+                taken.add(best)
+                detections.append(result.detections[best])
+                lights.append(light.moved_to(result.detections[best].candidate))
         self._lights = lights
         ms = (time.perf_counter() - start) * 1000.0
-        return FrameResult(
-            frame.source,
-            frame.index,
-            frame.width,
-            frame.height,
-            ms,
-            tuple(detections),
-            tuple(dict.fromkeys(notes)),
-        )
+        return replace(result, ms=ms, detections=tuple(detections))
 
-    def _search(self, frame: Frame, light: Light, notes: list[str]) -> Detection | None:
-        """The detection nearest to ``light``'s predicted centre within reach, or None."""
-        x, y = light.predicted()
-        reach = max(self.reach * light.radius, MIN_REACH_PX)
-        x0, y0, x1, y1 = region(x, y, reach, light.radius, frame.width, frame.height)
-        if x1 - x0 < 4 or y1 - y0 < 4:  # predicted outside the frame
-            return None
+    def _reach(self, light: Light) -> float:
+        return max(self.reach * light.radius, MIN_REACH_PX)
+
+    def _search(self, frame: Frame) -> list[Candidate]:
+        """The detector's candidates within reach of a light's predicted centre, found on one
+        crop holding every light's :func:`region`, in the frame's coordinates."""
+        boxes = []
+        for light in self._lights:
+            x, y = light.predicted()
+            boxes.append(region(x, y, self._reach(light), light.radius, frame.width, frame.height))
+        boxes = [b for b in boxes if b[2] - b[0] >= 4 and b[3] - b[1] >= 4]  # not outside
+        if not boxes:
+            return []
+        x0, y0 = min(b[0] for b in boxes), min(b[1] for b in boxes)
+        x1, y1 = max(b[2] for b in boxes), max(b[3] for b in boxes)
         crop = np.ascontiguousarray(frame.image[y0:y1, x0:x1])
-        result = self.pipeline.process(Frame(crop, frame.source, frame.index, frame.timestamp))
         self.calls["regions"] += 1
-        notes.extend(result.notes)
-        best, best_distance = None, reach
-        for detection in result.detections:
-            moved = shifted(detection, x0, y0)
-            distance = math.hypot(moved.candidate.x - x, moved.candidate.y - y)
-            if distance <= best_distance:
-                best, best_distance = moved, distance
-        if best is not None:
-            check_detection(best)
-        return best
+        found = [
+            shifted(c, x0, y0)
+            for c in self.pipeline.detector.detect(Frame(crop, frame.source, frame.index))
+        ]
+        near = []
+        for c in found:
+            for light in self._lights:
+                x, y = light.predicted()
+                if math.hypot(c.x - x, c.y - y) <= self._reach(light):
+                    near.append(c)
+                    break
+        return near
 
 
 def light_of(candidate: Candidate) -> Light:
-    """A light first seen at ``candidate`` (no step yet)."""
-    return Light(candidate.x, candidate.y, candidate.radius)
+    """A light first seen at ``candidate`` (no step yet). Its radius is that of the lens box
+    when smaller than the candidate's (a housing stage measures the lit lens, where a detector
+    such as ``union`` may keep a blob several times the lamp)."""
+    x0, y0, x1, y1 = candidate.lens_bbox
+    return Light(candidate.x, candidate.y, min(candidate.radius, max(x1 - x0, y1 - y0) / 2))
