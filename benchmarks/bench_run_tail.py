@@ -17,14 +17,14 @@ functions are wrapped to stamp the phases:
 spans N - 1 frame intervals). CPU is the summed user + system time of the process and every
 descendant (pool workers included), sampled every 50 ms.
 
-The older commit is extracted with ``git archive`` into a temporary folder and put first on
-``PYTHONPATH`` (its ``plugins/`` as ``tsrkit_plugins``), with this environment's packages and entry
-points; commits and worker counts are interleaved within each repeat so that load shifts hit all
-of them alike. The machine is shared: read the spreads (min, median, max over repeats), and the
-load average printed before and after.
+An older commit runs from its own virtual environment (:func:`at_commit.python_at`: its tree
+installed with its own entry points, this environment's other packages), every run in a
+scratch folder (so that no ``tsrkit`` of the working directory shadows it); commits and worker
+counts are interleaved within each repeat so that load shifts hit all of them alike. The
+machine is shared: read the spreads (min, median, max over repeats) and the load.
 
     python benchmarks/bench_run_tail.py --repeats 5                  # 42dcb98 vs this tree
-    python benchmarks/bench_run_tail.py --commits HEAD --frames 300 --workers 1,2 --detail
+    python benchmarks/bench_run_tail.py --commits tree --workers 1,2 --detail
 """
 
 from __future__ import annotations
@@ -39,10 +39,12 @@ import tempfile
 import time
 from pathlib import Path
 
+import harness
+from at_commit import python_at
+
 from tsrkit.synth import generate
 
 REPO = Path(__file__).resolve().parents[1]
-SINGLE_THREAD = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
 PHASES = ("start-up", "warm-up", "frame loop", "pool close", "evaluation", "writers", "exit")
 #: The stamps that bound the phases.
 BOUNDS = (
@@ -109,20 +111,6 @@ main()
 """
 
 
-def extract(commit: str, into: Path) -> Path:
-    """The tree of ``commit`` under ``into``, importable as ``tsrkit`` and ``tsrkit_plugins``."""
-    tree = into / commit
-    tree.mkdir(parents=True)
-    archive = subprocess.run(
-        ["git", "-C", str(REPO), "archive", commit, "tsrkit", "plugins"],
-        capture_output=True,
-        check=True,
-    )
-    subprocess.run(["tar", "-x", "-C", str(tree)], input=archive.stdout, check=True)
-    (tree / "tsrkit_plugins").symlink_to(tree / "plugins")
-    return tree
-
-
 def tree_cpu(proc, seen: dict[int, float]) -> None:
     """Record the latest user + system seconds of ``proc`` and each descendant in ``seen``."""
     import psutil
@@ -139,20 +127,22 @@ def tree_cpu(proc, seen: dict[int, float]) -> None:
         seen[p.pid] = max(seen.get(p.pid, 0.0), times.user + times.system)
 
 
-def measure(tree: Path | None, dataset: Path, workers: int, out: Path, extra: list[str]) -> dict:
+def measure(python: Path, dataset: Path, workers: int, out: Path, extra: list[str]) -> dict:
     """One run of the command: wall and CPU seconds, and the phases."""
     import psutil
 
     marks_file = out.with_suffix(".marks.json")
-    env = {**os.environ, **SINGLE_THREAD, "TAIL_MARKS": str(marks_file)}
-    if tree is not None:
-        env["PYTHONPATH"] = str(tree)
-    command = [sys.executable, "-c", PROBE, "benchmark", "--dataset", str(dataset)]
+    env = {**os.environ, **harness.SINGLE_THREAD, "TAIL_MARKS": str(marks_file)}
+    command = [str(python), "-c", PROBE, "benchmark", "--dataset", str(dataset)]
     command += ["-d", "conspicuity", "-c", "ab-hist", "-w", str(workers), "-o", str(out), "-q"]
     seen: dict[int, float] = {}
     begin = time.time()
     popen = subprocess.Popen(
-        [*command, *extra], env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE
+        [*command, *extra],
+        env=env,
+        cwd=out.parent,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
     )
     proc = psutil.Process(popen.pid)
     while popen.poll() is None:
@@ -193,6 +183,7 @@ def main() -> None:
     parser.add_argument("--detail", action="store_true", help="print each writer's seconds")
     parser.add_argument("extra", nargs="*", help="more benchmark options, after --")
     args = parser.parse_args()
+    harness.announce()
     data = args.data or Path(tempfile.gettempdir()) / f"tsrkit-tail-{args.frames}"
     if not (data / "annotations.json").is_file():
         print(f"rendering {args.frames} frames of 480x356 into {data} ...", flush=True)
@@ -200,13 +191,12 @@ def main() -> None:
     counts = [int(w) for w in args.workers.split(",")]
     work = Path(tempfile.mkdtemp(prefix="tsrkit-tail-"))
     trees = {
-        c: None if c == "tree" else extract(c, work / "trees") for c in args.commits.split(",")
+        c: Path(sys.executable) if c == "tree" else python_at(c) for c in args.commits.split(",")
     }
     warm = work / "warm"
     generate(warm, 4, seed=1)
-    for commit, tree in trees.items():  # compiles an extracted tree's numba functions once
+    for commit, tree in trees.items():  # compiles a new tree's numba functions once
         measure(tree, warm / "annotations.json", 1, work / f"warm-{commit}", [])
-    print(f"load average before: {' '.join(f'{x:.2f}' for x in os.getloadavg())}", flush=True)
     runs: dict[tuple[str, int], list[dict]] = {(c, w): [] for c in trees for w in counts}
     for r in range(args.repeats):
         for (commit, workers), done in runs.items():
@@ -218,7 +208,7 @@ def main() -> None:
                 f"loop {result['phases']['frame loop']:.2f} s",
                 flush=True,
             )
-    print(f"load average after: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
+    print(f"load:    {harness.load()} (after the runs)")
     n = args.frames
     print(f"\n{n} frames 480x356, conspicuity + ab-hist; median (min-max) over {args.repeats}")
     for (commit, workers), done in runs.items():
