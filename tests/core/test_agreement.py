@@ -9,9 +9,7 @@ from tsrkit.types import Candidate, Detection, Skipped
 
 
 def frame(index, *centres, source="drive.mp4"):
-    detections = tuple(
-        Detection(Candidate.from_circle(x, y, 3.0, 1.0), "red") for x, y in centres
-    )
+    detections = tuple(Detection(Candidate.from_circle(x, y, 3.0, 1.0), "red") for x, y in centres)
     return FrameResult(source, index, 640, 480, 1.0, detections)
 
 

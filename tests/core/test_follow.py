@@ -24,7 +24,7 @@ class RedDiscs(tsrkit.Detector):
     def detect(self, frame):
         self.searched.append(frame.image.shape[:2])
         mask = ((frame.image[..., 2] > 200) & (frame.image[..., 1] < 60)).astype(np.uint8)
-        count, _, stats, centres = cv2.connectedComponentsWithStats(mask)
+        _, _, stats, centres = cv2.connectedComponentsWithStats(mask)
         return [
             Candidate.from_circle(x, y, max(stats[k, 2], stats[k, 3]) / 2, 1.0, "red")
             for k, (x, y) in enumerate(centres)
@@ -62,7 +62,8 @@ def test_lights_are_followed_between_key_frames_and_new_ones_wait_for_the_next()
             assert mine == full, t
     whole = [shape for shape in detector.searched if shape == (120, 160)]
     assert len(whole) == 3 and follower.calls["key"] == 3  # frames 0, 4, 8
-    assert follower.calls["followed"] == 9 and follower.calls["regions"] == 9  # one crop a followed frame
+    assert follower.calls["followed"] == 9
+    assert follower.calls["regions"] == 9  # one crop on each followed frame
 
 
 def test_another_video_or_a_jump_back_starts_with_a_key_frame():
