@@ -49,9 +49,11 @@ __all__ = [
     "plugin_identity",
     "pool_context",
     "process_sample",
+    "read_cached",
     "run_records",
     "single_thread",
     "source_hash",
+    "start_pool_server",
 ]
 
 ENGINES = ("local", "dask")
@@ -123,7 +125,7 @@ def process_sample(index: int, sample: Sample, job: Job) -> FrameRecord:
         return replace(cached, index=index, cached=True)
     record = compute_record(index, sample, job)
     if path is not None and record.skipped is None:
-        with atomic_open(path) as fh:
+        with atomic_open(path, sync=False) as fh:
             json.dump(record.to_json(), fh)
     return record
 
@@ -134,13 +136,13 @@ MAX_CACHE_ENTRY = 64 * 2**20
 
 def read_cached(path: Path) -> FrameRecord | None:
     """The record cached at ``path``, or None when there is none or it cannot be used (not a
-    regular file, too large, not JSON, not a record): the frame is then computed again and
-    the entry replaced, so a damaged cache costs time, never the run."""
+    regular file, too large, cut short by a crash, edited by hand, not a record): the frame is
+    then computed again and the entry rewritten, so a damaged cache costs time, never the run."""
     if not path.is_file():
         return None
     try:
         return FrameRecord.from_json(read_json(path, MAX_CACHE_ENTRY))
-    except (InputFileError, KeyError, TypeError, ValueError, AttributeError, IndexError):
+    except (InputFileError, OSError, KeyError, TypeError, ValueError, AttributeError, IndexError):
         return None
 
 
@@ -203,11 +205,20 @@ def single_thread() -> None:
 
 def pool_context():
     """The multiprocessing context of every worker pool: workers fork from a clean fork server
-    that preloads the engine, because forking a process whose OpenCV thread pool has started
-    can crash the child."""
+    (forking a process whose OpenCV thread pool has started can crash the child) that has
+    imported the engine and the plugins and initialised numba (:mod:`tsrkit._preload`)."""
     context = multiprocessing.get_context("forkserver")
-    context.set_forkserver_preload(["tsrkit.engine"])
+    context.set_forkserver_preload(["tsrkit.engine", "tsrkit._preload"])
     return context
+
+
+def start_pool_server() -> None:
+    """Start the worker pools' fork server now (if it is not running), so that its imports run
+    on another core while the caller is still starting up, not after the pool is asked for."""
+    from multiprocessing import forkserver
+
+    pool_context()
+    forkserver.ensure_running()
 
 
 def _run_in_worker(index: int, sample: Sample) -> FrameRecord:
