@@ -12,7 +12,7 @@ from typing import Any
 
 from tsrkit.outputs import refuse_input
 
-__all__ = ["atomic_open", "finite", "json_line", "write_json"]
+__all__ = ["atomic_open", "finite", "json_line", "json_text", "write_json"]
 
 
 @contextlib.contextmanager
@@ -70,13 +70,24 @@ def finite(data: Any) -> Any:
     return data
 
 
+def json_text(data: Any, indent: int | None = None, default: Any = None) -> str:
+    """``data`` as JSON text with every non-finite number written as null (:func:`finite`):
+    what tsrkit writes is JSON that any strict reader accepts (no ``NaN`` / ``Infinity``).
+
+    Examples
+    --------
+    >>> json_text({"p": float("nan"), "m": float("-inf"), "n": 1.5})
+    '{"p": null, "m": null, "n": 1.5}'
+    """
+    return json.dumps(finite(data), indent=indent, default=default, allow_nan=False)
+
+
 def json_line(data: Any) -> str:
     """One JSON Lines record (no newline), with non-finite numbers as null."""
-    return json.dumps(finite(data), allow_nan=False)
+    return json_text(data)
 
 
-def write_json(path: str | os.PathLike, data: Any) -> None:
-    """Write ``data`` as indented JSON, atomically."""
+def write_json(path: str | os.PathLike, data: Any, indent: int | None = 2) -> None:
+    """Write ``data`` as indented JSON, atomically, with non-finite numbers as null."""
     with atomic_open(path) as fh:
-        json.dump(data, fh, indent=2, sort_keys=False)
-        fh.write("\n")
+        fh.write(json_text(data, indent) + "\n")

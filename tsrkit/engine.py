@@ -23,7 +23,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, TypeVar
 
-from tsrkit.atomic import atomic_open
+from tsrkit.atomic import atomic_open, json_line
 from tsrkit.errors import TsrkitError
 from tsrkit.files import InputFileError, read_json
 from tsrkit.images import ImageReadError
@@ -126,7 +126,7 @@ def process_sample(index: int, sample: Sample, job: Job) -> FrameRecord:
     record = compute_record(index, sample, job)
     if path is not None and record.skipped is None:
         with atomic_open(path, sync=False) as fh:
-            json.dump(record.to_json(), fh)
+            fh.write(json_line(record.to_json()))
     return record
 
 

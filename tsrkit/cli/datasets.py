@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 from collections import Counter
 from contextlib import nullcontext
 from pathlib import Path
@@ -11,6 +10,7 @@ import click
 from rich.console import Console
 from rich.table import Table
 
+from tsrkit.atomic import json_text
 from tsrkit.cli.completion import dataset_names, plugin_names
 from tsrkit.cli.drive import drive_command
 from tsrkit.cli.synth import synth_command
@@ -66,7 +66,7 @@ def list_command(as_json: bool) -> None:
     for entry in load_registry().values():
         rows.append({**entry.to_info(), "present": _present(entry)})
     if as_json:
-        click.echo(json.dumps(rows, indent=2))
+        click.echo(json_text(rows, indent=2))
         return
     table = Table(title=f"tsrkit datasets ({registry_path()})")
     for column in ("name", "format", "task", "box", "licence", "present"):
@@ -110,7 +110,7 @@ def info_command(name: str, as_json: bool) -> None:
         "labels": dict(labels.most_common()),
     }
     if as_json:
-        click.echo(json.dumps(facts, indent=2, default=str))
+        click.echo(json_text(facts, indent=2, default=str))
         return
     table = Table(title=f"dataset {dataset.name}", show_header=False)
     for key, value in facts.items():

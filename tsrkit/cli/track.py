@@ -12,7 +12,7 @@ import click
 from rich.console import Console
 from rich.table import Table
 
-from tsrkit.atomic import atomic_open
+from tsrkit.atomic import atomic_open, json_line
 from tsrkit.cli.common import FiniteFloatRange, plugin_options
 from tsrkit.cli.errors import UserError
 from tsrkit.files import not_regular
@@ -51,7 +51,7 @@ def _start_time(text: str | None) -> float | None:
 def _write_jsonl(path: Path, records) -> None:
     with atomic_open(path) as fh:
         for record in records:
-            fh.write(json.dumps(record) + "\n")
+            fh.write(json_line(record) + "\n")
 
 
 @click.command("track")
