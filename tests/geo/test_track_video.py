@@ -142,3 +142,31 @@ def test_non_finite_distances_are_refused(drive, tmp_path, option, value):
     errors = [line for line in result.output.splitlines() if line.startswith("Error:")]
     assert len(errors) == 1 and option in errors[0] and value in errors[0]
     assert "Traceback" not in result.output and not out.exists()
+
+
+def test_report_writes_a_track_run_again(drive, tmp_path):
+    out = tmp_path / "run"
+    assert CliRunner().invoke(cli, track_args(drive, out)).exit_code == 0
+    page = (out / "report.html").read_text()
+    (out / "report.html").unlink()
+    (out / "summary.md").unlink()
+    result = CliRunner().invoke(
+        cli, ["report", str(out), "--writer", "html", "--writer", "markdown"]
+    )
+    assert result.exit_code == 0, result.output
+    assert (out / "report.html").read_text() == page
+    assert "| 0 | 0 | through |" in (out / "summary.md").read_text()
+    (out / "traversals.jsonl").write_text('{"traversal": 0}\n')
+    broken = CliRunner().invoke(cli, ["report", str(out)])
+    assert broken.exit_code == 2
+    assert "traversals.jsonl: line 1: not a traversal record (missing intersection" in (
+        broken.output
+    )
+
+
+def test_report_says_what_a_track_run_without_video_lacks(drive, tmp_path):
+    args = ["track", "--gps", str(drive / "gps.csv"), "--map", str(drive / "map.osm")]
+    assert CliRunner().invoke(cli, [*args, "--out", str(tmp_path)]).exit_code == 0
+    result = CliRunner().invoke(cli, ["report", str(tmp_path)])
+    assert result.exit_code == 2 and "Traceback" not in result.output
+    assert "a track run without a video (traversals.jsonl only)" in result.output

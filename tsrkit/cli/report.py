@@ -24,13 +24,14 @@ __all__ = ["report_command"]
     help="Report writer to run (repeatable).",
 )
 def report_command(run_dir, writers) -> None:
-    """Write RUN_DIR/report.html (a benchmark folder) or RUN_DIR/compare.html (a compare
-    folder) from the files the run left, without recomputing.
+    """Write RUN_DIR/report.html (a benchmark or `track VIDEO --out` folder) or
+    RUN_DIR/compare.html (a compare folder) from the files the run left, without recomputing.
 
     \b
     Examples:
       tsrkit report tsrkit-out/conspicuity     # one benchmark run: report.html
       tsrkit report tsrkit-out                 # a compare folder: compare.html
+      tsrkit report runs/drive                 # a track run: report.html
       tsrkit report runs/kr --writer markdown --writer html
     """
     from tsrkit.eval.guard import Failure

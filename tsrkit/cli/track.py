@@ -293,6 +293,7 @@ def _track_video(
                 "map": signals.source,
                 "frames": count,
                 "fps": fps,
+                "start_utc": start,
                 "clip_frames": total,
                 "traversals": len(records),
                 **json.loads(identity(selection, settings)),
