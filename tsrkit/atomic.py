@@ -10,7 +10,7 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
-from tsrkit.outputs import refuse_input
+from tsrkit.outputs import refuse_input, refuse_special
 
 __all__ = ["atomic_open", "finite", "json_line", "json_text", "write_json"]
 
@@ -23,12 +23,14 @@ def atomic_open(
 
     On an exception the temporary file is removed and ``path`` is left as it was. A ``path``
     that names one of the run's inputs (:func:`tsrkit.outputs.reading`) is refused before
-    anything is written. ``sync`` forces the bytes to disk before the rename (``fsync``), so
-    that a crash of the machine cannot leave an empty file under the new name; a cache entry,
-    which is recomputed when it cannot be read, skips that wait.
+    anything is written, and so is a device node (:func:`tsrkit.outputs.refuse_special`).
+    ``sync`` forces the bytes to disk before the rename (``fsync``), so that a crash of the
+    machine cannot leave an empty file under the new name; a cache entry, which is recomputed
+    when it cannot be read, skips that wait.
     """
     path = Path(path)
     refuse_input(path)
+    refuse_special(path, follow=False)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:

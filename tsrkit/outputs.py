@@ -13,17 +13,20 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import os
+import stat
 from collections.abc import Iterable, Iterator
 
 from tsrkit.errors import TsrkitError
 
 __all__ = [
     "OutputIsInput",
+    "OutputIsSpecial",
     "dataset_inputs",
     "is_input",
     "is_output",
     "reading",
     "refuse_input",
+    "refuse_special",
     "writing",
 ]
 
@@ -37,6 +40,10 @@ _OUTPUTS: contextvars.ContextVar[frozenset[str]] = contextvars.ContextVar(
 
 class OutputIsInput(TsrkitError):
     """An output path that names one of the run's inputs."""
+
+
+class OutputIsSpecial(TsrkitError):
+    """An output path that names a device, FIFO or socket."""
 
 
 def _key(path: str | os.PathLike) -> str:
@@ -90,6 +97,41 @@ def refuse_input(path: str | os.PathLike, option: str = "the output") -> None:
     """
     if is_input(path):
         raise OutputIsInput(f"{option} {path} is an input of this run; choose another path")
+
+
+def refuse_special(
+    path: str | os.PathLike, option: str = "the output", follow: bool = True
+) -> None:
+    """Raise :class:`OutputIsSpecial` when ``path`` exists and is neither a regular file nor a
+    folder (``follow``: after symbolic links; else only a device node itself). Outputs are
+    written beside their path and renamed over it: that would replace a device (``-o
+    /dev/null`` run as root would replace ``/dev/null`` itself) and never reach a FIFO's
+    reader.
+
+    Examples
+    --------
+    >>> refuse_special("/dev/null", "--out")
+    Traceback (most recent call last):
+    ...
+    tsrkit.outputs.OutputIsSpecial: --out /dev/null: not a regular file (a character device); \
+outputs are written beside their path and renamed over it: choose a file
+    """
+    from tsrkit.files import not_regular
+
+    try:
+        mode = os.stat(path).st_mode if follow else os.lstat(path).st_mode
+    except OSError:  # missing (to be made) or unreachable: the writer says so
+        return
+    special = (
+        not (stat.S_ISREG(mode) or stat.S_ISDIR(mode))
+        if follow
+        else stat.S_ISCHR(mode) or stat.S_ISBLK(mode)
+    )
+    if special:
+        raise OutputIsSpecial(
+            f"{option} {path}: {not_regular(path)}; outputs are written beside their path "
+            "and renamed over it: choose a file"
+        )
 
 
 def dataset_inputs(refs: Iterable[str], dataset) -> list[str]:

@@ -11,12 +11,14 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import os
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 from tsrkit.errors import TsrkitError
 from tsrkit.eval.guard import Failure
+from tsrkit.files import loads_json, read_text
 from tsrkit.plugin import ReportWriter
 from tsrkit.records import FrameRecord
 from tsrkit.report import RunResult, run_results
@@ -181,21 +183,15 @@ def read_object(path: Path) -> dict[str, Any]:
             "report to write again; tsrkit report reads the folders of benchmark, compare "
             "and track VIDEO --out"
         )
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
+    if not os.path.lexists(path):
         raise TsrkitError(
             f"{path.parent}: not a run folder ({path.name} missing; tsrkit report reads the "
             "folders of benchmark, compare and track VIDEO --out)"
-        ) from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise TsrkitError(f"{path}: cannot be read ({exc})") from None
+        )
+    text = read_text(path)  # a special, unreadable or huge file: one line naming it
     if not text.strip():
         raise TsrkitError(f"{path}: empty file (the run did not finish writing it)")
-    try:
-        data = json.loads(text)
-    except ValueError as exc:
-        raise TsrkitError(f"{path}: not valid JSON ({exc})") from None
+    data = loads_json(text, path)
     if not isinstance(data, dict):
         raise TsrkitError(f"{path}: not a tsrkit report (not a JSON object)")
     return data
@@ -227,18 +223,15 @@ def read_records(path: Path) -> list[FrameRecord]:
     TsrkitError
         Missing file, or a line that is not a record (naming the line).
     """
-    try:
-        lines = path.read_text(encoding="utf-8").splitlines()
-    except FileNotFoundError:
-        raise TsrkitError(f"{path.parent}: not a run folder ({path.name} missing)") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise TsrkitError(f"{path}: cannot be read ({exc})") from None
+    if not os.path.lexists(path):
+        raise TsrkitError(f"{path.parent}: not a run folder ({path.name} missing)")
+    lines = read_text(path).splitlines()
     records = []
     for number, line in enumerate(lines, 1):
         if not line.strip():
             continue
         try:
-            data = json.loads(line)
+            data = loads_json(line, f"{path}: line {number}")
             records.append(FrameRecord.from_json(data))
         except (ValueError, KeyError, TypeError, AttributeError) as exc:
             problem = f"missing {exc}" if isinstance(exc, KeyError) else str(exc)

@@ -25,7 +25,7 @@ from tsrkit.datasets import (
 from tsrkit.datasets.registry import GENERATED_SAMPLE
 from tsrkit.errors import TsrkitError
 from tsrkit.outlock import locked_file
-from tsrkit.outputs import dataset_inputs, reading, refuse_input
+from tsrkit.outputs import dataset_inputs, reading, refuse_input, refuse_special
 from tsrkit.types import Dataset
 
 __all__ = [
@@ -200,6 +200,7 @@ def convert_command(
     console = Console(stderr=True, soft_wrap=True)
     with console.status(f"converting {src} to {to_format}...") if not quiet else nullcontext():
         dataset = open_dataset(src, format=src_format, images=images)
+        refuse_special(out, "--out")
         with reading(dataset_inputs([src], dataset)), locked_file(out):
             refuse_input(out, "--out")
             write_dataset(dataset, to_format, out)

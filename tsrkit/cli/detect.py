@@ -23,7 +23,7 @@ from tsrkit.errors import TsrkitError
 from tsrkit.follow import Follower
 from tsrkit.inputs import IMAGE_EXTENSIONS, VIDEO_EXTENSIONS, check_range
 from tsrkit.outlock import locked_file
-from tsrkit.outputs import reading, refuse_input, writing
+from tsrkit.outputs import reading, refuse_input, refuse_special, writing
 from tsrkit.report import ProgressBar
 from tsrkit.selection import build
 from tsrkit.streams import Runner, run_pipeline
@@ -217,6 +217,7 @@ def detect_command(
         for given, option in ((out, "--out"), (draw_dir, "--draw")):
             if given is not None:
                 refuse_input(given, option)
+                refuse_special(given, option)
         if out is not None and out.suffix.lower() in IMAGE_EXTENSIONS | VIDEO_EXTENSIONS:
             raise UserError(f"--out {out} names an image or video; detect writes JSON Lines")
         pipeline = build(detector, verifier, classifier, tracker, params, config).pipeline()

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import click
 
+from tsrkit.cli.common import FiniteFloatRange
 from tsrkit.errors import TsrkitError
 from tsrkit.synth.drive import MOVEMENTS
 
@@ -30,7 +31,7 @@ __all__ = ["drive_command"]
 @click.option("--width", default=480, show_default=True, type=click.IntRange(64, 4096))
 @click.option("--height", default=356, show_default=True, type=click.IntRange(48, 4096))
 @click.option(
-    "--fps", default=14.0, show_default=True, type=click.FloatRange(1, 120), help="Frames/s."
+    "--fps", default=14.0, show_default=True, type=FiniteFloatRange(1, 120), help="Frames/s."
 )
 @click.option("--seed", default=0, show_default=True, type=click.IntRange(min=0), help="Seed.")
 def drive_command(out: Path, route: str, width: int, height: int, fps: float, seed: int) -> None:

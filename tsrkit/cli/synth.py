@@ -10,6 +10,7 @@ from rich.console import Console
 
 from tsrkit.errors import TsrkitError
 from tsrkit.outlock import locked_file
+from tsrkit.outputs import refuse_special
 from tsrkit.synth import LIGHTINGS, generate
 
 __all__ = ["synth_command"]
@@ -70,6 +71,9 @@ def synth_command(
     """
     conditions = tuple(c.strip() for c in lighting.split(",") if c.strip())
     from tsrkit.report import ProgressBar
+
+    if video is not None:
+        refuse_special(video, "--video")
 
     try:
         with (

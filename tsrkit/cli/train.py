@@ -11,7 +11,7 @@ from tsrkit.cli.completion import dataset_names, plugin_names, trainable_names
 from tsrkit.errors import TsrkitError
 from tsrkit.models import model_paths
 from tsrkit.outlock import locked_file
-from tsrkit.outputs import dataset_inputs, reading, refuse_input
+from tsrkit.outputs import dataset_inputs, reading, refuse_input, refuse_special
 from tsrkit.params import parse_assignments
 from tsrkit.registry import get_registry
 from tsrkit.training import train
@@ -101,6 +101,8 @@ def train_command(
         f"training {plugin} on {len(dataset)} samples of {dataset.name}...", spinner="dots"
     )
     model = model_paths(out)
+    for path in model:
+        refuse_special(path, "--out")
     try:
         with reading(dataset_inputs(dataset_refs, dataset)), locked_file(model[0]):
             for path in model:
