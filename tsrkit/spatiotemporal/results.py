@@ -261,7 +261,7 @@ def load_track_run(folder: Path, report: dict[str, Any]) -> RunResult:
         raise TsrkitError(f"{folder / 'report.json'}: not a track report ({exc!r})") from None
     start = report.get("start_utc", records[0].get("start_utc") if records else None)
     frames, distance = _profile(report, start, fps, count)
-    counted = {k: report[k] for k in ("traversals", "temporal") if k in report}
+    counted: dict[str, Any] = {k: report[k] for k in ("traversals", "temporal") if k in report}
     traversals = TraversalsResult(counted, "traversals", tuple(records), frames, distance, vicinity)
     return RunResult(dict(report), results=(TrackFacts(report, "run"), traversals))
 
