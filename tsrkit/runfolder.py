@@ -133,7 +133,7 @@ def load_run(folder: Path) -> RunResult:
 
     if is_track_report(report):
         return load_track_run(folder, report)
-    if "dataset" not in report:
+    if not isinstance(report.get("dataset"), dict):
         raise TsrkitError(f"{folder / 'report.json'}: not a tsrkit report (no 'dataset' entry)")
     records = read_records(folder / "detections.jsonl")
     try:

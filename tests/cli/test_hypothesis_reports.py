@@ -23,6 +23,7 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 from hypothesis import HealthCheck, given, settings, strategies as st
+from test_edge_matrix_more import track_folder
 
 import tsrkit
 from tsrkit.api import Metric, ReportWriter, hookimpl
@@ -84,8 +85,8 @@ def sample(frames: int):
 
 @pytest.fixture(scope="module")
 def folders(tmp_path_factory) -> dict[str, Path]:
-    """A benchmark folder, a compare folder and a track folder (written by hand as the track
-    verb writes them, without its video)."""
+    """A benchmark folder, a compare folder and a track folder (as the track verb writes it,
+    written by hand)."""
     root = tmp_path_factory.mktemp("folders")
     tsrkit.benchmark(sample(4), tsrkit.detector("gray-tophat"), out=root / "run", cache=False)
     tsrkit.compare(
@@ -94,35 +95,7 @@ def folders(tmp_path_factory) -> dict[str, Path]:
         out=root / "compare",
         cache=False,
     )
-    track = root / "track"
-    track.mkdir()
-    record = {
-        "traversal": 0,
-        "intersection": 3,
-        "movement": "through",
-        "first_frame": 0,
-        "last_frame": 20,
-        "anchor_frame": 12,
-        "short_range": [8, 14],
-        "tracks": [],
-        "start_utc": 0.0,
-    }
-    (track / "traversals.jsonl").write_text(json.dumps(record) + "\n")
-    report = {
-        "video": "drive.mp4",
-        "gps": str(root / "missing.csv"),
-        "map": str(root / "missing.osm"),
-        "frames": 21,
-        "fps": 10.0,
-        "start_utc": 0.0,
-        "clip_frames": 21,
-        "traversals": 1,
-        "plugins": {},
-        "settings": {"vicinity": 30.0},
-        "files": [],
-        "plots": [],
-    }
-    (track / "report.json").write_text(json.dumps(report))
+    track = track_folder(root / "track", root / "missing.csv", root / "missing.osm")
     return {"run": root / "run", "compare": root / "compare", "track": track}
 
 

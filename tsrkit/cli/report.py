@@ -8,6 +8,7 @@ from pathlib import Path
 import click
 
 from tsrkit.cli.completion import plugin_names
+from tsrkit.cli.errors import UserError
 
 __all__ = ["report_command"]
 
@@ -49,6 +50,11 @@ def report_command(run_dir, writers) -> None:
                 written += writer.write_comparison(folder)
             except Exception as exc:
                 failures.append(Failure.of(f"writer '{writer.name}'", exc))
+        if not written and not failures:
+            names = ", ".join(w.name for w in chosen)
+            raise UserError(
+                f"{folder}: a compare folder; {names} write nothing for one (html does)"
+            )
     else:
         run = load_run(folder)
         for writer in chosen:

@@ -175,8 +175,12 @@ def track_command(
     """
     from tsrkit.geo import read_signals, read_track, traversals
 
-    if video is None and (truth or detector or verifier or classifier or tracker or params):
-        raise click.UsageError("--truth and plugin options need a VIDEO")
+    if video is None:
+        given = video_options_given(click.get_current_context())
+        if given:
+            raise click.UsageError(
+                f"{', '.join(given)}: need a VIDEO (without one, track lists the traversals)"
+            )
     with reading([video, gps, osm, truth]):
         if out is not None:
             refuse_input(out, "--out")
@@ -315,6 +319,36 @@ def _track_video(
             console.print(f"note: {note}", markup=False)
         shown = ", ".join(["traversals.jsonl", *written["files"]])
         console.print(f"-> {out}: {shown}, plots/", markup=False)
+
+
+#: The options that act on the video's frames only.
+VIDEO_ONLY = (
+    "detector",
+    "verifier",
+    "classifier",
+    "tracker",
+    "params",
+    "config",
+    "start_utc",
+    "upstream",
+    "downstream",
+    "top",
+    "roi_top",
+    "slack",
+    "flow_margin",
+    "truth",
+)
+
+
+def video_options_given(ctx: click.Context) -> list[str]:
+    """The video-only options the command line (or the environment) set, by their long name:
+    without a VIDEO they would be ignored without a word."""
+    flags = {p.name: p.opts[-1] for p in ctx.command.params}
+    return [
+        flags[name]
+        for name in VIDEO_ONLY
+        if ctx.get_parameter_source(name) not in (None, click.core.ParameterSource.DEFAULT)
+    ]
 
 
 def no_signals(signals, osm) -> None:
