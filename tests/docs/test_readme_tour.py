@@ -182,3 +182,10 @@ def test_the_video_range_line_decodes_the_frames_it_names(tour):
     done = next(d for line, d in results if "--every 2 --start 2 --end 10" in line)
     frames = [json.loads(line)["frame"] for line in done.stdout.splitlines()]
     assert frames == [2, 4, 6, 8]
+
+
+def test_the_report_lines_write_the_pages_again(tour):
+    _, results = tour
+    for run, page in (("runs/drive", "report.html"), ("runs/cinta", "compare.html")):
+        done = next(d for line, d in results if line.startswith(f"tsrkit report {run}"))
+        assert f"-> {run}/{page}" in done.stdout, done.stdout + done.stderr
