@@ -540,8 +540,6 @@ EARLIER = {
     ("annotations", "fifo"),
     ("annotations", "device"),
 }
-#: Left open: a model path that names nothing is only noticed once a candidate needs the model.
-OPEN = {("model", "dangling")}
 WRITTEN = ("detect-out", "convert-out", "synth-video")
 KINDS = ("fifo", "device", "socket", "folder", "dangling")
 
@@ -564,10 +562,35 @@ SPECIALS: list[Row] = [
     (f"{where}-{kind}", at(where, kind), *expected(where, kind))
     for where in NAMES
     for kind in KINDS
-    if (where, kind) not in EARLIER | OPEN
+    if (where, kind) not in EARLIER
 ]
 
-MORE = REPORTS + NUMBERS + SPECIALS
+PATHS: list[Row] = [
+    (
+        "model-missing-on-a-frame-without-candidates",
+        lambda tmp: [*detect("-c", "ab-hist")(tmp), "-p", f"model={tmp / 'nowhere.npz'}"],
+        2,
+        "no such file",
+    ),
+    (
+        "model-named-without-suffix-ok",
+        lambda tmp: [*detect("-c", "ab-hist")(tmp), "-p", f"model={model_copy(tmp)}"],
+        0,
+        "1 frames",
+    ),
+]
+
+
+def model_copy(tmp: Path) -> Path:
+    """The shipped ab-hist model copied to ``tmp/m.npz`` / ``.json``, named without suffix."""
+    from tsrkit_plugins.classifiers.ab_hist import DEFAULT_MODEL
+
+    for suffix in (".npz", ".json"):
+        shutil.copy(DEFAULT_MODEL.with_suffix(suffix), tmp / f"m{suffix}")
+    return tmp / "m"
+
+
+MORE = REPORTS + NUMBERS + SPECIALS + PATHS
 
 
 def test_the_third_table_is_a_hundred_new_cases():
