@@ -35,7 +35,7 @@ from tsrkit.plugin import Classifier, Detector, ReportWriter, Verifier
 from tsrkit.records import FrameRecord
 from tsrkit.registry import get_registry
 from tsrkit.report import REPORT_KEYS, ProgressBar, RunResult, build_report, ordered
-from tsrkit.runfolder import remove_stale_files, write_run
+from tsrkit.runfolder import refuse_foreign_report, remove_stale_files, write_run
 from tsrkit.types import Dataset
 
 __all__ = [
@@ -240,6 +240,8 @@ def run_benchmark(
         verifier,
     )
     label = (detector or classifier).name  # type: ignore[union-attr]
+    if out is not None:
+        refuse_foreign_report(Path(out))
     lock = locked(out) if out is not None else contextlib.nullcontext()
     with lock, ProgressBar(len(dataset), progress, label) as bar:
         records = bar.track(run_records(dataset.samples, job, workers, engine, scheduler))

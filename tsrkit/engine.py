@@ -119,6 +119,9 @@ def process_sample(index: int, sample: Sample, job: Job) -> FrameRecord:
         key = hashlib.sha256((image_hash(sample) + job.identity).encode()).hexdigest()
     except OSError as exc:
         return FrameRecord(sample.source, index, skipped=f"cannot read: {exc.strerror or exc}")
+    except ImageReadError as exc:
+        reason = str(exc).removeprefix(f"{sample.source}: ")
+        return FrameRecord(sample.source, index, skipped=reason)
     path = Path(job.cache_dir, key[:2], f"{key}.json") if job.cache_dir else None
     cached = read_cached(path) if path is not None else None
     if cached is not None:

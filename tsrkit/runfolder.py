@@ -31,6 +31,7 @@ __all__ = [
     "read_object",
     "read_records",
     "read_report",
+    "refuse_foreign_report",
     "remove_stale_files",
     "reopen",
     "write_run",
@@ -67,6 +68,29 @@ def write_run(
     run = _with_report(run, report, [listed[w.name] for w in kept])
     _write_all(run, kept, folder)
     return run
+
+
+def refuse_foreign_report(folder: Path) -> None:
+    """Refuse an output folder holding a ``report.json`` that no tsrkit run wrote: the run
+    would replace it (a rerun into a run's own folder replaces that run's report, as it
+    should).
+
+    Raises
+    ------
+    TsrkitError
+        When ``folder/report.json`` exists and is not a run's report.
+    """
+    path = folder / "report.json"
+    if not os.path.lexists(path):
+        return
+    try:
+        report = read_object(path)
+    except TsrkitError:
+        report = {}
+    if not isinstance(report.get("dataset"), dict):
+        raise TsrkitError(
+            f"{path}: not a tsrkit run's report, and the run would replace it; choose another --out"
+        )
 
 
 def remove_stale_files(folder: Path, keep: set[str]) -> list[str]:

@@ -13,8 +13,9 @@ from typing import Any
 
 import numpy as np
 
+from tsrkit.files import not_regular
 from tsrkit.geometry import Box, box_centre, circle_box, inscribed_circle
-from tsrkit.images import read_image
+from tsrkit.images import ImageReadError, read_image
 from tsrkit.records import DetectionRecord
 
 __all__ = [
@@ -194,11 +195,22 @@ class Sample:
 
     def hash_into(self, digest) -> None:
         """Feed the image to a ``hashlib`` digest: the file's bytes, or the in-memory pixels
-        and their shape (the cache key and the training-set checksum)."""
+        and their shape (the cache key and the training-set checksum).
+
+        Raises
+        ------
+        tsrkit.images.ImageReadError
+            The file is not a regular file (a FIFO, a device, a folder, missing).
+        OSError
+            It cannot be read.
+        """
         if self.image is not None:
             digest.update(repr(self.image.shape).encode())
             digest.update(self.image.tobytes())
             return
+        problem = not_regular(self.source)
+        if problem:  # a FIFO would block the read, a device never end it
+            raise ImageReadError(f"{self.source}: {problem}")
         with open(self.source, "rb") as fh:
             for block in iter(lambda: fh.read(1 << 20), b""):
                 digest.update(block)

@@ -411,6 +411,7 @@ NUMBERS: list[Row] = [
     ("synth-height-huge", synth("--height", "100000"), 2, "--height"),
     ("synth-frames-zero", synth("--frames", "0"), 2, "--frames"),
     ("synth-frames-word", synth("--frames", "many"), 2, "--frames"),
+    ("synth-seed-negative-named", synth("--seed", "-1"), 2, "--seed"),
     ("detect-every-negative", detect("--every", "-1"), 2, "--every"),
     ("detect-start-negative", detect("--start", "-1"), 2, "--start"),
     ("detect-end-negative", detect("--end", "-5"), 2, "--end"),
@@ -590,7 +591,50 @@ def model_copy(tmp: Path) -> Path:
     return tmp / "m"
 
 
-MORE = REPORTS + NUMBERS + SPECIALS + PATHS
+def declared(tmp: Path, name: str, kind: str) -> list[str]:
+    """``benchmark`` on a dataset whose first image, of declared size, is a special file (the
+    reader opens no image then: the run meets it first)."""
+    records = [
+        {"file": name, "width": 32, "height": 32, "boxes": []},
+        {"file": "a.png", "width": 32, "height": 32, "boxes": []},
+    ]
+    ds = norm_dataset(tmp, records)
+    make_special(tmp / name, kind)
+    out = ["-o", str(tmp / "o"), "--writer", "jsonl"]
+    return ["benchmark", "--dataset", str(ds), "-d", "gray-tophat", *FAST, *out]
+
+
+RUNS: list[Row] = [
+    (
+        "dataset-image-of-declared-size-fifo",
+        lambda tmp: declared(tmp, "p.png", "fifo"),
+        0,
+        "report",
+    ),
+    (
+        "dataset-image-of-declared-size-device",
+        lambda tmp: declared(tmp, "z.png", "device"),
+        0,
+        "report",
+    ),
+    (
+        "dataset-json-nested-too-deep-named",
+        lambda tmp: ["datasets", "info", str(write(tmp / "a.json", "[" * 500 + "]" * 500))],
+        2,
+        "a.json: nested deeper than 100 levels",
+    ),
+    (
+        "benchmark-out-holds-a-foreign-report-json",
+        lambda tmp: (
+            write(tmp / "o" / "report.json", '{"mine": true}'),
+            [*bench("-o", str(tmp / "o"))(tmp)],
+        )[1],
+        2,
+        "report.json: not a tsrkit run's report",
+    ),
+]
+
+MORE = REPORTS + NUMBERS + SPECIALS + PATHS + RUNS
 
 
 def test_the_third_table_is_a_hundred_new_cases():

@@ -30,7 +30,9 @@ __all__ = ["synth_command"]
     type=click.IntRange(1, 1_000_000),
     help="Number of frames.",
 )
-@click.option("--seed", default=0, show_default=True, type=int, help="Scene seed.")
+@click.option(
+    "--seed", default=0, show_default=True, type=click.IntRange(min=0), help="Scene seed."
+)
 @click.option("--width", default=480, show_default=True, type=click.IntRange(64, 8192))
 @click.option("--height", default=356, show_default=True, type=click.IntRange(64, 8192))
 @click.option(

@@ -16,7 +16,7 @@ from tsrkit.datasets.errors import DatasetError
 from tsrkit.datasets.registry import DatasetEntry, load_registry
 from tsrkit.datasets.states import check_mapping, to_state
 from tsrkit.errors import TsrkitError
-from tsrkit.files import not_regular
+from tsrkit.files import InputFileError, not_regular, read_json
 from tsrkit.registry import get_registry
 from tsrkit.types import Annotation, Dataset
 
@@ -143,6 +143,11 @@ def detect_format(path: Path) -> str:
             f"{path}: several formats match ({', '.join(matched)}); "
             f"pass --format (format=...) to choose"
         )
+    if Path(path).suffix.lower() == ".json":  # name why no JSON reader took it, if it is not JSON
+        try:
+            read_json(path)
+        except InputFileError as exc:
+            raise DatasetError(path, exc.problem) from None
     raise TsrkitError(
         f"{path}: no format recognises it; pass --format (format=...), one of: {every}"
     )
