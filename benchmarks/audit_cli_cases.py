@@ -1308,7 +1308,7 @@ case(
         "-o",
         "{tmp}/ds",
     ],
-    (2, "input"),
+    (2, "input|not a tsrkit run's report"),
     setup=keep_copy(
         "ds/report.json",
         lambda t: (
