@@ -261,12 +261,6 @@ def _convert(kind: str, value: Any) -> Any:
             problem = not_regular(value)
             if problem:  # a FIFO or device would block whatever reads it
                 raise ValueError(problem)
-        if kind == "path" and value and not _exists(value):
-            # read lazily (by a worker, at the first candidate): a path that names nothing
-            # would otherwise pass unnoticed on frames that never need it
-            raise ValueError(
-                "no such file" + (" (a dangling link)" if os.path.islink(value) else "")
-            )
         return value
     element = "int" if kind == "ints" else "float"
     if isinstance(value, str):
@@ -326,14 +320,6 @@ def parse_assignments(items: Iterable[str]) -> dict[str, str]:
 #: The keys of a run configuration, and the largest one read (bytes).
 CONFIG_KEYS = ("detector", "verifier", "classifier", "tracker", "description")
 MAX_CONFIG_BYTES = 2**20
-
-
-def _exists(value: str) -> bool:
-    """Whether a path parameter names something: the path itself, or a model's ``.npz`` named
-    without its suffix (:func:`tsrkit.models.model_paths`)."""
-    from tsrkit.models import model_paths
-
-    return any(os.path.exists(p) for p in (value, *model_paths(value)))
 
 
 def load_config(path: str | os.PathLike) -> dict[str, Any]:
