@@ -143,11 +143,12 @@ def detect_format(path: Path) -> str:
             f"{path}: several formats match ({', '.join(matched)}); "
             f"pass --format (format=...) to choose"
         )
-    if Path(path).suffix.lower() == ".json":  # name why no JSON reader took it, if it is not JSON
+    if Path(path).suffix.lower() == ".json":  # say why no JSON reader could read it
         try:
             read_json(path)
         except InputFileError as exc:
-            raise DatasetError(path, exc.problem) from None
+            if exc.problem.startswith("nested deeper"):
+                raise DatasetError(path, exc.problem) from None
     raise TsrkitError(
         f"{path}: no format recognises it; pass --format (format=...), one of: {every}"
     )
