@@ -19,6 +19,7 @@ from typing import Any
 from tsrkit.errors import TsrkitError
 from tsrkit.eval.guard import Failure
 from tsrkit.files import loads_json, read_text
+from tsrkit.outputs import refuse_input
 from tsrkit.plugin import ReportWriter
 from tsrkit.records import FrameRecord
 from tsrkit.report import RunResult, run_results
@@ -78,11 +79,12 @@ def refuse_foreign_report(folder: Path) -> None:
     Raises
     ------
     TsrkitError
-        When ``folder/report.json`` exists and is not a run's report.
+        When ``folder/report.json`` exists and is an input of this run or not a run's report.
     """
     path = folder / "report.json"
     if not os.path.lexists(path):
         return
+    refuse_input(path, "the run's report")
     try:
         report = read_object(path)
     except TsrkitError:

@@ -95,7 +95,7 @@ def test_unreadable_image_and_crashing_plugin_are_skipped(tmp_path):
     reasons = {Path(s["source"]).name: s["reason"] for s in report["skipped"]}
     assert set(reasons) == {"broken.png", "missing.png", "crash"}
     assert "plugin error: RuntimeError: deliberate crash" in reasons["crash"]
-    assert "cannot read" in reasons["missing.png"]
+    assert "no such file" in reasons["missing.png"]
     assert report["frames"] == 1 and report["per_frame"]["recall_mean"] == 1.0
 
 
