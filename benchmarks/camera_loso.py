@@ -27,9 +27,9 @@ every annotated box (grown by a quarter of its long side + 2 px) inpainted
 (``cv2.INPAINT_TELEA``): a frame of the held-out camera without a lit light (on the sets that
 are not exhaustively labelled, unlabelled lights stay, so those counts are upper bounds).
 
-Candidates are cached on disk by the detector's name, parameters and source code
-(``benchmarks/out/candidate_cache``): a rerun, or a run at another commit with the same detector
-code, reads them back.
+Candidates are cached on disk (``benchmarks/out/candidate_cache``), named by the detector's name,
+parameters and candidates on a few probe frames: a rerun, or a run at another commit whose
+detector finds the same candidates, reads them back.
 
 Run:  python benchmarks/camera_loso.py --out benchmarks/out/camera_loso        # ~1 h cold
       python benchmarks/camera_loso.py --tables benchmarks/out/camera_loso [--threshold 0.3]
@@ -73,7 +73,7 @@ from tsrkit_plugins.verifiers.pasting import feathered_alpha, paste_crops, place
 from tsrkit_plugins.verifiers.unlit import no_light_frames  # noqa: E402
 
 cv2.setNumThreads(1)
-#: The plugin tree the run imports (its detectors' code names the candidate cache).
+#: The plugin tree the run imports.
 REPO_PLUGINS = Path(__import__("tsrkit_plugins").__path__[0])
 
 
@@ -104,16 +104,18 @@ THRESHOLDS = (0.1, 0.2, 0.25, 0.3, 0.35, 0.4, 0.5, 0.6, 0.7)
 
 class CachedDetector(Detector):
     """A detector whose candidates are computed once per frame source, kept in memory and
-    appended to a JSON-lines file named by the detector's name, parameters and source code."""
+    appended to a JSON-lines file named by the detector's name, parameters and its candidates
+    on :data:`PROBES` (so a change of code that changes no candidate keeps the cache, one that
+    changes them starts another)."""
 
     def __init__(self, inner: Detector, folder: Path):
         super().__init__(**inner.params)
         self.inner = inner
         self.name = inner.name  # type: ignore[misc]
         digest = hashlib.sha256(f"{inner.name}{sorted(inner.params.items())}".encode())
-        for path in sorted((REPO_PLUGINS / "detectors").rglob("*")):
-            if path.is_file() and "__pycache__" not in path.parts:
-                digest.update(path.read_bytes())
+        for sample in probes():
+            for c in inner.detect(sample.load()):
+                digest.update(json.dumps(asdict(c)).encode())
         folder.mkdir(parents=True, exist_ok=True)
         self.path = folder / f"{digest.hexdigest()[:16]}.jsonl"
         self._seen: dict[str, list[Candidate]] = {}
@@ -131,6 +133,15 @@ class CachedDetector(Detector):
                 fh.write(json.dumps({"key": key, "candidates": [asdict(c) for c in found]}))
                 fh.write("\n")
         return self._seen[key]
+
+
+#: Frames whose candidates name the cache: the first frame of each family.
+PROBES = tuple(f.name for f in FAMILIES)
+
+
+def probes() -> list[Sample]:
+    """The cache's probe frames (:data:`PROBES`)."""
+    return [open_datasets([name]).samples[0] for name in PROBES]
 
 
 def _candidate(row: dict) -> Candidate:
