@@ -11,10 +11,11 @@ overlap, and Lee's summary: frames localised at overlap > 0.65, area precision /
 
 from __future__ import annotations
 
-import os
+import argparse
 
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ[_var] = "1"
+import harness
+
+harness.single_thread()
 
 import tempfile  # noqa: E402
 from pathlib import Path  # noqa: E402
@@ -134,7 +135,8 @@ def run(pipeline: Pipeline, video: Path, boxes: list[tuple]) -> dict:
 
 
 def main() -> None:
-    cv2.setNumThreads(1)
+    argparse.ArgumentParser(description=__doc__).parse_args()  # --help only
+    harness.announce()
     with tempfile.TemporaryDirectory() as tmp:
         video = Path(tmp) / "workzone.avi"
         boxes = write_video(video)

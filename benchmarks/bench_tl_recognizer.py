@@ -18,10 +18,9 @@ are validated.
 
 from __future__ import annotations
 
-import os
+import harness
 
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ[_var] = "1"
+harness.single_thread()
 
 import argparse  # noqa: E402
 import json  # noqa: E402
@@ -43,8 +42,8 @@ from at_commit import module_at  # noqa: E402
 from tl_recognizer_straightforward import tl_recognizer_straightforward  # noqa: E402
 
 WIDTH, HEIGHT = 1413, 1884
-REPO = Path(__file__).resolve().parents[1]
-DATA = Path(os.environ.get("TSRKIT_DATA_DIR", REPO.parent / "shared" / "datasets"))
+REPO = harness.REPO
+DATA = harness.data_dir()
 #: Hues (OpenCV scale) of the cluttered scenes' blobs: red, orange-yellow, green, magenta-red.
 CLUTTER_HUES = (5, 20, 80, 175)
 
@@ -179,7 +178,7 @@ def parsed(pairs) -> dict:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--dataset", default="roboflow_traffic_light_kr")
-    parser.add_argument("--repeats", type=int, default=5)
+    harness.add_repeats(parser, 5)
     parser.add_argument(
         "-p",
         "--param",
@@ -188,14 +187,14 @@ def main() -> None:
         help="detector parameter KEY=VALUE (repeatable)",
     )
     parser.add_argument("--reference", action="store_true", help="time against the reference")
-    parser.add_argument("--frames", type=int, default=5, help="frames per set (--reference)")
+    harness.add_frames(parser, 5, help="frames per set (--reference)")
     parser.add_argument("--blobs", type=int, default=1500, help="blobs per cluttered scene")
     parser.add_argument(
         "--baseline", default="74eb292", help="commit timed alongside with --reference ('' to skip)"
     )
     args = parser.parse_args()
+    harness.announce()
     params = parsed(args.param)
-    cv2.setNumThreads(1)
     if args.reference:
         print(f"tl-recognizer params {params or 'default'}, {args.repeats} repetitions, one thread")
         reference_comparison(params, args.frames, args.blobs, args.repeats, args.baseline)

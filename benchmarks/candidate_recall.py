@@ -18,10 +18,9 @@ Run: python benchmarks/candidate_recall.py [--out benchmarks/out/candidate_recal
 
 from __future__ import annotations
 
-import os
+import harness
 
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ[_var] = "1"
+harness.single_thread()
 
 import argparse  # noqa: E402
 import json  # noqa: E402
@@ -29,7 +28,6 @@ import time  # noqa: E402
 from collections.abc import Iterable, Sequence  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
 from tsrkit.datasets import open_datasets  # noqa: E402
@@ -42,15 +40,13 @@ from tsrkit_plugins.detectors.union import (  # noqa: E402
     parse_members,
 )
 
-cv2.setNumThreads(1)
-
 SETS = {
     "KR": "roboflow_traffic_light_kr:test",
     "cinTA": "roboflow_cinta_v2_id:test",
     "DTLD": "dtld_fridtjofs:test",
     "synthetic": "sample:test",
 }
-#: Size bins of r (px), down to the 2-3 px lenses the issue names.
+#: Size bins of r (px), down to lenses of 2-3 px.
 SIZE_BINS = ((0, 2), (2, 3), (3, 4), (4, 6), (6, 12), (12, float("inf")))
 
 
@@ -189,6 +185,7 @@ def main() -> None:
         "--quick", action="store_true", help="skip the detectors at their paper defaults"
     )
     args = parser.parse_args()
+    harness.announce()
     if args.tables:
         print(markdown(json.loads(Path(args.tables).read_text())))
         return

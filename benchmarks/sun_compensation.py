@@ -21,6 +21,7 @@ import tempfile
 import time
 from pathlib import Path
 
+import harness
 import numpy as np
 from scipy.stats import wilcoxon
 
@@ -70,6 +71,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--write-default-model", action="store_true")
     args = parser.parse_args()
+    harness.announce()
     with tempfile.TemporaryDirectory() as tmp:
         model = train(DEFAULT_MODEL if args.write_default_model else Path(tmp, "sun_pca"))
         registry = get_registry()
