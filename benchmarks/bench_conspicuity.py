@@ -91,7 +91,7 @@ def baseline_module(commit):
 def baseline_detector(module):
     """The baseline module's detector with its default parameters."""
     cls = module.Conspicuity
-    return cls(**{p.name: p.default for p in cls.params})
+    return cls(**{p.name: p.default for p in cls.PARAMS})
 
 
 def same_output(old, new, detect_old, detect_new, images):

@@ -53,9 +53,9 @@ from tsrkit.geometry import iou_matrix, xyxy_to_xywh  # noqa: E402
 from tsrkit.registry import get_registry  # noqa: E402
 from tsrkit.synth.heads import background, render_head  # noqa: E402
 from tsrkit.types import Candidate, Frame  # noqa: E402
-from tsrkit_plugins.classifiers.regions import find_lens  # noqa: E402
-from tsrkit_plugins.housing.fit import fit_housings  # noqa: E402
-from tsrkit_plugins.housing.margin import learn_margin, margin_free_iou, widen  # noqa: E402
+from tsrkit_plugins.shared.regions import find_lens  # noqa: E402
+from tsrkit_plugins.verifiers.housing.fit import fit_housings  # noqa: E402
+from tsrkit_plugins.verifiers.housing.margin import learn_margin, margin_free_iou, widen  # noqa: E402
 
 
 def speed() -> tuple[float, float]:

@@ -37,7 +37,7 @@ THESIS = {"threshold": 0.5, "min_size": 30, "max_boxes": 1}
 
 
 def detector(**params) -> ab.AdaBoostHSV:
-    values = {p.name: p.default for p in ab.AdaBoostHSV.params}
+    values = {p.name: p.default for p in ab.AdaBoostHSV.PARAMS}
     values.update(params)
     return ab.AdaBoostHSV(**values)
 

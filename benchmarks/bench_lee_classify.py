@@ -33,7 +33,7 @@ ANGLES = (0, 10, -10)
 
 
 def classifier(transform: str, n_components: int) -> LogPolarSVM:
-    values = {p.name: p.default for p in LogPolarSVM.params}
+    values = {p.name: p.default for p in LogPolarSVM.PARAMS}
     values.update(transform=transform, n_components=n_components)
     return LogPolarSVM(**values)
 

@@ -98,7 +98,7 @@ def trained_detector() -> AdaBoostHSV:
         image, box = render(i, 1, False, i % 12 == 0)
         samples.append(Sample(f"train-{i}", (Annotation(box, "orange"),), image=image))
         samples.append(Sample(f"empty-{i}", (), image=background(np.random.default_rng(i))))
-    values = {p.name: p.default for p in AdaBoostHSV.params}
+    values = {p.name: p.default for p in AdaBoostHSV.PARAMS}
     values.update(target="orange", labels="box", min_size=10, max_boxes=1, threshold=0.9)
     det = AdaBoostHSV(**values)
     det.use_model(det.fit(samples))
@@ -142,7 +142,7 @@ def main() -> None:
         boxes = write_video(video)
         det = trained_detector()
         only = run(Pipeline(det), video, boxes)
-        tracker = MeanShift(**{p.name: p.default for p in MeanShift.params} | {"min_size": 20})
+        tracker = MeanShift(**{p.name: p.default for p in MeanShift.PARAMS} | {"min_size": 20})
         tracked = run(Pipeline(det, tracker=tracker), video, boxes)
     print(
         f"{FRAMES} frames 640x480 MJPG @15 fps; pole frames {POLE.start}-{POLE.stop - 1}, "

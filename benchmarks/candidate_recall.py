@@ -32,12 +32,12 @@ import numpy as np  # noqa: E402
 
 from tsrkit.datasets import open_datasets  # noqa: E402
 from tsrkit.eval.matching import centre_hits  # noqa: E402
+from tsrkit.params import parse_parts  # noqa: E402
+from tsrkit.registry import get_registry  # noqa: E402
 from tsrkit.types import Candidate, Sample  # noqa: E402
 from tsrkit_plugins.detectors.union import (  # noqa: E402
     DEFAULT_MEMBERS,
-    create_member,
     merge,
-    parse_members,
 )
 
 SETS = {
@@ -81,7 +81,8 @@ def recall_by_size(
 
 def run_detector(name: str, params: dict, samples: Sequence[Sample]):
     """Candidates of every sample and the median ms per frame."""
-    detector = create_member(name, params)
+    detector = get_registry().create("detector", "union", {"members": detector_key(name, params)})
+    detector = detector.members[0]
     found, times = [], []
     for sample in samples:
         frame = sample.load()
@@ -112,7 +113,7 @@ def union_variants(members: list, extras: list) -> list[tuple[str, list]]:
 
 
 def measure(extras: list, quick: bool) -> dict:
-    members = parse_members(DEFAULT_MEMBERS)
+    members = parse_parts(DEFAULT_MEMBERS)
     configs = [] if quick else [(name, {}) for name in ("lab-frst", "conspicuity", "gray-tophat")]
     configs += [] if quick else [("adaboost-hsv", {}), ("tl-recognizer", {})]
     configs += [(n, v) for n, v in members if v or quick] + [("gray-tophat", {"n_top": "15"})]
@@ -191,7 +192,7 @@ def main() -> None:
         return
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    extras = [member for text in args.extra for member in parse_members(text)]
+    extras = [member for text in args.extra for member in parse_parts(text)]
     results = measure(extras, args.quick)
     (out / "results.json").write_text(json.dumps(results, indent=1))
     print(markdown(results))

@@ -42,8 +42,8 @@ import numpy as np  # noqa: E402
 from verifier_speed import candidates  # noqa: E402
 
 import tsrkit_plugins.classifiers.lamp_state.features as lamp_now  # noqa: E402
+import tsrkit_plugins.shared.forest as forest_now  # noqa: E402
 import tsrkit_plugins.verifiers.features as verifier_now  # noqa: E402
-import tsrkit_plugins.verifiers.forest as forest_now  # noqa: E402
 from tsrkit.registry import get_registry  # noqa: E402
 from tsrkit.synth import SynthOptions, render_frame  # noqa: E402
 from tsrkit.types import Frame  # noqa: E402

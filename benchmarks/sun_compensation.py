@@ -36,7 +36,7 @@ from tsrkit.types import Candidate
 SEQUENCES = {"A": 75, "B": 62, "C": 34, "D": 19, "E": 1, "F": 8, "G": 13,
              "H": 96, "I": 112, "J": 154, "K": 172}  # fmt: skip
 FRAMES = 20
-DEFAULT_MODEL = Path("plugins/sun_pca/models/sun_pca_default")
+DEFAULT_MODEL = Path("plugins/classifiers/sun_pca/models/sun_pca_default")
 
 
 def train(out: Path) -> Path:

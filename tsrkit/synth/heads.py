@@ -11,6 +11,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+__all__ = ["LAMP_COLOURS", "RIM_WIDTH", "Head", "background", "render_head", "scatter_heads"]
+
 #: BGR of lit lamps (a slightly orange red, amber, blue-green) by state.
 LAMP_COLOURS = {"red": (40, 40, 230), "yellow": (20, 170, 250), "green": (170, 230, 40)}
 #: Width of a light rim, in lens radii (the dark face is inset by it; cells stay 2.8 radii).

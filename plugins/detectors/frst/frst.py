@@ -5,7 +5,7 @@ its gradient direction; the votes, clipped and sharpened, are smoothed and summe
 Reusable: any detector may call :func:`frst` on a 2-D float map. The votes are cast by a
 compiled loop (:func:`cast_votes`) that finds each affected pixel and adds to it in one pass, with
 no per-radius index arrays; it sums in the order ``np.bincount`` does, so the transform is the
-same to the last bit (issue 16).
+same to the last bit.
 
 Source: G. Loy and A. Zelinsky, "Fast radial symmetry for detecting points of interest",
 IEEE PAMI 25(8), 2003: the definition of the transform and its refinements
@@ -200,7 +200,7 @@ def frst(
     -------
     ndarray, float32, same shape
         Positive at centres of bright radial symmetry, negative at dark ones. Loy & Zelinsky
-        average S_n over the radii; the sum used here (as tsrkit issue 4 states) differs only by
+        average S_n over the radii; the sum used here (Zheng 5.2.2's reading) differs only by
         the factor 1/len(radii).
 
     Examples

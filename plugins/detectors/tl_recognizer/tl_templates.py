@@ -26,8 +26,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from tsrkit.errors import TsrkitError
-from tsrkit.inputs import read_image
+from tsrkit.api import TsrkitError, read_image
 
 #: Colours of the generated templates (BGR): a lit lens as a fixed exposure records it.
 LENS_BGR = {"green": (190, 255, 80), "yellow": (40, 200, 255), "red": (60, 40, 255)}
@@ -208,7 +207,7 @@ def extract_patch(
     :func:`tl_geometry.level_coordinates`; the patch is rotated on the fly, as the paper does, by
     one affine warp from patch pixels to image pixels (bilinear, border replicated).
     """
-    width, height = (size, size) if np.isscalar(size) else size
+    width, height = (size, size) if isinstance(size, int | float) else size
     u0, v0, u1, v1 = box_uv
     su, sv = (u1 - u0) / width, (v1 - v0) / height
     c, s = np.cos(roll), np.sin(roll)
