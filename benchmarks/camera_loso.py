@@ -27,8 +27,8 @@ every annotated box (grown by a quarter of its long side + 2 px) inpainted
 (``cv2.INPAINT_TELEA``): a frame of the held-out camera without a lit light (on the sets that
 are not exhaustively labelled, unlabelled lights stay, so those counts are upper bounds).
 
-Candidates are cached on disk (``benchmarks/out/candidate_cache``), named by the detector's name,
-parameters and candidates on a few probe frames: a rerun, or a run at another commit whose
+Candidates are cached on disk (``benchmarks/out/candidate_cache``), named by the detector's name
+and its candidates on a few probe frames: a rerun, or a run at another commit whose
 detector finds the same candidates, reads them back.
 
 Run:  python benchmarks/camera_loso.py --out benchmarks/out/camera_loso        # ~1 h cold
@@ -54,7 +54,6 @@ from pathlib import Path  # noqa: E402
 import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 import yaml  # noqa: E402
-from candidate_recall import recall_by_size  # noqa: E402
 
 import tsrkit  # noqa: E402
 from tsrkit.datasets import open_datasets  # noqa: E402
@@ -104,15 +103,15 @@ THRESHOLDS = (0.1, 0.2, 0.25, 0.3, 0.35, 0.4, 0.5, 0.6, 0.7)
 
 class CachedDetector(Detector):
     """A detector whose candidates are computed once per frame source, kept in memory and
-    appended to a JSON-lines file named by the detector's name, parameters and its candidates
-    on :data:`PROBES` (so a change of code that changes no candidate keeps the cache, one that
-    changes them starts another)."""
+    appended to a JSON-lines file named by the detector's name and its candidates on
+    :data:`PROBES` (so a change of code or parameters that changes no candidate keeps the cache,
+    one that changes them starts another)."""
 
     def __init__(self, inner: Detector, folder: Path):
         super().__init__(**inner.params)
         self.inner = inner
         self.name = inner.name  # type: ignore[misc]
-        digest = hashlib.sha256(f"{inner.name}{sorted(inner.params.items())}".encode())
+        digest = hashlib.sha256(inner.name.encode())
         for sample in probes():
             for c in inner.detect(sample.load()):
                 digest.update(json.dumps(asdict(c)).encode())
@@ -259,11 +258,11 @@ def dump(samples: Iterable[Sample], detector: Detector, verifier, box: str) -> d
     ``frame``, ``decision`` and ``score`` (the verifier's), ``agreement`` (the detector's own
     score), ``light`` (index of the frame's light its centre hits, -1), ``fit`` (index of a
     light its ``box`` meets at IoU >= 0.5, -1), the reported ``boxes``; and per frame the
-    number of lights, the raw candidates' light hits for candidate recall (``found``) and the
-    truth boxes for AP."""
+    number of lights, the truth boxes (for AP) and per light its lens radius (:func:`lens_radius`)
+    and whether a raw candidate's centre lies in its circle (candidate recall)."""
     rows: dict[str, list] = {k: [] for k in ("frame", "decision", "score", "agreement")}
     rows |= {"light": [], "fit": [], "boxes": []}
-    lights, truth, candidates = [], [], []
+    lights, truth, radius, found_by = [], [], [], []
     samples = list(samples)
     for index, sample in enumerate(samples):
         frame = sample.load()
@@ -271,7 +270,11 @@ def dump(samples: Iterable[Sample], detector: Detector, verifier, box: str) -> d
         lights.append(len(boxes))
         truth += [(index, *b) for b in boxes]
         found = detector.detect(frame)
-        candidates.append(found)
+        radius += [lens_radius(b, box) for b in boxes]
+        if boxes:
+            points = [(c.x, c.y) for c in found]
+            hit = centre_hits(points, boxes).any(axis=0) if points else np.zeros(len(boxes), bool)
+            found_by += hit.tolist()
         staged, decision, score = verifier.scores(frame, found) if found else ([], [], [])
         if not len(staged):
             continue
@@ -296,13 +299,31 @@ def dump(samples: Iterable[Sample], detector: Detector, verifier, box: str) -> d
     }
     out["lights"] = np.asarray(lights)
     out["truth"] = np.asarray(truth, float).reshape(-1, 5)
-    sizes = recall_by_size(samples, candidates)
-    out["recall_bins"] = np.array(list(sizes))
-    out["recall_values"] = np.array(
-        [[v[0] if v[0] is not None else np.nan, v[1]] for v in sizes.values()]
-    )
+    out["light_radius"] = np.asarray(radius, float)
+    out["light_found"] = np.asarray(found_by, bool)
     out["shapes"] = np.array([(s.width or 0, s.height or 0) for s in samples])
     return out
+
+
+#: Lens radius bins (px) of the candidate recall table; the issue's tiny lights are r <= 3.
+LENS_BINS = ((0, 2), (2, 3), (3, 4), (4, 6), (6, 12), (12, np.inf))
+
+
+def lens_radius(box: Sequence[float], kind: str) -> float:
+    """The lens radius of an annotated light: half a lens box's shorter side; a housing box's
+    shorter side / 2.8 (a housing is about 2.8 lens radii across: :mod:`tsrkit.synth.heads`)."""
+    short = min(box[2] - box[0], box[3] - box[1])
+    return short / 2 if kind == "lens" else short / 2.8
+
+
+def recall_by_lens(d: dict) -> list[tuple[float | None, int]]:
+    """Candidate recall and light count, over all lights then per :data:`LENS_BINS`."""
+    r, found = d["light_radius"], d["light_found"]
+    cells = [(found.mean() if len(r) else None, len(r))]
+    for low, high in LENS_BINS:
+        inside = (r >= low) & (r < high)
+        cells.append((found[inside].mean() if inside.any() else None, int(inside.sum())))
+    return cells
 
 
 def figures(d: dict, threshold: float, relative: float, exhaustive: bool) -> dict:
@@ -472,20 +493,20 @@ def tables(out: Path, threshold: float | None = None, relative: float | None = N
                 else None
             )
             ap = ap50(d, part) if exhaustive[part] else None
-            bins = [str(b) for b in d["recall_bins"]]
-            values = d["recall_values"]
+            cells = recall_by_lens(d)
             lines.append(
-                f"| {part} | {info['frames']} | {_f(values[0][0])} | {_f(f['hit'])} | "
+                f"| {part} | {info['frames']} | {_f(cells[0][0])} | {_f(f['hit'])} | "
                 f"{_f(f['precision'])} | {_f(f['iou50_recall'])} | {_f(ap)} ({info['box']}) | "
                 f"{_f(f['fp_per_frame'] if exhaustive[part] else None)} | "
                 f"{_f(e)}{'' if exhaustive[part] or e is None else ' (upper bound)'} | {_f(nl)} |"
             )
-            size_rows.append(
-                f"| {part} | " + " | ".join(f"{_f(v[0])} ({int(v[1])})" for v in values) + " |"
-            )
+            size_rows.append(f"| {part} | " + " | ".join(f"{_f(v)} ({n})" for v, n in cells) + " |")
+    bins = ["all"] + [f"{lo:g}-{hi:g}" if hi < np.inf else f">={lo:g}" for lo, hi in LENS_BINS]
     lines += [
         "",
-        "Candidate recall by light size, r = half the box's shorter side in px (lights):",
+        "Candidate recall (a raw candidate's centre in the light's circle) by lens radius r, px "
+        "(lens box: half its shorter side; housing box: its shorter side / 2.8); lights in "
+        "brackets:",
         "",
         "| held out | " + " | ".join(bins) + " |",
         "|---|" + "---:|" * len(bins),
