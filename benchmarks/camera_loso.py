@@ -68,7 +68,7 @@ from tsrkit.synth.heads import LAMP_COLOURS, render_head  # noqa: E402
 from tsrkit.training import train  # noqa: E402
 from tsrkit.types import Annotation, Candidate, Sample  # noqa: E402
 from tsrkit_plugins.verifiers.learned import passes  # noqa: E402
-from tsrkit_plugins.verifiers.pasting import feathered_alpha, paste_crops, place  # noqa: E402
+from tsrkit_plugins.verifiers.pasting import feathered_alpha, paste, place  # noqa: E402
 from tsrkit_plugins.verifiers.unlit import no_light_frames  # noqa: E402
 
 cv2.setNumThreads(1)
@@ -177,13 +177,24 @@ def no_light_samples() -> list[Sample]:
 
 def mit_samples() -> list[Sample]:
     """MIT test crops (whole heads) pasted, five a scene, into synthetic daylight no-light
-    scenes (the verifier's pasting, :func:`paste_crops`); boxes: the crops."""
+    scenes, each at a housing height log-uniform in 10-110 px (the verifier's pasting:
+    :func:`place`, :func:`paste`, written here so that any commit's pasting module serves);
+    boxes: the crops."""
     crops = sorted(open_datasets(["udacity_mit_tl_crops:test"]).samples, key=lambda s: s.source)
+    images = [c.load().image for c in crops]
     rng = np.random.default_rng(CROP_TEST_SEED)
     out = []
     for frame in no_light_frames(MIT_SCENES, CROP_TEST_SEED, ("day",), "mit-test"):
         image = frame.image.copy()
-        boxes = paste_crops(image, crops, rng)
+        boxes: list = []
+        for _ in range(5):
+            crop = images[int(rng.integers(0, len(images)))]
+            height = max(4, int(round(np.exp(rng.uniform(np.log(10), np.log(110))))))
+            width = max(2, int(round(height * crop.shape[1] / crop.shape[0])))
+            box = place(rng, image.shape[:2], (width, height), boxes)
+            if box is not None:
+                paste(image, crop, box)
+                boxes.append(tuple(float(v) for v in box))
         out.append(_scene(frame.source, image, boxes))
     return out
 
