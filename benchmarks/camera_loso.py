@@ -321,10 +321,10 @@ LENS_BINS = ((0, 2), (2, 3), (3, 4), (4, 6), (6, 12), (12, np.inf))
 
 
 def lens_radius(box: Sequence[float], kind: str) -> float:
-    """The lens radius of an annotated light: half a lens box's shorter side; a housing box's
-    shorter side / 2.8 (a housing is about 2.8 lens radii across: :mod:`tsrkit.synth.heads`)."""
+    """The lens radius of an annotated light: half a lens box's shorter side; half a housing
+    box's shorter side / 1.3 (as ``candidate_recall.py`` bins them)."""
     short = min(box[2] - box[0], box[3] - box[1])
-    return short / 2 if kind == "lens" else short / 2.8
+    return short / 2 if kind == "lens" else short / 2 / 1.3
 
 
 def recall_by_lens(d: dict) -> list[tuple[float | None, int]]:
@@ -516,7 +516,7 @@ def tables(out: Path, threshold: float | None = None, relative: float | None = N
     lines += [
         "",
         "Candidate recall (a raw candidate's centre in the light's circle) by lens radius r, px "
-        "(lens box: half its shorter side; housing box: its shorter side / 2.8); lights in "
+        "(lens box: half its shorter side; housing box: half its shorter side / 1.3); lights in "
         "brackets:",
         "",
         "| held out | " + " | ".join(bins) + " |",
