@@ -31,6 +31,8 @@ Candidates are cached on disk (``benchmarks/out/candidate_cache``), named by the
 and its candidates on a few probe frames: a rerun, or a run at another commit whose
 detector finds the same candidates, reads them back.
 
+A run into a folder that holds a run of the same settings adds its folds to it (``--only``).
+
 Run:  python benchmarks/camera_loso.py --out benchmarks/out/camera_loso        # ~1 h cold
       python benchmarks/camera_loso.py --tables benchmarks/out/camera_loso [--threshold 0.3]
 """
@@ -417,6 +419,14 @@ def run(args) -> None:
         "crop_fold": args.crop_fold, "code": {"commit": commit, "tsrkit": tsrkit.__file__},
         "folds": {},
     }  # fmt: skip
+    earlier = out / "results.json"
+    if earlier.exists():  # a run of other folds (--only) into the same folder: keep its folds
+        before = json.loads(earlier.read_text())
+        same = ("config", "detector_params", "verifier_params", "threshold", "relative")
+        if any(before[k] != results[k] for k in same):
+            raise SystemExit(f"{earlier}: a run of other settings; choose another --out")
+        results["folds"] = before["folds"]
+        results["code"] = before["code"] | {"later": results["code"]}
     started = time.perf_counter()
     folds = [(f.key, [o for o in FAMILIES if o.key != f.key], {}) for f in FAMILIES]
     folds.append(("crops", list(FAMILIES), parse_assignments(args.crop_fold)))
