@@ -11,7 +11,9 @@ import tempfile
 from pathlib import Path
 from types import ModuleType
 
-REPO = Path(__file__).resolve().parents[1]
+import harness
+
+REPO = harness.REPO
 
 
 def module_at(commit: str, path: str) -> ModuleType:

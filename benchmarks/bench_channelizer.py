@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import time
 
+import harness
 import numpy as np
 
 from tsrkit.eval.overlap import match_by_iou
@@ -22,10 +23,11 @@ BINS = ((5, 10), (10, 20), (20, 30), (30, 50), (50, 60))
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--frames", type=int, default=200)
+    harness.add_frames(parser, 200)
     parser.add_argument("--seed", type=int, default=2017)
     parser.add_argument("-p", "--param", action="append", default=[], help="channelizer KEY=V")
     args = parser.parse_args()
+    harness.announce()
     detector = get_registry().create("detector", "channelizer", parse_assignments(args.param))
     data = generate(args.frames, seed=args.seed)
     tp = fp = 0

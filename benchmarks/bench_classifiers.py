@@ -6,18 +6,15 @@ Run: python benchmarks/bench_classifiers.py [--repeats 5]
 
 from __future__ import annotations
 
-import os
+import harness
 
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ[_var] = "1"
+harness.single_thread()
 
 import argparse  # noqa: E402
 import statistics  # noqa: E402
 import tempfile  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
-
-import cv2  # noqa: E402
 
 from tsrkit.datasets import open_dataset  # noqa: E402
 from tsrkit.registry import get_registry  # noqa: E402
@@ -98,7 +95,7 @@ def show(name: str, result: dict) -> None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("--repeats", type=int, default=5)
+    harness.add_repeats(parser, 5)
     parser.add_argument(
         "--param",
         action="append",
@@ -111,7 +108,7 @@ def main() -> None:
         help="also run each classifier with the paper's exact settings",
     )
     args = parser.parse_args()
-    cv2.setNumThreads(1)
+    harness.announce()
     registry = get_registry()
     train, sets = benchmark_sets()
     tmp = tempfile.mkdtemp(prefix="bench_classifiers_")

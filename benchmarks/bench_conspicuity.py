@@ -11,10 +11,9 @@ ratios measured in this run.
 Usage: python benchmarks/bench_conspicuity.py [--frames 8] [--reps 5] [--baseline d213fc8]
 """
 
-import os
+import harness
 
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ[_var] = "1"
+harness.single_thread()
 
 import argparse  # noqa: E402
 import importlib.util  # noqa: E402
@@ -34,13 +33,12 @@ from tsrkit.types import Frame  # noqa: E402
 from tsrkit_plugins.detectors.conspicuity import conspicuity_map  # noqa: E402
 from tsrkit_plugins.detectors.localization import localize  # noqa: E402
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = harness.REPO
 sys.path.insert(0, str(REPO / "tests"))
 from conspicuity_filter2d import conspicuity_filter2d  # noqa: E402
 from oracles.conspicuity_oracle import conspicuity_reference  # noqa: E402
 
-cv2.setNumThreads(1)
-DATA = Path(os.environ.get("TSRKIT_DATA_DIR", REPO.parent / "shared" / "datasets"))
+DATA = harness.data_dir()
 
 
 def frames(count, size):
@@ -93,7 +91,7 @@ def baseline_module(commit):
 def baseline_detector(module):
     """The baseline module's detector with its default parameters."""
     cls = module.Conspicuity
-    return cls(**{p.name: p.default for p in cls.params})
+    return cls(**{p.name: p.default for p in cls.PARAMS})
 
 
 def same_output(old, new, detect_old, detect_new, images):
@@ -126,8 +124,8 @@ def interleaved(calls, reps):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("--frames", type=int, default=8)
-    parser.add_argument("--reps", type=int, default=5)
+    harness.add_frames(parser, 8)
+    harness.add_repeats(parser, 5, flag="--reps")
     parser.add_argument("--oracle-frames", type=int, default=2)
     parser.add_argument(
         "--baseline",
@@ -135,6 +133,7 @@ def main():
         help="commit whose conspicuity detector is timed alongside ('' to skip)",
     )
     args = parser.parse_args()
+    harness.announce()
     print(f"first conspicuity_map call: {first_call_seconds():.2f} s")
     conspicuity = tsrkit.detector("conspicuity")
     tophat = tsrkit.detector("gray-tophat")

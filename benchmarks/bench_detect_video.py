@@ -20,6 +20,8 @@ import tempfile
 import time
 from pathlib import Path
 
+import harness
+
 FPS = 25
 
 
@@ -63,6 +65,7 @@ def main() -> None:
     parser.add_argument("--minutes", type=float, default=10.0)
     parser.add_argument("--detector", default="gray-tophat")
     args = parser.parse_args()
+    harness.announce()
     folder = Path(tempfile.gettempdir()) / "tsrkit-bench-video"
     folder.mkdir(exist_ok=True)
     video = folder / f"drive-{args.minutes:g}min.mp4"

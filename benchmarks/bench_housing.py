@@ -31,10 +31,9 @@ only misses the annotation's margin counts, a wrong housing does not.
 
 from __future__ import annotations
 
-import os
+import harness
 
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ[_var] = "1"
+harness.single_thread()
 
 import argparse  # noqa: E402
 import json  # noqa: E402
@@ -54,11 +53,9 @@ from tsrkit.geometry import iou_matrix, xyxy_to_xywh  # noqa: E402
 from tsrkit.registry import get_registry  # noqa: E402
 from tsrkit.synth.heads import background, render_head  # noqa: E402
 from tsrkit.types import Candidate, Frame  # noqa: E402
-from tsrkit_plugins.classifiers.regions import find_lens  # noqa: E402
-from tsrkit_plugins.housing.fit import fit_housings  # noqa: E402
-from tsrkit_plugins.housing.margin import learn_margin, margin_free_iou, widen  # noqa: E402
-
-cv2.setNumThreads(1)
+from tsrkit_plugins.shared.regions import find_lens  # noqa: E402
+from tsrkit_plugins.verifiers.housing.fit import fit_housings  # noqa: E402
+from tsrkit_plugins.verifiers.housing.margin import learn_margin, margin_free_iou, widen  # noqa: E402
 
 
 def speed() -> tuple[float, float]:
@@ -259,6 +256,7 @@ def main() -> None:
     parser.add_argument("--select", nargs="+", metavar="SET:SPLIT", help="only: which candidate")
     parser.add_argument("--pads", nargs="+", type=float, metavar="P", help="only: fits + P px")
     args = parser.parse_args()
+    harness.announce()
     if args.pads:
         print(
             "| set | split | housings | "

@@ -12,22 +12,20 @@ Run: python benchmarks/bench_lab_frst.py [--frames N] [--repeats R] [--reference
 
 from __future__ import annotations
 
-import os
+import harness
 
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ[_var] = "1"
+harness.single_thread()
 
 import argparse  # noqa: E402
 import json  # noqa: E402
 import statistics  # noqa: E402
 import sys  # noqa: E402
 import time  # noqa: E402
-from pathlib import Path  # noqa: E402
 
 import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = harness.REPO
 sys.path.insert(0, str(REPO / "tests"))
 
 from oracles.frst_oracle import frst_oracle  # noqa: E402
@@ -46,7 +44,7 @@ SIZES = ((480, 356), (1280, 720))
 
 def scenes(count: int) -> list[np.ndarray]:
     """The first ``count`` images of roboflow_traffic_light_kr, as BGR uint8."""
-    root = Path(os.environ.get("TSRKIT_DATA_DIR", REPO.parent / "shared" / "datasets"))
+    root = harness.data_dir()
     entries = json.loads((root / "roboflow_traffic_light_kr" / "annotations.json").read_text())
     return [
         cv2.imread(str(root / "roboflow_traffic_light_kr" / e["file"])) for e in entries[:count]
@@ -161,13 +159,13 @@ def baseline_comparison(images: list[np.ndarray], commit: str, repeats: int) -> 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--frames", type=int, default=10)
-    parser.add_argument("--repeats", type=int, default=10)
+    harness.add_frames(parser, 10)
+    harness.add_repeats(parser, 10)
     parser.add_argument("--beta", type=float, default=None, help="override the beta default")
     parser.add_argument("--reference-frames", type=int, default=3)
     parser.add_argument("--baseline", default="", help="commit whose FRST is timed alongside")
     args = parser.parse_args()
-    cv2.setNumThreads(1)
+    harness.announce()
     images = scenes(args.frames)
     detector = tsrkit.detector("lab-frst", **({} if args.beta is None else {"beta": args.beta}))
     print(f"lab-frst params: {detector.params}")

@@ -12,10 +12,11 @@
 
 from __future__ import annotations
 
-import os
+import argparse
 
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ[_var] = "1"
+import harness
+
+harness.single_thread()
 
 import itertools  # noqa: E402
 import time  # noqa: E402
@@ -36,7 +37,7 @@ THESIS = {"threshold": 0.5, "min_size": 30, "max_boxes": 1}
 
 
 def detector(**params) -> ab.AdaBoostHSV:
-    values = {p.name: p.default for p in ab.AdaBoostHSV.params}
+    values = {p.name: p.default for p in ab.AdaBoostHSV.PARAMS}
     values.update(params)
     return ab.AdaBoostHSV(**values)
 
@@ -110,7 +111,6 @@ def _f(value) -> str:
 
 
 def speed(train) -> None:
-    cv2.setNumThreads(1)
     det = detector()
     model = det.fit(train)
     det.use_model(model)
@@ -137,6 +137,8 @@ def speed(train) -> None:
 
 
 def main() -> None:
+    argparse.ArgumentParser(description=__doc__).parse_args()  # --help only
+    harness.announce()
     kr, cinta = open_dataset(KR), open_dataset(CINTA)
     print(
         "## Held-out pixel accuracy: balanced accuracy (TPR / TNR) of f > 0; test pixels: "

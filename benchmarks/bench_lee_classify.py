@@ -10,10 +10,11 @@ rotated by +-10 deg about the ROI centre, and measures classified crops per seco
 
 from __future__ import annotations
 
-import os
+import argparse
 
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ[_var] = "1"
+import harness
+
+harness.single_thread()
 
 import dataclasses  # noqa: E402
 import time  # noqa: E402
@@ -32,7 +33,7 @@ ANGLES = (0, 10, -10)
 
 
 def classifier(transform: str, n_components: int) -> LogPolarSVM:
-    values = {p.name: p.default for p in LogPolarSVM.params}
+    values = {p.name: p.default for p in LogPolarSVM.PARAMS}
     values.update(transform=transform, n_components=n_components)
     return LogPolarSVM(**values)
 
@@ -62,7 +63,8 @@ def predict(clf: LogPolarSVM, samples, angle: float) -> tuple[list[str], float]:
 
 
 def main() -> None:
-    cv2.setNumThreads(1)
+    argparse.ArgumentParser(description=__doc__).parse_args()  # --help only
+    harness.announce()
     data = open_dataset("gtsrb_test_35px_subset")
     labels = [s.annotations[0].state for s in data.samples]
     train, test = train_test_split(

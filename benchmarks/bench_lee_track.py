@@ -11,10 +11,11 @@ overlap, and Lee's summary: frames localised at overlap > 0.65, area precision /
 
 from __future__ import annotations
 
-import os
+import argparse
 
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ[_var] = "1"
+import harness
+
+harness.single_thread()
 
 import tempfile  # noqa: E402
 from pathlib import Path  # noqa: E402
@@ -97,7 +98,7 @@ def trained_detector() -> AdaBoostHSV:
         image, box = render(i, 1, False, i % 12 == 0)
         samples.append(Sample(f"train-{i}", (Annotation(box, "orange"),), image=image))
         samples.append(Sample(f"empty-{i}", (), image=background(np.random.default_rng(i))))
-    values = {p.name: p.default for p in AdaBoostHSV.params}
+    values = {p.name: p.default for p in AdaBoostHSV.PARAMS}
     values.update(target="orange", labels="box", min_size=10, max_boxes=1, threshold=0.9)
     det = AdaBoostHSV(**values)
     det.use_model(det.fit(samples))
@@ -134,13 +135,14 @@ def run(pipeline: Pipeline, video: Path, boxes: list[tuple]) -> dict:
 
 
 def main() -> None:
-    cv2.setNumThreads(1)
+    argparse.ArgumentParser(description=__doc__).parse_args()  # --help only
+    harness.announce()
     with tempfile.TemporaryDirectory() as tmp:
         video = Path(tmp) / "workzone.avi"
         boxes = write_video(video)
         det = trained_detector()
         only = run(Pipeline(det), video, boxes)
-        tracker = MeanShift(**{p.name: p.default for p in MeanShift.params} | {"min_size": 20})
+        tracker = MeanShift(**{p.name: p.default for p in MeanShift.PARAMS} | {"min_size": 20})
         tracked = run(Pipeline(det, tracker=tracker), video, boxes)
     print(
         f"{FRAMES} frames 640x480 MJPG @15 fps; pole frames {POLE.start}-{POLE.stop - 1}, "

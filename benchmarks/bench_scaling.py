@@ -1,5 +1,5 @@
 """Throughput of ``tsrkit.benchmark`` with 1..N worker processes, and its memory at 200 vs 2,000
-frames, on synthetic 1280x720 frames (issue 16: efficiency >= 0.8, memory ratio <= 1.5).
+frames, on synthetic 1280x720 frames (targets: efficiency >= 0.8, memory ratio <= 1.5).
 
 Each run is a child process (``--child``) that benchmarks the first F frames of one generated
 set (no cache, report writers ``json`` only, so the frame loop and the evaluation are timed, not
@@ -20,18 +20,17 @@ import tempfile
 import time
 from pathlib import Path
 
-from memory_benchmark import SINGLE_THREAD, tree_rss
+import harness
+from memory_benchmark import tree_rss
 
 
 def child(frames: int, data: Path, detector: str, classifier: str, workers: int) -> None:
     """Benchmark the first ``frames`` frames of ``data`` (runs in the measured process)."""
-    import cv2
-
     import tsrkit
     from tsrkit.datasets import open_dataset
     from tsrkit.types import Dataset
 
-    cv2.setNumThreads(1)
+    harness.single_thread()
     full = open_dataset(str(data / "annotations.json"))
     subset = Dataset(f"synth-{frames}", full.samples[:frames], full.format, full.root)
     with tempfile.TemporaryDirectory() as out:
@@ -55,7 +54,9 @@ def measure(frames: int, args: argparse.Namespace, workers: int) -> tuple[float,
     cmd += ["--detector", args.detector, "--classifier", args.classifier]
     cmd += ["--workers", str(workers)]
     start = time.perf_counter()
-    popen = subprocess.Popen(cmd, env={**os.environ, **SINGLE_THREAD}, stdout=subprocess.PIPE)
+    popen = subprocess.Popen(
+        cmd, env={**os.environ, **harness.SINGLE_THREAD}, stdout=subprocess.PIPE
+    )
     proc, peak = psutil.Process(popen.pid), 0
     while popen.poll() is None:
         peak = max(peak, tree_rss(proc))
@@ -70,7 +71,7 @@ def measure(frames: int, args: argparse.Namespace, workers: int) -> tuple[float,
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--child", type=int, default=None, help=argparse.SUPPRESS)
-    parser.add_argument("--frames", type=int, default=2000)
+    harness.add_frames(parser, 2000)
     parser.add_argument("--data", type=Path, default=None, help="synthetic set (made if absent)")
     parser.add_argument("--detector", default="conspicuity")
     parser.add_argument("--classifier", default="ab-hist")
@@ -79,6 +80,7 @@ def main() -> None:
     if args.child is not None:
         child(args.child, args.data, args.detector, args.classifier, int(args.workers))
         return
+    harness.announce()
     if args.data is None:
         args.data = Path(tempfile.gettempdir()) / f"tsrkit-scaling-{args.frames}-1280x720"
     if not (args.data / "annotations.json").is_file():

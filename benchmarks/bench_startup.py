@@ -1,4 +1,4 @@
-"""Start-up time of the command line (issue 15): ``tsrkit --help`` and ``tsrkit plugins``.
+"""Start-up time of the command line: ``tsrkit --help`` and ``tsrkit plugins``.
 
 Each command runs ``--runs`` times in a fresh interpreter (``python -m tsrkit``); the median
 wall time is printed, with the bare interpreter and the old eager start-up (every plugin loaded
@@ -16,6 +16,8 @@ import statistics
 import subprocess
 import sys
 import time
+
+import harness
 
 COMMANDS = {
     "python -c pass (bare interpreter)": [sys.executable, "-c", "pass"],
@@ -43,6 +45,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=7)
     args = parser.parse_args()
+    harness.announce()
     print(f"load average before: {os.getloadavg()[0]:.2f}; {args.runs} runs each")
     for label, command in COMMANDS.items():
         median_seconds(command, 1)  # warm the file cache

@@ -23,10 +23,9 @@ are validated.
 
 from __future__ import annotations
 
-import os
+import harness
 
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ[_var] = "1"
+harness.single_thread()
 
 import argparse  # noqa: E402
 import json  # noqa: E402
@@ -48,8 +47,8 @@ from at_commit import module_at  # noqa: E402
 from tl_recognizer_straightforward import tl_recognizer_straightforward  # noqa: E402
 
 WIDTH, HEIGHT = 1413, 1884
-REPO = Path(__file__).resolve().parents[1]
-DATA = Path(os.environ.get("TSRKIT_DATA_DIR", REPO.parent / "shared" / "datasets"))
+REPO = harness.REPO
+DATA = harness.data_dir()
 #: Hues (OpenCV scale) of the cluttered scenes' blobs: red, orange-yellow, green, magenta-red.
 CLUTTER_HUES = (5, 20, 80, 175)
 
@@ -91,7 +90,7 @@ def baseline_detector(commit: str, params: dict):
     """TL-recognizer as of ``commit`` (its ``tl_recognizer.py``), with ``params`` over the
     defaults."""
     cls = module_at(commit, "plugins/detectors/tl_recognizer/tl_recognizer.py").TlRecognizer
-    return cls(**{**{p.name: p.default for p in cls.params}, **params})
+    return cls(**{**{p.name: p.default for p in cls.PARAMS}, **params})
 
 
 def reference_comparison(
@@ -144,7 +143,7 @@ def cluttered_frames(count: int) -> list[Frame]:
     detector = tsrkit.detector("tl-recognizer")
     ranked = []
     for name in ("roboflow_traffic_light_kr", "roboflow_cinta_v2_id", "iwai_japan_tl"):
-        for sample in tsrkit.dataset(str(DATA / name), format="normalized"):
+        for sample in tsrkit.dataset(str(harness.data_dir() / name), format="normalized"):
             image = cv2.resize(sample.load().image, (WIDTH, HEIGHT), interpolation=cv2.INTER_LINEAR)
             ranked.append((len(detector.scored(Frame(image, sample.source))), sample.source))
     ranked.sort(key=lambda item: (-item[0], item[1]))
@@ -221,7 +220,7 @@ def parsed(pairs) -> dict:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--dataset", default="roboflow_traffic_light_kr")
-    parser.add_argument("--repeats", type=int, default=5)
+    harness.add_repeats(parser, 5)
     parser.add_argument(
         "-p",
         "--param",
@@ -233,14 +232,14 @@ def main() -> None:
     parser.add_argument(
         "--cluttered", type=int, default=0, metavar="N", help="time on the N most cluttered frames"
     )
-    parser.add_argument("--frames", type=int, default=5, help="frames per set (--reference)")
+    harness.add_frames(parser, 5, help="frames per set (--reference)")
     parser.add_argument("--blobs", type=int, default=1500, help="blobs per cluttered scene")
     parser.add_argument(
         "--baseline", default="74eb292", help="commit timed alongside with --reference ('' to skip)"
     )
     args = parser.parse_args()
+    harness.announce()
     params = parsed(args.param)
-    cv2.setNumThreads(1)
     if args.cluttered:
         cluttered_comparison(params, args.cluttered, args.repeats, args.baseline)
         return

@@ -14,6 +14,7 @@ import os
 import platform
 import time
 
+import harness
 import numpy as np
 from scipy.spatial import cKDTree
 
@@ -44,8 +45,9 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--positions", type=int, default=1_000_000)
     parser.add_argument("--side", type=int, default=100, help="grid side: side^2 signals")
-    parser.add_argument("--repeats", type=int, default=3)
+    harness.add_repeats(parser, 3)
     args = parser.parse_args()
+    harness.announce()
     city = grid_city(args.side, seed=0)
     print(
         f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, "

@@ -26,10 +26,9 @@ Run: python benchmarks/candidate_recall.py [--out benchmarks/out/candidate_recal
 
 from __future__ import annotations
 
-import os
+import harness
 
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ[_var] = "1"
+harness.single_thread()
 
 import argparse  # noqa: E402
 import hashlib  # noqa: E402
@@ -39,25 +38,19 @@ from collections.abc import Iterable, Sequence  # noqa: E402
 from dataclasses import asdict  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
 from tsrkit.atomic import write_json  # noqa: E402
 from tsrkit.datasets import open_dataset, open_datasets  # noqa: E402
 from tsrkit.errors import TsrkitError  # noqa: E402
 from tsrkit.eval.matching import centre_hits  # noqa: E402
-from tsrkit.params import ParamError  # noqa: E402
+from tsrkit.params import ParamError, parse_parts  # noqa: E402
+from tsrkit.registry import get_registry  # noqa: E402
 from tsrkit.types import Candidate, Sample  # noqa: E402
 from tsrkit_plugins.detectors.union import (  # noqa: E402
     DEFAULT_MEMBERS,
-    create_member,
     merge,
-    parse_members,
 )
-
-cv2.setNumThreads(1)
-
-REPO = Path(__file__).resolve().parents[1]
 
 SETS = {
     "KR": "roboflow_traffic_light_kr:test",
@@ -112,11 +105,6 @@ def recall_by_size(
     return out
 
 
-def data_dir() -> Path:
-    """The datasets folder: ``$TSRKIT_DATA_DIR``, else ``../shared/datasets``."""
-    return Path(os.environ.get("TSRKIT_DATA_DIR", REPO.parent / "shared" / "datasets"))
-
-
 def open_set(key: str) -> list[Sample]:
     """The samples of set ``key`` of :data:`SETS` (Japan by its folder while the registry
     does not name it)."""
@@ -126,12 +114,13 @@ def open_set(key: str) -> list[Sample]:
     except TsrkitError:
         if key != "Japan":
             raise
-        return list(open_dataset(data_dir() / ref, format="normalized").samples)
+        return list(open_dataset(harness.data_dir() / ref, format="normalized").samples)
 
 
 def run_detector(name: str, params: dict, samples: Sequence[Sample]):
     """Candidates of every sample and the median CPU ms per frame."""
-    detector = create_member(name, params)
+    detector = get_registry().create("detector", "union", {"members": detector_key(name, params)})
+    detector = detector.members[0]
     found, times = [], []
     for sample in samples:
         frame = sample.load()
@@ -200,7 +189,7 @@ def measure(
     sets: list[str],
     cache: Path | None,
 ) -> dict:
-    members = parse_members(member_text)
+    members = parse_parts(member_text)
     configs = [] if quick else [(name, {}) for name in ("lab-frst", "conspicuity", "gray-tophat")]
     configs += [] if quick else [("adaboost-hsv", {}), ("tl-recognizer", {})]
     configs += [(n, v) for n, v in members if v or quick]
@@ -294,6 +283,7 @@ def main() -> None:
         "only: clear it after changing a detector)",
     )
     args = parser.parse_args()
+    harness.announce()
     if args.tables:
         print(markdown(json.loads(Path(args.tables).read_text())))
         return
@@ -302,8 +292,8 @@ def main() -> None:
     if unknown or not sets:
         raise SystemExit(f"candidate_recall: --sets takes names among {', '.join(SETS)}")
     try:
-        extras = [member for text in args.extra for member in parse_members(text)]
-        parse_members(args.members)
+        extras = [member for text in args.extra for member in parse_parts(text)]
+        parse_parts(args.members)
     except ParamError as error:
         raise SystemExit(f"candidate_recall: {error}") from None
     cache = Path(args.cache) if args.cache else None

@@ -1,8 +1,9 @@
 """The straightforward OpenCV version of Zheng's conspicuity map (2016, 3.2.1, Eq. 3.1-3.12), the
-speed reference of issue 16: every window average is one ``cv2.filter2D`` with its mask as a
-normalised kernel (disk A1, the four quadrant parts of A1 and A2, the saturation disk and the
-annulus A3), per radius, borders mirrored (reflect-101); Eq. 3.1 with its root per radius and
-the maximum of Eq. 3.2. The paper's defaults (Table 5-1): radii 1..10, unit weights, margin 0.
+speed reference of ``bench_conspicuity.py``: every window average is one ``cv2.filter2D`` with
+its mask as a normalised kernel (disk A1, the four quadrant parts of A1 and A2, the saturation
+disk and the annulus A3), per radius, borders mirrored (reflect-101); Eq. 3.1 with its root per
+radius and the maximum of Eq. 3.2. The paper's defaults (Table 5-1): radii 1..10, unit weights,
+margin 0.
 """
 
 from __future__ import annotations

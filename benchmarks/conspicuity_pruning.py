@@ -1,5 +1,5 @@
 """Can pruning make the conspicuity detector 3x faster than commit d213fc8 and keep its output?
-(issue 16, part 3; the study behind the "pruning" paragraph of RESULTS.scaling.md).
+(the study behind "Exact pruning" in RESULTS.detector_speed.md).
 
 The idea: compute the exact map (Zheng 2016, Eq. 3.1-3.12) only where a cheap per-pixel upper
 bound U says it could reach the lowest threshold the localization (3.2.2, Figure 3-10) will
@@ -28,10 +28,9 @@ on real frames, the three quantities that decide whether that can pay:
 Usage: python benchmarks/conspicuity_pruning.py [--frames 4] [--reps 3]
 """
 
-import os
+import harness
 
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ[_var] = "1"
+harness.single_thread()
 
 import argparse  # noqa: E402
 import json  # noqa: E402
@@ -56,9 +55,8 @@ from tsrkit_plugins.detectors.conspicuity.conspicuity_kernel import (  # noqa: E
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_conspicuity import baseline_detector, baseline_module  # noqa: E402
 
-cv2.setNumThreads(1)
-REPO = Path(__file__).resolve().parents[1]
-DATA = Path(os.environ.get("TSRKIT_DATA_DIR", REPO.parent / "shared" / "datasets"))
+REPO = harness.REPO
+DATA = harness.data_dir()
 SETS = ("roboflow_traffic_light_kr", "dtld_fridtjofs", "roboflow_cinta_v2_id")
 RADII = tuple(range(1, 11))
 
@@ -275,10 +273,11 @@ def cpu_medians(calls, reps):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("--frames", type=int, default=4)
-    parser.add_argument("--reps", type=int, default=3)
+    harness.add_frames(parser, 4)
+    harness.add_repeats(parser, 3, flag="--reps")
     parser.add_argument("--baseline", default="d213fc8")
     args = parser.parse_args()
+    harness.announce()
     detector = tsrkit.detector("conspicuity")
     params = detector.params
     print(

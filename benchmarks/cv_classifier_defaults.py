@@ -13,17 +13,15 @@ Run::
 
 from __future__ import annotations
 
-import os
+import harness
 
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ[_var] = "1"
+harness.single_thread()
 
 import argparse  # noqa: E402
 import itertools  # noqa: E402
 import tempfile  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-import cv2  # noqa: E402
 from sklearn.model_selection import StratifiedKFold  # noqa: E402
 
 from tsrkit.datasets import open_dataset  # noqa: E402
@@ -93,7 +91,7 @@ def main() -> None:
     parser = grid_parser(__doc__)
     parser.add_argument("--folds", type=int, default=5)
     args = parser.parse_args()
-    cv2.setNumThreads(1)
+    harness.announce()
     train = open_dataset("udacity_mit_tl_crops", format="crops").split("train")
     samples = [s for s in train if s.annotations and s.annotations[0].state in STATES]
     labels = [s.annotations[0].state for s in samples]

@@ -16,16 +16,14 @@ Run: python benchmarks/fusion_study.py --out benchmarks/out/fusion        # dump
 
 from __future__ import annotations
 
-import os
+import harness
 
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ[_var] = "1"
+harness.single_thread()
 
 import argparse  # noqa: E402
 from collections.abc import Callable  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 from verifier_loso import SETS, Memo, no_light_dataset  # noqa: E402
 
@@ -35,8 +33,6 @@ from tsrkit.registry import get_registry  # noqa: E402
 from tsrkit.training import train  # noqa: E402
 from tsrkit_plugins.verifiers.features import candidate_features  # noqa: E402
 from tsrkit_plugins.verifiers.learned import passes  # noqa: E402
-
-cv2.setNumThreads(1)
 
 #: The recommended preset's verifier training parameters (tsrkit/presets/recommended.yaml).
 TRAINING = {"after": "housing", "prior": 0.7, "box_rank": 0.5}
@@ -152,6 +148,7 @@ def main() -> None:
     parser.add_argument("--rules", action="store_true", help="only the tables of a finished dump")
     parser.add_argument("--relative", type=float, default=0.6, help="the per-frame gate")
     args = parser.parse_args()
+    harness.announce()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     if args.rules:

@@ -1,5 +1,5 @@
 """Mutation fuzzing of tsrkit's input surfaces: counts the cases that end in an exception other
-than tsrkit's own clear errors (issue 15: the target is 0).
+than tsrkit's own clear errors (the target is 0).
 
 Surfaces:
 - ``image``: a small PNG and a small JPEG with random byte flips, insertions, deletions,
@@ -30,6 +30,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 import cv2
+import harness
 import numpy as np
 
 from tsrkit.datasets import open_dataset
@@ -265,6 +266,7 @@ def main() -> None:
         "--only", default=None, help="Comma-separated surfaces to run (default all)."
     )
     args = parser.parse_args()
+    harness.announce()
     rng = np.random.default_rng(args.seed)
     folder = Path(tempfile.mkdtemp(prefix="tsrkit-fuzz-"))
     try:

@@ -1,4 +1,4 @@
-"""Mutation fuzzing of tsrkit's GPS log and map readers (issue 13): counts the cases that end
+"""Mutation fuzzing of tsrkit's GPS log and map readers: counts the cases that end
 in an exception other than tsrkit's own clear ``GeoError`` (the target is 0).
 
 Seeds are cut from the real Seattle drive (its first 40 fixes) and the real Bellevue extract
@@ -16,12 +16,12 @@ from __future__ import annotations
 import argparse
 import gzip
 import json
-import os
 import shutil
 import tempfile
 from datetime import UTC, datetime
 from pathlib import Path
 
+import harness
 import numpy as np
 from fuzz import run_surface  # benchmarks/fuzz.py: the mutations and the outcome counts
 
@@ -29,8 +29,8 @@ from tsrkit.geo import GeoError, Track, read_signals, read_track
 from tsrkit.geo.export import to_gpx, to_nmea
 from tsrkit.geo.osm import _nodes
 
-REPO = Path(__file__).resolve().parents[1]
-DATA = Path(os.environ.get("TSRKIT_DATA_DIR", REPO.parent / "shared" / "datasets"))
+REPO = harness.REPO
+DATA = harness.data_dir()
 SET = DATA / "nk_seattle_gps_bellevue_osm"
 
 
@@ -80,6 +80,7 @@ def main() -> None:
     parser.add_argument("--cases", type=int, default=10000)
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args()
+    harness.announce()
     rng = np.random.default_rng(args.seed)
     folder = Path(tempfile.mkdtemp(prefix="tsrkit-fuzz-geo-"))
     try:

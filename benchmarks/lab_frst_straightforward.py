@@ -1,5 +1,5 @@
 """The straightforward NumPy/OpenCV version of LAB-FRST (Zheng 2016, 5.2.2; Loy & Zelinsky 2003),
-the speed reference of issue 16 for ``lab-frst``.
+the speed reference of ``bench_lab_frst.py`` for ``lab-frst``.
 
 Each step is written the plain way: votes added with ``np.add.at`` on the image grid after a
 bounds check, F_n with the power computed per pixel, and the smoothing A_n as one non-separable

@@ -18,19 +18,18 @@ import tempfile
 import time
 from pathlib import Path
 
+import harness
+
 SIZES = (200, 2000)
-SINGLE_THREAD = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
 
 
 def child(frames: int, data: Path, detector: str, workers: int) -> None:
     """Benchmark the first ``frames`` frames of ``data`` (runs in the measured process)."""
-    import cv2
-
     import tsrkit
     from tsrkit.datasets import open_dataset
     from tsrkit.types import Dataset
 
-    cv2.setNumThreads(1)
+    harness.single_thread()
     full = open_dataset(str(data / "annotations.json"))
     subset = Dataset(f"synth-{frames}", full.samples[:frames], full.format, full.root)
     with tempfile.TemporaryDirectory() as out:
@@ -57,7 +56,7 @@ def measure(frames: int, data: Path, detector: str, workers: int) -> tuple[float
     """Peak tree RSS (MiB), wall seconds and the child's output for one run."""
     import psutil
 
-    env = {**os.environ, **SINGLE_THREAD}
+    env = {**os.environ, **harness.SINGLE_THREAD}
     cmd = [
         sys.executable,
         __file__,
@@ -101,11 +100,12 @@ def main() -> None:
     )
     parser.add_argument("--detector", default="gray-tophat")
     parser.add_argument("--workers", type=int, default=2)
-    parser.add_argument("--repeats", type=int, default=3)
+    harness.add_repeats(parser, 3)
     args = parser.parse_args()
     if args.child is not None:
         child(args.child, args.data, args.detector, args.workers)
         return
+    harness.announce()
     data = ensure_data(args.data)
     peaks = {}
     for frames in SIZES:

@@ -1,7 +1,7 @@
 """Cross-camera model selection for the state classifiers, with honest held-out numbers.
 
 Cross-validation on MIT train (``cv_classifier_defaults.py``) sees one camera and so cannot
-choose settings for the situation issue 5 measures: a model trained on MIT crops read on other
+choose settings for the situation measured here: a model trained on MIT crops read on other
 cameras. This script trains every grid point on MIT train, scores it on the five test sets of
 ``bench_classifiers.py`` and then, for each set in turn, picks the grid point with the best
 mean *balanced accuracy* (mean per-class recall over red, yellow, green) on the *other four*
@@ -18,15 +18,13 @@ Run::
 
 from __future__ import annotations
 
-import os
+import harness
 
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ[_var] = "1"
+harness.single_thread()
 
 import tempfile  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 from bench_classifiers import STATES, benchmark_sets, evaluate  # noqa: E402
 from cv_classifier_defaults import grid_parser, grid_points  # noqa: E402
@@ -50,7 +48,7 @@ def describe(result: dict) -> str:
 
 def main() -> None:
     args = grid_parser(__doc__).parse_args()
-    cv2.setNumThreads(1)
+    harness.announce()
     registry = get_registry()
     train, sets = benchmark_sets()
     points = grid_points(args.grid) or [{}]

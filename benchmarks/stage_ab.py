@@ -22,6 +22,8 @@ from __future__ import annotations
 import os
 import tempfile
 
+import harness
+
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ[_var] = "1"
 if "NUMBA_CACHE_DIR" not in os.environ:  # removed at exit
@@ -40,8 +42,8 @@ import numpy as np  # noqa: E402
 from verifier_speed import candidates  # noqa: E402
 
 import tsrkit_plugins.classifiers.lamp_state.features as lamp_now  # noqa: E402
+import tsrkit_plugins.shared.forest as forest_now  # noqa: E402
 import tsrkit_plugins.verifiers.features as verifier_now  # noqa: E402
-import tsrkit_plugins.verifiers.forest as forest_now  # noqa: E402
 from tsrkit.registry import get_registry  # noqa: E402
 from tsrkit.synth import SynthOptions, render_frame  # noqa: E402
 from tsrkit.types import Frame  # noqa: E402
@@ -62,13 +64,14 @@ def load(name: str, path: Path) -> ModuleType:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--base", type=Path, required=True, help="root of the other checkout")
-    parser.add_argument("--frames", type=int, default=10)
-    parser.add_argument("--repeats", type=int, default=5)
+    harness.add_frames(parser, 10)
+    harness.add_repeats(parser, 5)
     parser.add_argument("--candidates", type=int, default=50)
     parser.add_argument(
         "--changed", action="store_true", help="outputs differ by design: count, do not stop"
     )
     args = parser.parse_args()
+    harness.announce()
     plugins = args.base / "plugins"
     versions = {
         "base": (

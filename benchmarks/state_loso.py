@@ -26,10 +26,9 @@ full model alone, as before the colour model).
 
 from __future__ import annotations
 
-import os
+import harness
 
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ[_var] = "1"
+harness.single_thread(opencv=False)
 
 import argparse  # noqa: E402
 import hashlib  # noqa: E402
@@ -170,6 +169,7 @@ def main() -> None:
         help="lamp-state's colour_weight (default: its own)",
     )
     args = parser.parse_args()
+    harness.announce()
     chosen = {"seed": args.seed}
     if args.colour_weight is not None:
         chosen["colour_weight"] = args.colour_weight

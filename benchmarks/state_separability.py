@@ -1,6 +1,6 @@
 """Is a held-out camera's state separable by colour from what the other cameras show?
 
-Evidence for issue 11's target (accuracy and red recall >= 0.95 on every set, leave one set
+Evidence for the target of lamp-state (accuracy and red recall >= 0.95 on every set, leave one set
 out): for each of the six sets of ``state_loso.py`` (MIT test, VGIS day and night deduplicated,
 KR, cinTA, DTLD test), beside the others' training parts that leave-one-set-out (LOSO) trains on.
 
@@ -27,10 +27,9 @@ KR, cinTA, DTLD test), beside the others' training parts that leave-one-set-out 
 
 from __future__ import annotations
 
-import os
+import harness
 
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ[_var] = "1"
+harness.single_thread(opencv=False)
 
 import argparse  # noqa: E402
 
@@ -236,6 +235,7 @@ def main() -> None:
     parser.add_argument("--folds", type=int, default=5, help="folds of the in-set CV")
     parser.add_argument("--neighbours", type=int, default=15, help="colour neighbours counted")
     args = parser.parse_args()
+    harness.announce()
     params = get_registry().create("classifier", "lamp-state", {"seed": args.seed}).params
     data = parts()
     features = {

@@ -21,6 +21,7 @@ import tempfile
 import time
 from pathlib import Path
 
+import harness
 import numpy as np
 from scipy.stats import wilcoxon
 
@@ -35,7 +36,7 @@ from tsrkit.types import Candidate
 SEQUENCES = {"A": 75, "B": 62, "C": 34, "D": 19, "E": 1, "F": 8, "G": 13,
              "H": 96, "I": 112, "J": 154, "K": 172}  # fmt: skip
 FRAMES = 20
-DEFAULT_MODEL = Path("plugins/sun_pca/models/sun_pca_default")
+DEFAULT_MODEL = Path("plugins/classifiers/sun_pca/models/sun_pca_default")
 
 
 def train(out: Path) -> Path:
@@ -70,6 +71,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--write-default-model", action="store_true")
     args = parser.parse_args()
+    harness.announce()
     with tempfile.TemporaryDirectory() as tmp:
         model = train(DEFAULT_MODEL if args.write_default_model else Path(tmp, "sun_pca"))
         registry = get_registry()

@@ -9,8 +9,10 @@ which the test extra installs).
 
 from __future__ import annotations
 
+import argparse
 import time
 
+import harness
 import numpy as np
 import pandas as pd
 from pvlib import solarposition
@@ -29,6 +31,8 @@ def timed(function, *args, **kwargs):
 
 
 def main() -> None:
+    argparse.ArgumentParser(description=__doc__).parse_args()  # --help only
+    harness.announce()
     times = pd.date_range("2025-01-01", "2026-01-01", freq="7min", tz="UTC")[:-1]
     utc = (times - pd.Timestamp("1970-01-01", tz="UTC")).total_seconds().to_numpy()
     print(f"{len(times)} instants per place")

@@ -20,6 +20,7 @@ import argparse
 import tempfile
 from pathlib import Path
 
+import harness
 import numpy as np
 
 from tsrkit.eval.overlap import match_by_iou
@@ -67,11 +68,12 @@ def channelizer_counts(sample, frame, detector) -> np.ndarray:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--frames", type=int, default=12, help="frames per sequence")
+    harness.add_frames(parser, 12, help="frames per sequence")
     parser.add_argument("--lights", type=int, default=3, help="traffic lights per frame")
     parser.add_argument("--channelizers", type=int, default=3, help="channelizers per frame")
     parser.add_argument("-p", "--param", action="append", default=[], help="channelizer KEY=V")
     args = parser.parse_args()
+    harness.announce()
     registry = get_registry()
     with tempfile.TemporaryDirectory() as tmp:
         model = str(train(Path(tmp, "lamps"), args.lights))

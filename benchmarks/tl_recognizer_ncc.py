@@ -9,14 +9,12 @@ ceiling) and keeps at that T. Usage: ``python benchmarks/tl_recognizer_ncc.py``.
 
 from __future__ import annotations
 
-import os
+import harness
 
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ[_var] = "1"
+harness.single_thread()
 
 import argparse  # noqa: E402
 
-import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 from sklearn.metrics import roc_auc_score  # noqa: E402
 
@@ -77,7 +75,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--resize-factor", type=int, default=1)
     args = parser.parse_args()
-    cv2.setNumThreads(1)
+    harness.announce()
     print(f"resize factor {args.resize_factor}; quantiles are median/p90/p99/max")
     print(
         f"{'set':<28} {'setting':<14} {'lights':>6} {'others':>7} {'lights NCC':>22} "

@@ -1,5 +1,5 @@
 """The straightforward version of TL-recognizer's pruning and validation (Mascetti 2016, 3.3-3.5,
-4.1), the speed reference of issue 16 for ``tl-recognizer``.
+4.1), the speed reference of ``bench_tl_recognizer.py --reference`` for ``tl-recognizer``.
 
 Written the plain way: the whole frame is rotated once so that the horizon is level, every
 contour is levelled on its own, and each surviving contour's patch is cropped from the levelled

@@ -1,4 +1,4 @@
-"""``tsrkit track VIDEO`` on rendered drives (Zheng 2016, 3.4 and 5.4; issue 13).
+"""``tsrkit track VIDEO`` on rendered drives (Zheng 2016, 3.4 and 5.4).
 
     python benchmarks/track_drive.py                 # all stages
     python benchmarks/track_drive.py --stage short   # one of: short, flow, long
@@ -27,6 +27,7 @@ import time
 from pathlib import Path
 
 import cv2
+import harness
 import numpy as np
 
 from tsrkit.geo import LocalProjection
@@ -35,7 +36,7 @@ from tsrkit.spatiotemporal.flow import project
 from tsrkit.spatiotemporal.points import Point
 from tsrkit.synth.drive import DriveOptions, render_drive
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = harness.REPO
 WORK = REPO / "benchmarks" / "out" / "track_drive"
 #: The detector setting of every run: Zheng's conspicuity with ab-hist, peaks at 0.8 of the
 #: maximum (the paper's 0.9 loses 2-px lenses to the opening) and radii up to 6 px.
@@ -219,6 +220,7 @@ def main() -> None:
     parser.add_argument("--stage", choices=("short", "flow", "long", "all"), default="all")
     parser.add_argument("--flow-margin", type=int, default=None, help="passed to track")
     args = parser.parse_args()
+    harness.announce()
     stage = args.stage
     extra = [] if args.flow_margin is None else ["--flow-margin", str(args.flow_margin)]
     WORK.mkdir(parents=True, exist_ok=True)

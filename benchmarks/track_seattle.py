@@ -7,10 +7,10 @@ and the vicinity profile plot (Zheng 2016, Figure 3-13 style) written to benchma
 
 from __future__ import annotations
 
-import os
+import argparse
 from datetime import UTC, datetime
-from pathlib import Path
 
+import harness
 import matplotlib
 
 matplotlib.use("Agg")
@@ -22,8 +22,8 @@ from tsrkit.geo import read_signals, read_track, traversals
 from tsrkit.geo.osm import _nodes
 from tsrkit.geo.vicinity import vicinity_profile
 
-REPO = Path(__file__).resolve().parents[1]
-DATA = Path(os.environ.get("TSRKIT_DATA_DIR", REPO.parent / "shared" / "datasets"))
+REPO = harness.REPO
+DATA = harness.data_dir()
 SET = DATA / "nk_seattle_gps_bellevue_osm"
 
 
@@ -32,6 +32,8 @@ def utc(seconds: float) -> str:
 
 
 def main() -> None:
+    argparse.ArgumentParser(description=__doc__).parse_args()  # --help only
+    harness.announce()
     track = read_track(SET / "gps_data.txt")
     signals = read_signals(SET / "map-issue147.osm.gz")
     found = traversals(track, signals, 30.0)

@@ -24,10 +24,9 @@ Several detectors: ``--detector union -p "union.members=lab-frst top=15; conspic
 
 from __future__ import annotations
 
-import os
+import harness
 
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ[_var] = "1"
+harness.single_thread()
 
 import argparse  # noqa: E402
 import json  # noqa: E402
@@ -35,7 +34,6 @@ import time  # noqa: E402
 from dataclasses import dataclass, replace  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 from candidate_recall import SIZE_BINS, bin_label, recall_by_size  # noqa: E402
 
@@ -50,8 +48,6 @@ from tsrkit.training import train  # noqa: E402
 from tsrkit.types import Dataset, Sample  # noqa: E402
 from tsrkit_plugins.verifiers.learned import LearnedVerifier, passes  # noqa: E402
 from tsrkit_plugins.verifiers.mining import no_light_frames  # noqa: E402
-
-cv2.setNumThreads(1)
 
 PAPER = ("conspicuity", "gray-tophat", "lab-frst", "tl-recognizer", "adaboost-hsv")
 
@@ -310,6 +306,7 @@ def main() -> None:
         help="only AP50 of the models of the finished run in --out at these box_rank weights",
     )
     args = parser.parse_args()
+    harness.announce()
     if args.tables:
         results = json.loads(Path(args.tables).read_text())
         measured = next(iter(results["folds"].values()))["loso"]["by_threshold"]

@@ -14,10 +14,9 @@ Run: python benchmarks/verifier_speed.py [--frames 20] [--repeats 5] [--candidat
 
 from __future__ import annotations
 
-import os
+import harness
 
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ[_var] = "1"
+harness.single_thread()
 
 import argparse  # noqa: E402
 import dataclasses  # noqa: E402
@@ -26,7 +25,6 @@ import time  # noqa: E402
 from collections.abc import Callable  # noqa: E402
 from functools import partial  # noqa: E402
 
-import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
 from tsrkit.params import load_config  # noqa: E402
@@ -34,8 +32,6 @@ from tsrkit.registry import get_registry  # noqa: E402
 from tsrkit.synth import SynthOptions, render_frame  # noqa: E402
 from tsrkit.types import Candidate, Frame  # noqa: E402
 from tsrkit_plugins.verifiers.features import candidate_features  # noqa: E402
-
-cv2.setNumThreads(1)
 
 
 def candidates(rng: np.random.Generator, n: int) -> list[Candidate]:
@@ -60,8 +56,8 @@ def timed(stage: Callable[[], object]) -> tuple[float, float]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--frames", type=int, default=20)
-    parser.add_argument("--repeats", type=int, default=5)
+    harness.add_frames(parser, 20)
+    harness.add_repeats(parser, 5)
     parser.add_argument("--candidates", type=int, default=50)
     parser.add_argument(
         "--classifier",
@@ -69,6 +65,7 @@ def main() -> None:
         help="state classifier timed after (default: the recommended preset's)",
     )
     args = parser.parse_args()
+    harness.announce()
     verifier = get_registry().create("verifier", "verifier", {"threshold": 0.5})
     housing = get_registry().create("verifier", "housing")
     rng = np.random.default_rng(0)

@@ -9,10 +9,9 @@ Run: python benchmarks/zheng_accuracy.py [OUT] [--workers 2] [--synth PATH]
 
 from __future__ import annotations
 
-import os
+import harness
 
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ[_var] = "1"
+harness.single_thread(opencv=False)
 
 import argparse  # noqa: E402
 import json  # noqa: E402
@@ -460,6 +459,7 @@ def main(argv: list[str] | None = None) -> None:
         "OUT/synth500 with seed 1)",
     )
     args = parser.parse_args(argv)
+    harness.announce()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     options = {"workers": args.workers, "cache_dir": out / "cache"}

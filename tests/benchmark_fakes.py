@@ -20,7 +20,7 @@ from tsrkit.types import Annotation, Candidate, Dataset, Detection, Sample
 class OracleDetector(Detector):
     name = "oracle"
     summary = "returns the candidates written in the frame's metadata"
-    params = (
+    PARAMS = (
         Param("delay", "float", 0.0, min=0, help="seconds to sleep per frame"),
         Param("crash_on", "str", "", help="raise on the frame with this source"),
     )
@@ -91,4 +91,4 @@ def make(cls, **params):
     """Instantiate a fake plugin with its schema's validated parameters."""
     from tsrkit.params import validate
 
-    return cls(**validate(cls.params, params, cls.name))
+    return cls(**validate(cls.PARAMS, params, cls.name))

@@ -10,6 +10,8 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
+__all__ = ["atomic_open", "finite", "json_line", "write_json"]
+
 
 @contextlib.contextmanager
 def atomic_open(path: str | os.PathLike, mode: str = "w", encoding: str | None = "utf-8"):

@@ -32,6 +32,16 @@ from tsrkit.registry import get_registry
 from tsrkit.report import ProgressBar, RunResult, build_report, merge_sections
 from tsrkit.types import Dataset
 
+__all__ = [
+    "benchmark",
+    "eval_settings",
+    "evaluate",
+    "metrics_for",
+    "remove_stale_files",
+    "run_benchmark",
+    "writers_for",
+]
+
 
 def eval_settings(
     dataset: Dataset, detection: bool = True, iou_threshold: float = 0.5, box: str = "auto"

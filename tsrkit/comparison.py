@@ -24,6 +24,16 @@ from tsrkit.plugin import Classifier, Detector
 from tsrkit.report import HEADLINE, RunResult, fmt, headline, markdown_table, title
 from tsrkit.types import Dataset
 
+__all__ = [
+    "box_ap50",
+    "compare",
+    "compare_markdown",
+    "frame_recalls",
+    "paired_tests",
+    "verifier_tests",
+    "write_compare",
+]
+
 
 def frame_recalls(run: RunResult) -> dict[int, float]:
     """Zheng 5.2.1 recall of every evaluated ground-truth frame, by dataset position."""

@@ -9,6 +9,8 @@ Any detector whose target has a standard size can fill a candidate's ``distance_
 
 from __future__ import annotations
 
+__all__ = ["PANEL_HEIGHT_M", "distance_from_height", "lateral_offset", "vertical_offset"]
+
 #: Lee's channelizer (vertical panel) height: 24 inches, the US standard (3.5).
 PANEL_HEIGHT_M = 24 * 0.0254
 

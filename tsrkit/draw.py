@@ -9,6 +9,8 @@ import numpy as np
 
 from tsrkit.types import Detection
 
+__all__ = ["STATE_COLOURS", "draw_detections"]
+
 #: BGR colour of each state on overlays.
 STATE_COLOURS = {
     "red": (0, 0, 255),

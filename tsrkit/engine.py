@@ -31,6 +31,25 @@ from tsrkit.records import FrameRecord
 from tsrkit.registry import PluginNotFound, get_registry
 from tsrkit.types import Candidate, Frame, Sample
 
+__all__ = [
+    "ENGINES",
+    "BenchmarkError",
+    "Item",
+    "Job",
+    "Result",
+    "classify_annotations",
+    "compute_record",
+    "default_cache_dir",
+    "image_hash",
+    "ordered",
+    "plugin_identity",
+    "pool_context",
+    "process_sample",
+    "run_records",
+    "single_thread",
+    "source_hash",
+]
+
 ENGINES = ("local", "dask")
 Item = TypeVar("Item")
 Result = TypeVar("Result")

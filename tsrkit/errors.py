@@ -4,6 +4,8 @@ The CLI turns any :class:`TsrkitError` into a single line on stderr and exit sta
 else is a bug and keeps its traceback.
 """
 
+__all__ = ["TsrkitError"]
+
 
 class TsrkitError(ValueError):
     """A problem the user can fix: bad parameter, unknown plugin, unreadable file..."""

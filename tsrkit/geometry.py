@@ -11,6 +11,21 @@ from collections.abc import Sequence
 
 import numpy as np
 
+__all__ = [
+    "Box",
+    "as_boxes",
+    "box_areas",
+    "box_centre",
+    "circle_box",
+    "clip_box",
+    "enclosing_circles",
+    "inscribed_circle",
+    "intersection_matrix",
+    "iou_matrix",
+    "xywh_to_xyxy",
+    "xyxy_to_xywh",
+]
+
 Box = tuple[float, float, float, float]
 
 

@@ -25,8 +25,26 @@ if TYPE_CHECKING:
         Verifier,
     )
 
-hookspec = pluggy.HookspecMarker("tsrkit")
-hookimpl = pluggy.HookimplMarker("tsrkit")
+__all__ = [
+    "ENTRY_POINT_GROUP",
+    "hookimpl",
+    "hookspec",
+    "register_classifiers",
+    "register_commands",
+    "register_dataset_formats",
+    "register_detectors",
+    "register_metrics",
+    "register_report_writers",
+    "register_trackers",
+    "register_verifiers",
+]
+
+#: The entry-point group a package declares its tsrkit plugins in (``pyproject.toml``:
+#: ``[project.entry-points.tsrkit]``).
+ENTRY_POINT_GROUP = "tsrkit"
+
+hookspec = pluggy.HookspecMarker(ENTRY_POINT_GROUP)
+hookimpl = pluggy.HookimplMarker(ENTRY_POINT_GROUP)
 
 
 @hookspec

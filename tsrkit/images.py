@@ -15,6 +15,8 @@ from PIL import Image
 
 from tsrkit.errors import TsrkitError
 
+__all__ = ["MAX_PIXELS", "ImageReadError", "max_pixels", "read_image", "to_bgr8"]
+
 #: Default largest image (decoded pixels) read; ``TSRKIT_MAX_PIXELS`` overrides it.
 MAX_PIXELS = 100_000_000
 

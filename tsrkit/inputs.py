@@ -17,6 +17,18 @@ import cv2
 from tsrkit.images import ImageReadError, read_image, to_bgr8
 from tsrkit.types import Frame, Skipped
 
+__all__ = [
+    "IMAGE_EXTENSIONS",
+    "VIDEO_EXTENSIONS",
+    "Work",
+    "expand_paths",
+    "iter_frames",
+    "iter_video",
+    "plan_work",
+    "read_work",
+    "video_frame_count",
+]
+
 IMAGE_EXTENSIONS = {
     ".jpg",
     ".jpeg",

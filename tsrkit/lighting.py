@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
+__all__ = ["LIGHT_CONDITIONS", "condition_of_m", "light_condition", "mean_v"]
+
 #: The four light conditions of Table 4, brightest first.
 LIGHT_CONDITIONS = ("very_high", "high", "mid", "low")
 

@@ -22,6 +22,9 @@ import numpy as np
 
 from tsrkit.atomic import atomic_open, write_json
 from tsrkit.errors import TsrkitError
+from tsrkit.params import Part
+
+__all__ = ["FORMAT_VERSION", "Model", "ModelError", "load_model", "model_paths", "save_model"]
 
 FORMAT_VERSION = 1
 
@@ -172,4 +175,6 @@ def _plain(value: Any) -> Any:
         return value.item()
     if isinstance(value, np.ndarray):
         return value.tolist()
+    if isinstance(value, Part):
+        return value.spec
     return value

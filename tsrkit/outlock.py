@@ -14,6 +14,8 @@ from pathlib import Path
 
 from tsrkit.errors import TsrkitError
 
+__all__ = ["LOCK", "OutputBusy", "locked"]
+
 LOCK = ".tsrkit.lock"
 
 

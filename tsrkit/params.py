@@ -10,12 +10,27 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass
-from typing import Any
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import yaml
 
 from tsrkit.errors import TsrkitError
+
+if TYPE_CHECKING:
+    from tsrkit.plugin import Plugin
+
+__all__ = [
+    "PLUGIN_TYPES",
+    "TYPES",
+    "Param",
+    "ParamError",
+    "Part",
+    "load_config",
+    "parse_assignments",
+    "parse_parts",
+    "validate",
+]
 
 #: Parameter types and what they accept.
 TYPES = {
@@ -26,6 +41,19 @@ TYPES = {
     "path": "a file or folder path",
     "ints": "a list of integers, e.g. 1,2,3 or 1..10",
     "floats": "a list of numbers, e.g. 1,1,2",
+    "detector": "a detector: NAME KEY=VALUE ... ('' for none)",
+    "detectors": "detectors: NAME KEY=VALUE ...; NAME ...",
+    "verifier": "a verifier: NAME KEY=VALUE ... ('' for none)",
+    "classifier": "a classifier: NAME KEY=VALUE ... ('' for none)",
+}
+
+#: Parameter types whose values are plugins the core builds for the plugin that declares
+#: them (:class:`Part`), and the kind of plugin each names.
+PLUGIN_TYPES = {
+    "detector": "detector",
+    "detectors": "detector",
+    "verifier": "verifier",
+    "classifier": "classifier",
 }
 
 _TRUE = {"1", "true", "yes", "on"}
@@ -58,6 +86,10 @@ class Param:
         Required number of elements for list types.
     section : str
         The document section or table the default comes from.
+    options : tuple of Param
+        For a plugin type (:data:`PLUGIN_TYPES`): keys written among a part's own
+        ``KEY=VALUE`` that the declaring plugin reads itself (:attr:`Part.options`), not the
+        part's plugin.
     """
 
     name: str
@@ -69,10 +101,13 @@ class Param:
     choices: tuple | None = None
     length: int | None = None
     section: str = ""
+    options: tuple[Param, ...] = ()
 
     def __post_init__(self):
         if self.type not in TYPES:
             raise ValueError(f"parameter {self.name!r}: unknown type {self.type!r}")
+        if self.options and self.type not in PLUGIN_TYPES:
+            raise ValueError(f"parameter {self.name!r}: only plugin types take options")
 
     def allowed(self) -> str:
         """Describe the allowed values in words."""
@@ -102,6 +137,8 @@ class Param:
                 out[key] = getattr(self, key)
         if self.choices is not None:
             out["choices"] = list(self.choices)
+        if self.options:
+            out["options"] = [p.to_json() for p in self.options]
         return out
 
     def coerce(self, value: Any, owner: str) -> Any:
@@ -135,11 +172,65 @@ class Param:
         return out
 
 
+@dataclass(frozen=True)
+class Part:
+    """A plugin that another plugin is built on, made by the core from a plugin-typed
+    parameter (:data:`PLUGIN_TYPES`): a ``union``'s member, a verifier's stage before it.
+
+    ``str(part)`` is the spec it was made from (reports and cache keys show it).
+    """
+
+    plugin: Plugin = field(repr=False)
+    spec: str
+    options: dict[str, Any] = field(default_factory=dict)
+
+    def __str__(self) -> str:
+        return self.spec
+
+
+def parse_parts(text: str) -> list[tuple[str, dict[str, str]]]:
+    """``"a k=v; b"`` -> ``[("a", {"k": "v"}), ("b", {})]``: the plugins a plugin-typed
+    parameter names, each with its own assignments.
+
+    Raises
+    ------
+    ParamError
+        A ``KEY=VALUE`` without ``=``.
+    """
+    parts = []
+    for chunk in text.split(";"):
+        words = chunk.split()
+        if words:
+            parts.append((words[0], parse_assignments(words[1:])))
+    return parts
+
+
+def _spec(kind: str, value: Any) -> str:
+    """The canonical spec of a plugin-typed value: ``NAME K=V ...``, parts joined by ``; ``."""
+    if isinstance(value, Part):
+        value = value.spec
+    elif isinstance(value, tuple | list) and all(isinstance(v, Part) for v in value):
+        value = "; ".join(v.spec for v in value)
+    if not isinstance(value, str):
+        raise ValueError("not a string")
+    parts = parse_parts(value)
+    if kind != "detectors" and len(parts) > 1:
+        raise ValueError("one plugin only")
+    if kind == "detectors" and not parts:
+        raise ValueError("no plugin named")
+    return "; ".join(
+        " ".join([name, *(f"{k}={v}" for k, v in assignments.items())])
+        for name, assignments in parts
+    )
+
+
 def _jsonable(value: Any) -> Any:
     return list(value) if isinstance(value, tuple) else value
 
 
 def _convert(kind: str, value: Any) -> Any:
+    if kind in PLUGIN_TYPES:
+        return _spec(kind, value) or None  # '' names no plugin
     if kind == "bool":
         if isinstance(value, bool):
             return value

@@ -14,6 +14,8 @@ from tsrkit.plugin import Classifier, Detector, Tracker, Verifier
 from tsrkit.records import FrameRecord
 from tsrkit.types import Candidate, Detection, Frame
 
+__all__ = ["FrameResult", "Pipeline", "as_detections", "check_detection"]
+
 
 @dataclass(frozen=True)
 class FrameResult:

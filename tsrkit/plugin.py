@@ -2,9 +2,11 @@
 Metric and ReportWriter; and the :class:`Trainable` protocol of plugins ``tsrkit train`` fits.
 
 A subclass sets the class attributes ``name``, ``summary``, ``section`` (the document section it
-implements) and ``params`` (a tuple of :class:`tsrkit.params.Param`), then implements the one
-method of its kind. The core validates parameters before calling ``__init__``, so
-``self.params`` always holds every declared key with a checked value.
+implements) and ``PARAMS`` (its parameter schema: a tuple of :class:`tsrkit.params.Param`), then
+implements the one method of its kind. The core validates parameters against ``PARAMS`` before
+calling ``__init__``, so the instance's ``params`` always holds every declared key with a
+checked value; a plugin-typed parameter (:data:`tsrkit.params.PLUGIN_TYPES`) holds the
+:class:`tsrkit.params.Part` the core built from its spec.
 """
 
 from __future__ import annotations
@@ -23,6 +25,19 @@ if TYPE_CHECKING:
     from tsrkit.models import Model
     from tsrkit.report import RunResult
 
+__all__ = [
+    "Classifier",
+    "DatasetFormat",
+    "Detector",
+    "Metric",
+    "Plugin",
+    "ReportWriter",
+    "Tracker",
+    "Trainable",
+    "Verifier",
+    "is_trainable",
+]
+
 
 class Plugin(ABC):  # noqa: B024 - the ABC metaclass serves the kinds' abstract methods
     """Common part of every plugin kind."""
@@ -31,15 +46,16 @@ class Plugin(ABC):  # noqa: B024 - the ABC metaclass serves the kinds' abstract 
     name: ClassVar[str] = ""
     summary: ClassVar[str] = ""
     section: ClassVar[str] = ""
-    params: ClassVar[tuple[Param, ...]] = ()
+    PARAMS: ClassVar[tuple[Param, ...]] = ()
     #: Set when the plugin's own version differs from its distribution's.
     version: ClassVar[str | None] = None
     #: What the plugin has to say about the frame it last processed (e.g. that it fell back to
     #: a simpler model); the pipeline copies it into the frame's record and reports count it.
     notes: tuple[str, ...] = ()
 
-    def __init__(self, **params):
-        self.params = params
+    def __init__(self, **params: Any) -> None:
+        #: The validated values of :attr:`PARAMS`, by name.
+        self.params: dict[str, Any] = params
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}({self.params!r})"
@@ -82,8 +98,9 @@ class Classifier(Plugin):
     """
 
     kind = "classifier"
-    #: The states this classifier can output (besides ``"unknown"``).
-    states: ClassVar[tuple[str, ...]] = ("red", "yellow", "green")
+    #: The states this classifier can output (besides ``"unknown"``); an instance may narrow
+    #: them to what its model knows.
+    states: tuple[str, ...] = ("red", "yellow", "green")
 
     @abstractmethod
     def classify(self, frame: Frame, candidates: Sequence[Candidate]) -> list[Detection]:
@@ -180,6 +197,11 @@ class ReportWriter(Plugin):
     @abstractmethod
     def write(self, run: RunResult, folder: Path) -> None:
         """Write the files into ``folder`` (atomically, :mod:`tsrkit.atomic`)."""
+
+    def write_comparison(self, folder: Path) -> list[str]:
+        """Write files of a ``compare`` folder (its ``compare.json`` and run folders are
+        there) and return their names; by default none."""
+        return []
 
 
 @runtime_checkable

@@ -14,6 +14,8 @@ from typing import Any
 
 from tsrkit.geometry import Box
 
+__all__ = ["BOX_CHOICES", "DECIMALS", "DetectionRecord", "FrameRecord"]
+
 #: Decimals kept for coordinates (and ``ms``) in records.
 DECIMALS = 3
 #: The boxes an evaluation can read from a record (``--eval-box``).

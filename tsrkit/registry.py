@@ -1,7 +1,8 @@
 """The plugin manager: discovery through the ``tsrkit`` entry-point group, and look-up by name.
 
 Built-ins load through the same entry points a third-party package declares; the core's own
-metrics and verbs are internal plugins (:data:`INTERNAL`) registered through the same hooks. A
+metrics are an internal plugin (:data:`INTERNAL`) registered through the same hooks (the command
+line registers the built-in verbs the same way, :mod:`tsrkit.cli.main`). A
 plugin that fails to import or to register is recorded as a :class:`PluginFailure` and the
 others still load. ``TSRKIT_LOAD_PLUGINS`` (comma-separated entry-point names or shell patterns;
 empty for none) limits which installed plugins load; report writers (``writer-*``) and the
@@ -21,9 +22,9 @@ from typing import Any, Literal, overload
 import pluggy
 
 from tsrkit import hookspecs
-from tsrkit.cli.verbs import ENTRY_POINT_GROUP
 from tsrkit.errors import TsrkitError
-from tsrkit.params import ParamError, validate
+from tsrkit.hookspecs import ENTRY_POINT_GROUP
+from tsrkit.params import PLUGIN_TYPES, Param, ParamError, Part, parse_parts, validate
 from tsrkit.plugin import (
     Classifier,
     DatasetFormat,
@@ -36,6 +37,18 @@ from tsrkit.plugin import (
     is_trainable,
 )
 
+__all__ = [
+    "ENTRY_POINT_GROUP",
+    "INTERNAL",
+    "LOAD_ENV",
+    "PluginFailure",
+    "PluginInfo",
+    "PluginNotFound",
+    "Registry",
+    "get_registry",
+    "reset_registry",
+]
+
 LOAD_ENV = "TSRKIT_LOAD_PLUGINS"
 KINDS = {
     "detector": "register_detectors",
@@ -46,8 +59,8 @@ KINDS = {
     "metric": "register_metrics",
     "writer": "register_report_writers",
 }
-#: The core's own plugin modules: the built-in metrics and command-line verbs.
-INTERNAL = {"tsrkit-metrics": "tsrkit.eval.builtin", "tsrkit-commands": "tsrkit.cli.commands"}
+#: The core's own plugin modules: the built-in metrics.
+INTERNAL = {"tsrkit-metrics": "tsrkit.eval.builtin"}
 #: Entry points that load whatever ``TSRKIT_LOAD_PLUGINS`` says.
 ALWAYS_LOAD = ("writer-*",)
 
@@ -76,11 +89,6 @@ class PluginInfo:
     def version(self) -> str:
         return self.cls.version or self.package_version
 
-    def create(self, **params: Any) -> Plugin:
-        """Validate ``params`` against the schema and instantiate the plugin."""
-        values = validate(self.cls.params, params, f"{self.kind} '{self.name}'")
-        return self.cls(**values)
-
     def to_json(self) -> dict[str, Any]:
         """What ``tsrkit plugins --json`` prints for this plugin."""
         return {
@@ -91,7 +99,7 @@ class PluginInfo:
             "summary": self.cls.summary,
             "section": self.cls.section,
             "trainable": is_trainable(self.cls),
-            "params": [p.to_json() for p in self.cls.params],
+            "params": [p.to_json() for p in self.cls.PARAMS],
         }
 
 
@@ -200,8 +208,40 @@ class Registry:
     def create(self, kind: str, name: str, params: Mapping[str, Any] | None = None) -> Plugin: ...
 
     def create(self, kind: str, name: str, params: Mapping[str, Any] | None = None) -> Plugin:
-        """Instantiate a plugin with validated parameters (typed by ``kind`` for the checker)."""
-        return self.get(kind, name).create(**(params or {}))
+        """Instantiate a plugin with validated parameters (typed by ``kind`` for the checker).
+
+        A plugin-typed parameter (:data:`tsrkit.params.PLUGIN_TYPES`) reaches the constructor
+        as the :class:`~tsrkit.params.Part` (or tuple of parts) built here from its spec, so
+        that a plugin receives the plugins it builds on instead of looking them up.
+        """
+        cls = self.get(kind, name).cls
+        values = validate(cls.PARAMS, params or {}, f"{kind} '{name}'")
+        for param in cls.PARAMS:
+            if param.type in PLUGIN_TYPES and values[param.name] is not None:
+                parts = self._parts(param, values[param.name], kind, name)
+                values[param.name] = tuple(parts) if param.type == "detectors" else parts[0]
+        return cls(**values)
+
+    def _parts(self, param: Param, spec: str, kind: str, owner: str) -> list[Part]:
+        """The plugins that ``owner``'s plugin-typed parameter names, built with their own
+        parameters (``param.options`` keys stay with the declaring plugin)."""
+        own_keys = {p.name for p in param.options}
+        parts = []
+        for name, assignments in parse_parts(spec):
+            where = f"{kind} '{owner}': {param.name} {name!r}"
+            if (PLUGIN_TYPES[param.type], name) == (kind, owner):
+                raise ParamError(f"{where}: a plugin cannot be built on itself")
+            own = {k: v for k, v in assignments.items() if k not in own_keys}
+            options = validate(
+                param.options, {k: v for k, v in assignments.items() if k in own_keys}, where
+            )
+            try:
+                plugin = self.create(PLUGIN_TYPES[param.type], name, own)
+            except ParamError as exc:
+                raise ParamError(f"{kind} '{owner}': {param.name}: {exc}") from None
+            text = " ".join([name, *(f"{k}={v}" for k, v in assignments.items())])
+            parts.append(Part(plugin, text, options))
+        return parts
 
     def _collect(self) -> dict[str, dict[str, PluginInfo]]:
         if self._plugins is not None:
@@ -253,13 +293,15 @@ def _check_class(cls: object, kind: str, seen: Mapping[str, PluginInfo]) -> str 
         return f"{cls!r} is not a {kind} plugin class"
     if not cls.name:
         return f"{cls.__name__} has no name"
+    if isinstance(vars(cls).get("params"), tuple):
+        return f"{cls.__name__} declares its parameters as 'params'; name the tuple 'PARAMS'"
     if cls.name in seen:
         return (
             f"duplicate {kind} name '{cls.name}' (already registered by "
             f"{seen[cls.name].package}); the first one is kept"
         )
     try:
-        validate(cls.params, {}, f"{kind} '{cls.name}'")
+        validate(cls.PARAMS, {}, f"{kind} '{cls.name}'")
     except (ParamError, ValueError) as exc:
         return f"invalid parameter schema: {exc}"
     return None

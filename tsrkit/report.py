@@ -7,11 +7,14 @@ built-in ones are in ``tsrkit_plugins.writers``), each atomically (:mod:`tsrkit.
 
 from __future__ import annotations
 
+import dataclasses
+import json
 import platform
 import sys
 from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from importlib import metadata
+from pathlib import Path
 from typing import Any
 
 from rich import box
@@ -23,6 +26,22 @@ from tsrkit.errors import TsrkitError
 from tsrkit.eval.settings import EvalSettings
 from tsrkit.records import FrameRecord
 from tsrkit.types import Dataset, Sample
+
+__all__ = [
+    "HEADLINE",
+    "ProgressBar",
+    "RunResult",
+    "build_report",
+    "fmt",
+    "headline",
+    "load_run",
+    "markdown_table",
+    "merge_sections",
+    "print_table",
+    "report_table",
+    "title",
+    "versions",
+]
 
 #: (section, key, column label, format) of the headline figures.
 HEADLINE = (
@@ -232,3 +251,32 @@ def report_table(reports: list[dict]) -> Table:
 def print_table(reports: list[dict], file=None) -> None:
     """Print the headline table to stdout (or ``file``)."""
     Console(file=file or sys.stdout).print(report_table(reports))
+
+
+def load_run(folder: Path) -> RunResult:
+    """The :class:`RunResult` of a run folder: its ``report.json``, its ``detections.jsonl``
+    and the dataset re-opened by the name the report gives (``name`` or ``name:split``)."""
+    from tsrkit.benchmarking import eval_settings
+    from tsrkit.datasets import open_dataset
+
+    try:
+        report = json.loads((folder / "report.json").read_text(encoding="utf-8"))
+        lines = (folder / "detections.jsonl").read_text(encoding="utf-8").splitlines()
+    except FileNotFoundError as exc:
+        raise TsrkitError(
+            f"{folder}: not a run folder ({Path(exc.filename).name} missing)"
+        ) from None
+    except ValueError as exc:
+        raise TsrkitError(f"{folder}/report.json: not valid JSON ({exc})") from None
+    name, _, split = report["dataset"]["name"].partition(":")
+    dataset = open_dataset(name)
+    if split:
+        dataset = dataset.split(split)
+    index = {s.source: k for k, s in enumerate(dataset.samples)}
+    records = []
+    for line in lines:
+        record = FrameRecord.from_json(json.loads(line))
+        if record.skipped is None and record.source in index:
+            records.append(dataclasses.replace(record, index=index[record.source]))
+    settings = eval_settings(dataset, True, 0.5, report.get("evaluated_box") or "auto")
+    return RunResult(report, dataset, settings, tuple(records))

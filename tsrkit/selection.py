@@ -18,6 +18,17 @@ from tsrkit.pipeline import Pipeline
 from tsrkit.plugin import Classifier, Detector, Tracker, Verifier
 from tsrkit.registry import get_registry
 
+__all__ = [
+    "DEFAULT_DETECTOR",
+    "STAGES",
+    "Config",
+    "Params",
+    "Selection",
+    "build",
+    "build_compare",
+    "route_params",
+]
+
 DEFAULT_DETECTOR = "conspicuity"
 STAGES = ("detector", "verifier", "classifier", "tracker")
 
@@ -120,7 +131,7 @@ def build_compare(
     for kind, name in [*(("detector", d) for d in detectors), *shared.items()]:
         registry.get(kind, name)
     declared = {
-        (kind, name): {p.name for p in registry.get(kind, name).cls.params}
+        (kind, name): {p.name for p in registry.get(kind, name).cls.PARAMS}
         for kind, name in [*(("detector", d) for d in detectors), *shared.items()]
     }
     per_run: list[dict[str, dict[str, Any]]] = [
@@ -186,7 +197,7 @@ def route_params(
         owners = [
             k
             for k, name in selected.items()
-            if key in {p.name for p in registry.get(k, name).cls.params}
+            if key in {p.name for p in registry.get(k, name).cls.PARAMS}
         ]
         if len(owners) == 1:
             routed[owners[0]][key] = value
@@ -198,7 +209,7 @@ def route_params(
         else:
             names = " or ".join(f"{k} '{n}'" for k, n in selected.items())
             allowed = sorted(
-                {p.name for k, n in selected.items() for p in registry.get(k, n).cls.params}
+                {p.name for k, n in selected.items() for p in registry.get(k, n).cls.PARAMS}
             )
             raise ParamError(
                 f"{names}: unknown parameter '{key}' (allowed: {', '.join(allowed) or 'none'})"

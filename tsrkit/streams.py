@@ -20,6 +20,8 @@ from tsrkit.inputs import Work, iter_frames, plan_work, read_work
 from tsrkit.pipeline import FrameResult, Pipeline
 from tsrkit.types import Frame, Skipped
 
+__all__ = ["CHUNK_FRAMES", "process_frame", "run_pipeline"]
+
 #: Kept frames of a video per unit of work: long enough that the seek to a chunk's key frame is
 #: a small share of its decoding, short enough to spread a short clip over the workers.
 CHUNK_FRAMES = 64

@@ -17,6 +17,8 @@ from tsrkit.plugin import Detector, is_trainable
 from tsrkit.registry import PluginInfo, get_registry
 from tsrkit.types import Dataset
 
+__all__ = ["dataset_checksum", "train", "trainable_plugin"]
+
 
 def trainable_plugin(name: str) -> PluginInfo:
     """The trainable detector, verifier or classifier called ``name``."""
@@ -65,7 +67,7 @@ def train(
             f"verifier '{name}' learns on a detector's candidates: give one "
             "(tsrkit train NAME --detector X)"
         )
-    plugin = info.create(**params)
+    plugin = get_registry().create(info.kind, info.name, params)
     extra = {"detector": detector} if detector is not None else {}
     model = plugin.fit(dataset, **extra)  # type: ignore[attr-defined]
     training = {
@@ -80,6 +82,6 @@ def train(
         model,
         plugin=info.name,
         plugin_version=info.version,
-        params=plugin.params,  # type: ignore[arg-type]  # the instance's values
+        params=plugin.params,
         training=training,
     )

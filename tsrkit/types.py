@@ -1,7 +1,8 @@
 """The small immutable values that flow between tsrkit's stages.
 
 Images are NumPy arrays, BGR uint8, as OpenCV reads them. Coordinates are pixels, x right and
-y down; boxes are ``(x_min, y_min, x_max, y_max)``. See ``shared/DESIGN.md`` for the data path.
+y down; boxes are ``(x_min, y_min, x_max, y_max)``. The README's "Where things live" shows the data
+path.
 """
 
 from __future__ import annotations
@@ -15,6 +16,17 @@ import numpy as np
 from tsrkit.geometry import Box, box_centre, circle_box, inscribed_circle
 from tsrkit.images import read_image
 from tsrkit.records import DetectionRecord
+
+__all__ = [
+    "STATES",
+    "Annotation",
+    "Candidate",
+    "Dataset",
+    "Detection",
+    "Frame",
+    "Sample",
+    "Skipped",
+]
 
 #: The signal states every classifier and dataset reader maps its labels onto. ``red_yellow``
 #: is the red+amber phase (Germany, UK...) where a dataset labels it.

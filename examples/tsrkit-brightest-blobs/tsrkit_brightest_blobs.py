@@ -7,7 +7,7 @@ Threshold the HSV value channel at a top percentile, label 8-connected blobs, an
 import cv2
 import numpy as np
 
-from tsrkit import Candidate, Detector, Param, hookimpl
+from tsrkit.api import Candidate, Detector, Param, hookimpl
 
 
 class BrightestBlobs(Detector):
@@ -16,7 +16,7 @@ class BrightestBlobs(Detector):
     name = "brightest-blobs"
     summary = "Brightest connected blobs of the V channel (example plugin)"
     section = "none (example)"
-    params = (
+    PARAMS = (
         Param("percentile", "float", 99.5, min=50, max=100, help="V percentile threshold"),
         Param("top", "int", 5, min=1, max=100, help="Blobs to keep"),
         Param("min_area", "int", 2, min=1, help="Smallest blob in pixels"),

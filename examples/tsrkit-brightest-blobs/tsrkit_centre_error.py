@@ -8,9 +8,7 @@ pixels from its centre to the box centre, as the ``centre_error`` section of ``r
 import math
 import statistics
 
-from tsrkit import Metric, hookimpl
-from tsrkit.eval.matching import centre_hits, greedy_match
-from tsrkit.geometry import box_centre
+from tsrkit.api import Metric, box_centre, centre_hits, greedy_match, hookimpl
 
 
 class CentreError(Metric):

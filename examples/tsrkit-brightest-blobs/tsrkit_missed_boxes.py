@@ -3,9 +3,7 @@ centre fell into (Zheng 5.2.1's rule), with its frame, state and size, to look a
 
 import csv
 
-from tsrkit import ReportWriter, hookimpl
-from tsrkit.atomic import atomic_open
-from tsrkit.eval.matching import centre_hits
+from tsrkit.api import ReportWriter, atomic_open, centre_hits, hookimpl
 
 
 class MissedBoxes(ReportWriter):

@@ -12,15 +12,23 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from tsrkit.errors import TsrkitError
-from tsrkit.hookspecs import hookimpl
-from tsrkit.models import Model, ModelError, load_model
-from tsrkit.params import Param
-from tsrkit.plugin import Classifier, Detector
-from tsrkit.types import Candidate, Detection, Frame, Sample
+from tsrkit.api import (
+    Candidate,
+    Classifier,
+    Detection,
+    Detector,
+    Frame,
+    Model,
+    ModelError,
+    Param,
+    Sample,
+    TsrkitError,
+    hookimpl,
+    load_model,
+)
 from tsrkit_plugins.classifiers.decision import UNKNOWN, best_state, discriminative_ratio
 from tsrkit_plugins.classifiers.priors import warm_red
-from tsrkit_plugins.classifiers.regions import (
+from tsrkit_plugins.shared.regions import (
     labelled_lenses,
     lens_of,
     region_params,
@@ -189,7 +197,7 @@ class AbHist(Classifier):
     name = "ab-hist"
     summary = "CIELab a-b histogram angle matching of lens disk and annulus (trainable)"
     section = "Zheng 2016, 3.3 Eq. 3.16-3.20, 5.3"
-    params = (
+    PARAMS = (
         Param(
             "model",
             "path",

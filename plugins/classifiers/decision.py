@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 
-from tsrkit.eval.state import discriminative_ratio as ratio_or_none
+from tsrkit.api import discriminative_ratio as ratio_or_none
 
 UNKNOWN = "unknown"
 

@@ -13,15 +13,23 @@ import cv2
 import numpy as np
 from scipy.ndimage import gaussian_filter1d
 
-from tsrkit.errors import TsrkitError
-from tsrkit.hookspecs import hookimpl
-from tsrkit.models import Model, ModelError, load_model
-from tsrkit.params import Param
-from tsrkit.plugin import Classifier, Detector
-from tsrkit.types import Candidate, Detection, Frame, Sample
+from tsrkit.api import (
+    Candidate,
+    Classifier,
+    Detection,
+    Detector,
+    Frame,
+    Model,
+    ModelError,
+    Param,
+    Sample,
+    TsrkitError,
+    hookimpl,
+    load_model,
+)
 from tsrkit_plugins.classifiers.decision import UNKNOWN, best_state, fuse_lights
 from tsrkit_plugins.classifiers.priors import warm_red
-from tsrkit_plugins.classifiers.regions import (
+from tsrkit_plugins.shared.regions import (
     clip_box,
     disk_kernel,
     is_housing,
@@ -120,7 +128,7 @@ class HsiBackprojection(Classifier):
     name = "hsi-backprojection"
     summary = "HSI histogram back-projection with a lens-sized circular filter (trainable)"
     section = "Lee 2017, 5.3.3-5.3.4 Eq. 5.6-5.8"
-    params = (
+    PARAMS = (
         Param(
             "model",
             "path",

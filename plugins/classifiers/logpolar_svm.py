@@ -17,13 +17,20 @@ from typing import Any
 import cv2
 import numpy as np
 
-from tsrkit.errors import TsrkitError
-from tsrkit.hookspecs import hookimpl
-from tsrkit.models import Model, load_model
-from tsrkit.params import Param
-from tsrkit.plugin import Classifier, Detector
-from tsrkit.types import Candidate, Detection, Frame, Sample
-from tsrkit_plugins.classifiers.regions import clip_box
+from tsrkit.api import (
+    Candidate,
+    Classifier,
+    Detection,
+    Detector,
+    Frame,
+    Model,
+    Param,
+    Sample,
+    TsrkitError,
+    hookimpl,
+    load_model,
+)
+from tsrkit_plugins.shared.regions import clip_box
 
 #: Parameters that shape the feature vector; a model records them and they must match.
 FEATURE_KEYS = ("transform", "crop_size", "n_rho", "n_theta")
@@ -131,7 +138,7 @@ class LogPolarSVM(Classifier):
     summary = "Intensity-normalised log-polar crop, PCA, SVM over the model's sign classes"
     section = "Lee 2017, 3.4"
     states = ()
-    params = (
+    PARAMS = (
         Param("model", "path", None, help="trained model (tsrkit train logpolar-svm ...)"),
         Param(
             "transform",
@@ -238,6 +245,7 @@ class LogPolarSVM(Classifier):
                     "logpolar-svm --dataset ... --out M' and pass --param model=M"
                 )
             self.use_model(load_model(self.params["model"], plugin=self.name))
+        assert self._model is not None  # use_model set it
         return self._model
 
     def project(self, x: np.ndarray) -> np.ndarray:

@@ -2,7 +2,7 @@
 
 Hue is ordered round the circle red -> orange -> yellow -> green. Red lamps image anywhere from
 pink-red to orange-red depending on the camera (white balance, and over-exposure clipping the red
-channel so that green rises: the orange-red pitfall of issue 5), while one camera's training set
+channel so that green rises: the orange-red pitfall), while one camera's training set
 shows only its own red. Under this prior a trained yellow histogram keeps only the hues from its
 mode away from red, and the red histogram takes over the warm arc between the red mode and the
 yellow mode. It has no tuned number: the boundary is the trained yellow mode. It is a deviation

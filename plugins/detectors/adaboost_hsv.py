@@ -21,13 +21,20 @@ import cv2
 import numpy as np
 from scipy.special import expit
 
-from tsrkit.errors import TsrkitError
-from tsrkit.geometry import clip_box, iou_matrix
-from tsrkit.hookspecs import hookimpl
-from tsrkit.models import Model, load_model
-from tsrkit.params import Param
-from tsrkit.plugin import Detector
-from tsrkit.types import STATES, Candidate, Frame, Sample
+from tsrkit.api import (
+    STATES,
+    Candidate,
+    Detector,
+    Frame,
+    Model,
+    Param,
+    Sample,
+    TsrkitError,
+    clip_box,
+    hookimpl,
+    iou_matrix,
+    load_model,
+)
 
 if TYPE_CHECKING:  # scikit-learn loads when a model is fitted or read, not on import
     from sklearn.ensemble import AdaBoostClassifier
@@ -409,7 +416,7 @@ class AdaBoostHSV(Detector):
     name = "adaboost-hsv"
     summary = "AdaBoost stumps on hue/saturation per pixel, probability map, largest blobs"
     section = "Lee 2017, 3.2 (Eq. 3.1)"
-    params = (
+    PARAMS = (
         Param(
             "model",
             "path",
@@ -570,11 +577,14 @@ class AdaBoostHSV(Detector):
         """The (hue, saturation) posterior table (best colour), loading the model on first use."""
         if self._table is None:
             self.use_model(load_model(self.params["model"] or DEFAULT_MODEL, plugin=self.name))
+        assert self._table is not None
         return self._table
 
     def detect(self, frame: Frame) -> list[Candidate]:
         p = self.params
-        prob, colour = probability_map(frame.image, self.table(), self._colour, p["min_value"])
+        table = self.table()
+        assert self._colour is not None  # set with the table
+        prob, colour = probability_map(frame.image, table, self._colour, p["min_value"])
         boxes, labels, label_image = blob_boxes(prob > p["threshold"], p["min_size"])
         if not len(boxes):
             return []

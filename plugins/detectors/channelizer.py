@@ -19,11 +19,15 @@ from dataclasses import replace
 import cv2
 import numpy as np
 
-from tsrkit.depth import PANEL_HEIGHT_M, distance_from_height
-from tsrkit.hookspecs import hookimpl
-from tsrkit.params import Param
-from tsrkit.plugin import Detector
-from tsrkit.types import Candidate, Frame
+from tsrkit.api import (
+    PANEL_HEIGHT_M,
+    Candidate,
+    Detector,
+    Frame,
+    Param,
+    distance_from_height,
+    hookimpl,
+)
 
 #: Lee's diagonal filter g and its horizontal flip g' (3.5).
 DIAG = np.array([[-1.0, 0.0], [0.0, 1.0]], np.float32)
@@ -95,7 +99,7 @@ class Channelizer(Detector):
     name = "channelizer"
     summary = "Work-zone channelizers: diagonal edge filters, scan lines, orange check, depth"
     section = "Lee 2017, 3.5 (Eq. 3.5-3.7)"
-    params = (
+    PARAMS = (
         Param("horizon", "float", 0.5, min=0.0, max=1.0, section="3.5",
               help="vanishing point row as a fraction of the height, when the frame's metadata "
               "has no horizon_y; the search looks below it"),

@@ -11,10 +11,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from tsrkit.hookspecs import hookimpl
-from tsrkit.params import Param
-from tsrkit.plugin import Detector
-from tsrkit.types import Candidate, Frame
+from tsrkit.api import Candidate, Detector, Frame, Param, hookimpl
 from tsrkit_plugins.detectors.localization import (
     LOCALIZATION_PARAMS,
     ROI_PARAM,
@@ -39,7 +36,7 @@ class GrayTophat(Detector):
     name = "gray-tophat"
     summary = "White top-hat on grayscale + Zheng's localization (GRAY-TOPHAT baseline)"
     section = "Zheng 2016, 5.2.2 (de Charette & Nashashibi) with 3.2.2"
-    params = (
+    PARAMS = (
         Param(
             "se_size",
             "int",

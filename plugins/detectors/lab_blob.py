@@ -30,10 +30,7 @@ import cv2
 import numpy as np
 from numba import njit
 
-from tsrkit.hookspecs import hookimpl
-from tsrkit.params import Param
-from tsrkit.plugin import Detector
-from tsrkit.types import Candidate, Frame
+from tsrkit.api import Candidate, Detector, Frame, Param, hookimpl
 from tsrkit_plugins.detectors.frst.lab_frst import lab_feature_map
 
 
@@ -118,7 +115,7 @@ class LabBlob(Detector):
         "(red) and dark (green) spots"
     )
     section = "Zheng 2016, 5.2.2 (the map); beyond the documents (DoG: Lindeberg 1998, Lowe 2004)"
-    params = (
+    PARAMS = (
         Param(
             "sigma",
             "float",

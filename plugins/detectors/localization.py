@@ -29,8 +29,7 @@ import cv2
 import numpy as np
 from numba import njit
 
-from tsrkit.params import Param
-from tsrkit.types import Candidate
+from tsrkit.api import Candidate, Param
 
 #: The localization parameters both detectors expose (Table 5-1 defaults where it gives one).
 LOCALIZATION_PARAMS = (

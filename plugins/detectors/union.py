@@ -1,4 +1,4 @@
-"""``union``: the candidates of several detectors, merged, for recall (issue 11, item 2).
+"""``union``: the candidates of several detectors, merged, for recall.
 
 Beyond the documents: the learned verifier can only keep what some detector proposed, and each
 paper detector misses lights the others find (lab-frst the small ones, conspicuity the
@@ -52,12 +52,16 @@ from dataclasses import replace
 import cv2
 import numpy as np
 
-from tsrkit.geometry import Box, circle_box
-from tsrkit.hookspecs import hookimpl
-from tsrkit.params import Param, ParamError, parse_assignments, validate
-from tsrkit.plugin import Detector
-from tsrkit.registry import get_registry
-from tsrkit.types import Candidate, Frame
+from tsrkit.api import (
+    Box,
+    Candidate,
+    Detector,
+    Frame,
+    Param,
+    ParamError,
+    circle_box,
+    hookimpl,
+)
 
 DEFAULT_MEMBERS = (
     "lab-frst top=15 fraction=0.1; conspicuity n_top=15; adaboost-hsv max_boxes=10; tl-recognizer"
@@ -68,49 +72,6 @@ SCALE_PARAMS = (
     Param("scale", "float", 1.0, min=0.25, max=4.0, help="resize factor of the member's frame"),
     Param("scale_top", "float", 1.0, min=0.01, max=1.0, help="upper share of rows it searches"),
 )
-
-
-def parse_members(text: str) -> list[tuple[str, dict[str, str]]]:
-    """``"a k=v; b"`` -> ``[("a", {"k": "v"}), ("b", {})]``.
-
-    Raises
-    ------
-    ParamError
-        No member, a member given twice, ``union`` itself, or a ``KEY=VALUE`` without ``=``.
-    """
-    members = []
-    for part in text.split(";"):
-        words = part.split()
-        if not words:
-            continue
-        name, assignments = words[0], words[1:]
-        if name == Union.name:
-            raise ParamError("union: a member cannot be 'union' itself")
-        values = parse_assignments(assignments)
-        if any((name, _scaling(values)) == (seen, _scaling(v)) for seen, v in members):
-            raise ParamError(f"union: member {name!r} given twice at the same scale")
-        members.append((name, values))
-    if not members:
-        raise ParamError(f"union: no member detector in {text!r}")
-    return members
-
-
-def _scaling(values: dict[str, str]) -> tuple[str, str]:
-    """A member's ``scale`` and ``scale_top`` as written (``1`` when not given)."""
-    return values.get("scale", "1"), values.get("scale_top", "1")
-
-
-def split_scaling(values: dict[str, str], owner: str) -> tuple[dict[str, str], float, float]:
-    """A member's own values, and the union's checked ``scale`` and ``scale_top``.
-
-    Raises
-    ------
-    ParamError
-        A ``scale`` or ``scale_top`` outside its range or not a number.
-    """
-    own = {k: v for k, v in values.items() if k not in {p.name for p in SCALE_PARAMS}}
-    scaling = validate(SCALE_PARAMS, {k: v for k, v in values.items() if k not in own}, owner)
-    return own, scaling["scale"], scaling["scale_top"]
 
 
 def map_back(c: Candidate, sx: float, sy: float) -> Candidate:
@@ -154,13 +115,6 @@ class ScaledMember:
         resized = cv2.resize(image, size, interpolation=cv2.INTER_LINEAR)
         found = self.detector.detect(replace(frame, image=resized))
         return [map_back(c, size[0] / w, size[1] / h) for c in found]
-
-
-def create_member(name: str, values: dict[str, str]) -> ScaledMember:
-    """The registered detector ``name`` with its own ``values``, run at the union's ``scale``
-    and ``scale_top`` given among them."""
-    own, scale, top = split_scaling(values, f"union member {name!r}")
-    return ScaledMember(get_registry().create("detector", name, own), scale, top)
 
 
 def rank_scores(count: int) -> np.ndarray:
@@ -208,14 +162,15 @@ class Union(Detector):
 
     name = "union"
     summary = "union of several detectors' candidates: rank-normalised scores, duplicates merged"
-    section = "issue 11 (beyond the documents)"
-    params = (
+    section = "beyond the documents"
+    PARAMS = (
         Param(
             "members",
-            "str",
+            "detectors",
             DEFAULT_MEMBERS,
             help="member detectors with their parameters: 'NAME KEY=VALUE ...; NAME ...'; "
             "scale=S (and scale_top=T) runs a member on the frame's top T upscaled by S",
+            options=SCALE_PARAMS,
         ),
         Param(
             "merge",
@@ -245,7 +200,14 @@ class Union(Detector):
 
     def __init__(self, **params):
         super().__init__(**params)
-        self.members = [create_member(n, v) for n, v in parse_members(self.params["members"])]
+        self.members = [
+            ScaledMember(part.plugin, part.options["scale"], part.options["scale_top"])
+            for part in self.params["members"]
+        ]
+        runs = [(m.detector.name, m.scale, m.top) for m in self.members]
+        twice = sorted({run[0] for run in runs if runs.count(run) > 1})
+        if twice:
+            raise ParamError(f"union: member {twice[0]!r} given twice at the same scale")
 
     def detect(self, frame: Frame) -> list[Candidate]:
         """Every member's candidates, merged; scores in [0, 1]."""

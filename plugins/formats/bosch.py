@@ -17,12 +17,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from tsrkit.datasets import DatasetError
-from tsrkit.datasets.errors import read_yaml
-from tsrkit.hookspecs import hookimpl
-from tsrkit.params import Param
-from tsrkit.plugin import DatasetFormat
-from tsrkit.types import Dataset, Sample
+from tsrkit.api import Dataset, DatasetError, DatasetFormat, Param, Sample, hookimpl, read_yaml
 from tsrkit_plugins.formats.common import absolute, annotation, field, numbers, read_json
 
 #: The 14 BSTLD labels and the state each means (arrows keep their colour).
@@ -80,7 +75,7 @@ class Bosch(DatasetFormat):
     name = "bosch"
     summary = "Bosch Small Traffic Lights YAML/JSON (14 labels -> states, bad boxes repaired)"
     section = "Behrendt, Novak & Botros, ICRA 2017 (BSTLD label files)"
-    params = (
+    PARAMS = (
         Param("width", "int", 1280, min=1, help="Image width for clipping boxes", section="BSTLD"),
         Param("height", "int", 720, min=1, help="Image height for clipping boxes", section="BSTLD"),
     )

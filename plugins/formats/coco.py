@@ -11,13 +11,19 @@ from __future__ import annotations
 
 from collections import defaultdict
 from pathlib import Path
+from typing import Any
 
-from tsrkit.atomic import write_json
-from tsrkit.datasets import DatasetError, to_state
-from tsrkit.geometry import xywh_to_xyxy, xyxy_to_xywh
-from tsrkit.hookspecs import hookimpl
-from tsrkit.plugin import DatasetFormat
-from tsrkit.types import Dataset, Sample
+from tsrkit.api import (
+    Dataset,
+    DatasetError,
+    DatasetFormat,
+    Sample,
+    hookimpl,
+    to_state,
+    write_json,
+    xywh_to_xyxy,
+    xyxy_to_xywh,
+)
 from tsrkit_plugins.formats.common import (
     annotation,
     attributes,
@@ -31,10 +37,10 @@ from tsrkit_plugins.formats.common import (
     optional,
     raw_label,
     read_json,
-    relative_source,
     resolve_image,
     sniff_json,
 )
+from tsrkit_plugins.shared.paths import relative_source
 
 
 def _is_coco(data) -> bool:
@@ -94,7 +100,8 @@ class Coco(DatasetFormat):
         out = Path(out)
         names = class_names(dataset)
         ids = {name: i for i, name in enumerate(names, 1)}
-        images, annotations = [], []
+        images: list[dict[str, Any]] = []
+        annotations: list[dict[str, Any]] = []
         for image_id, sample in enumerate(dataset, 1):
             image = {
                 "id": image_id,

@@ -9,9 +9,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from tsrkit.datasets import DatasetError, to_state
-from tsrkit.datasets.errors import read_text
-from tsrkit.types import STATES, Annotation, Dataset
+from tsrkit.api import STATES, Annotation, Dataset, DatasetError, read_text, to_state
 
 
 def resolve_image(base: Path, name: str, images: Path | None = None) -> str:
@@ -29,11 +27,6 @@ def absolute(path: str | os.PathLike) -> str:
     return os.path.abspath(path)
 
 
-def relative_source(source: str, folder: Path) -> str:
-    """``source`` written relative to ``folder`` (POSIX separators), as writers store it."""
-    return Path(os.path.relpath(Path(source).resolve(), Path(folder).resolve())).as_posix()
-
-
 def annotation(
     bbox: Sequence[float], label: Any, state: str | None = None, /, **attributes: Any
 ) -> Annotation:
@@ -44,8 +37,9 @@ def annotation(
     wins).
     """
     label = str(label)
+    x_min, y_min, x_max, y_max = (float(v) for v in bbox)
     return Annotation(
-        tuple(float(v) for v in bbox), state or to_state(label), {**attributes, "label": label}
+        (x_min, y_min, x_max, y_max), state or to_state(label), {**attributes, "label": label}
     )
 
 

@@ -12,14 +12,18 @@ from __future__ import annotations
 import csv
 import io
 from pathlib import Path
+from typing import Any
 
-from tsrkit.datasets import DatasetError
-from tsrkit.datasets.errors import read_text
-from tsrkit.datasets.imagesize import image_size
-from tsrkit.hookspecs import hookimpl
-from tsrkit.inputs import IMAGE_EXTENSIONS
-from tsrkit.plugin import DatasetFormat
-from tsrkit.types import Dataset, Sample
+from tsrkit.api import (
+    IMAGE_EXTENSIONS,
+    Dataset,
+    DatasetError,
+    DatasetFormat,
+    Sample,
+    hookimpl,
+    image_size,
+    read_text,
+)
 from tsrkit_plugins.formats.common import absolute, annotation, resolve_image
 
 LABELS = "labels.csv"
@@ -104,7 +108,9 @@ def _from_csv(file: Path, images: Path | None) -> list[Sample]:
                 raise DatasetError(file, "empty file or label", where)
             source = resolve_image(file.parent, row["file"], images)
             size = _size(file, row, source, where)
-            metadata = {"lighting": row["condition"]} if row.get("condition") else {}
+            metadata: dict[str, Any] = (
+                {"lighting": row["condition"]} if row.get("condition") else {}
+            )
             samples.append(
                 crop_sample(
                     source, row["label"], *size, SPLITS.get(row.get("split") or ""), **metadata

@@ -13,10 +13,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from tsrkit.datasets import DatasetError
-from tsrkit.hookspecs import hookimpl
-from tsrkit.plugin import DatasetFormat
-from tsrkit.types import Dataset, Sample
+from tsrkit.api import Dataset, DatasetError, DatasetFormat, Sample, hookimpl
 from tsrkit_plugins.formats.common import (
     annotation,
     checked_box,

@@ -18,11 +18,7 @@ import csv
 import io
 from pathlib import Path
 
-from tsrkit.datasets import DatasetError
-from tsrkit.datasets.errors import read_text
-from tsrkit.hookspecs import hookimpl
-from tsrkit.plugin import DatasetFormat
-from tsrkit.types import Dataset, Sample
+from tsrkit.api import Dataset, DatasetError, DatasetFormat, Sample, hookimpl, read_text
 from tsrkit_plugins.formats.common import annotation, checked_box, resolve_image
 
 GT_COLUMNS = ("Filename", "Width", "Height", "Roi.X1", "Roi.Y1", "Roi.X2", "Roi.Y2", "ClassId")

@@ -13,12 +13,7 @@ from __future__ import annotations
 import shlex
 from pathlib import Path
 
-from tsrkit.datasets import DatasetError
-from tsrkit.datasets.errors import read_text
-from tsrkit.hookspecs import hookimpl
-from tsrkit.params import Param
-from tsrkit.plugin import DatasetFormat
-from tsrkit.types import Dataset, Sample
+from tsrkit.api import Dataset, DatasetError, DatasetFormat, Param, Sample, hookimpl, read_text
 from tsrkit_plugins.formats.common import annotation, checked_box, resolve_image
 
 SUBTYPES = {"go": "green", "stop": "red", "warning": "yellow", "ambiguous": "unknown"}
@@ -63,7 +58,7 @@ class Lara(DatasetFormat):
     name = "lara"
     summary = "LaRA traffic lights ground-truth txt (go/stop/warning/ambiguous)"
     section = "LaRA TLR benchmark, Mines ParisTech (Lara_UrbanSeq1_GroundTruth_GT.txt)"
-    params = (
+    PARAMS = (
         Param(
             "image_pattern",
             "str",

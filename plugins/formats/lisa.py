@@ -16,12 +16,7 @@ import csv
 import io
 from pathlib import Path
 
-from tsrkit.datasets import DatasetError
-from tsrkit.datasets.errors import read_text
-from tsrkit.hookspecs import hookimpl
-from tsrkit.params import Param
-from tsrkit.plugin import DatasetFormat
-from tsrkit.types import Dataset, Sample
+from tsrkit.api import Dataset, DatasetError, DatasetFormat, Param, Sample, hookimpl, read_text
 from tsrkit_plugins.formats.common import absolute, annotation, checked_box
 
 COLUMNS = (
@@ -47,7 +42,7 @@ class Lisa(DatasetFormat):
     name = "lisa"
     summary = "LISA traffic light CSV (semicolon; frameAnnotationsBOX / BULB files)"
     section = "Jensen et al., IEEE T-ITS 2016 (LISA Traffic Light Dataset)"
-    params = (
+    PARAMS = (
         Param(
             "kind",
             "str",

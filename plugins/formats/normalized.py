@@ -10,11 +10,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from tsrkit.atomic import write_json
-from tsrkit.datasets import DatasetError, to_state
-from tsrkit.hookspecs import hookimpl
-from tsrkit.plugin import DatasetFormat
-from tsrkit.types import Dataset, Sample
+from tsrkit.api import Dataset, DatasetError, DatasetFormat, Sample, hookimpl, to_state, write_json
 from tsrkit_plugins.formats.common import (
     annotation,
     attributes,
@@ -26,10 +22,10 @@ from tsrkit_plugins.formats.common import (
     optional,
     raw_label,
     read_json,
-    relative_source,
     resolve_image,
     sniff_json,
 )
+from tsrkit_plugins.shared.paths import relative_source
 
 FILE_NAME = "annotations.json"
 COORDS = ("x_min", "y_min", "x_max", "y_max")

@@ -17,21 +17,25 @@ from pathlib import Path
 import defusedxml.ElementTree as SafeET
 from defusedxml import DefusedXmlException
 
-from tsrkit.atomic import atomic_open
-from tsrkit.datasets import DatasetError, to_state
-from tsrkit.datasets.errors import read_text
-from tsrkit.hookspecs import hookimpl
-from tsrkit.plugin import DatasetFormat
-from tsrkit.types import Dataset, Sample
+from tsrkit.api import (
+    Dataset,
+    DatasetError,
+    DatasetFormat,
+    Sample,
+    atomic_open,
+    hookimpl,
+    read_text,
+    to_state,
+)
 from tsrkit_plugins.formats.common import (
     absolute,
     annotation,
     checked_box,
     explicit_state,
     raw_label,
-    relative_source,
     unique_path,
 )
+from tsrkit_plugins.shared.paths import relative_source
 
 ANNOTATIONS = "Annotations"
 SETS = Path("ImageSets") / "Main"
@@ -98,7 +102,7 @@ class Voc(DatasetFormat):
 
 def _splits(root: Path) -> dict[str, str]:
     sets = root / SETS
-    out = {}
+    out: dict[str, str] = {}
     for split_file, split in SPLIT_FILES.items():
         listed = sets / f"{split_file}.txt"
         if listed.is_file():
@@ -128,9 +132,10 @@ def _parse(file: Path) -> ET.Element:
 
 def _text(element: ET.Element, tag: str, file: Path, where: str) -> str:
     found = element.find(tag)
-    if found is None or not (found.text or "").strip():
+    text = "" if found is None else (found.text or "").strip()
+    if not text:
         raise DatasetError(file, f"missing <{tag}>", where)
-    return found.text.strip()
+    return text
 
 
 def _image(file: Path, root: ET.Element, images: Path | None) -> str:
@@ -156,17 +161,16 @@ def _sample(file: Path, images: Path | None, split: str | None) -> Sample:
         if box is None:
             raise DatasetError(file, "missing <bndbox>", where)
         bbox = checked_box([_text(box, k, file, where) for k in COORDS], file, where)
-        flags = {k: int(obj.findtext(k)) for k in FLAGS if (obj.findtext(k) or "").isdecimal()}
+        flags = {k: int(text) for k in FLAGS if (text := obj.findtext(k) or "").isdecimal()}
         state = explicit_state(
             {"state": obj.findtext("state")} if obj.find("state") is not None else {}, file, where
         )
         annotations.append(annotation(bbox, label, state, **flags))
-    size = {
-        k: int(root.findtext(f"size/{k}"))
+    width, height = (
+        int(text) if (text := (root.findtext(f"size/{k}") or "").strip()).isdecimal() else None
         for k in ("width", "height")
-        if (root.findtext(f"size/{k}") or "").strip().isdecimal()
-    }
-    return Sample(_image(file, root, images), tuple(annotations), split=split, **size)
+    )
+    return Sample(_image(file, root, images), tuple(annotations), width, height, split=split)
 
 
 def _element(sample: Sample, folder: Path) -> ET.Element:
@@ -188,8 +192,8 @@ def _element(sample: Sample, folder: Path) -> ET.Element:
             if flag in ann.attributes:
                 ET.SubElement(obj, flag).text = str(int(ann.attributes[flag]))
         box = ET.SubElement(obj, "bndbox")
-        for key, value in zip(COORDS, ann.bbox):
-            ET.SubElement(box, key).text = f"{float(value):.3f}".rstrip("0").rstrip(".")
+        for key, edge in zip(COORDS, ann.bbox):
+            ET.SubElement(box, key).text = f"{float(edge):.3f}".rstrip("0").rstrip(".")
     ET.indent(root)
     return root
 

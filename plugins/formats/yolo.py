@@ -17,14 +17,18 @@ from pathlib import Path
 
 import yaml
 
-from tsrkit.atomic import atomic_open
-from tsrkit.datasets import DatasetError
-from tsrkit.datasets.errors import read_text, read_yaml
-from tsrkit.datasets.imagesize import image_size
-from tsrkit.hookspecs import hookimpl
-from tsrkit.inputs import IMAGE_EXTENSIONS
-from tsrkit.plugin import DatasetFormat
-from tsrkit.types import Dataset, Sample
+from tsrkit.api import (
+    IMAGE_EXTENSIONS,
+    Dataset,
+    DatasetError,
+    DatasetFormat,
+    Sample,
+    atomic_open,
+    hookimpl,
+    image_size,
+    read_text,
+    read_yaml,
+)
 from tsrkit_plugins.formats.common import (
     absolute,
     annotation,
@@ -109,7 +113,8 @@ class Yolo(DatasetFormat):
         data = read_data_yaml(file)
         classes = class_table(data, file)
         base = file.parent / str(data.get("path") or ".")
-        samples, missing = [], []
+        samples: list[Sample] = []
+        missing: list[str] = []
         for key, split in SPLIT_KEYS.items():
             if not data.get(key):
                 continue

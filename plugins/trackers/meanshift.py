@@ -14,10 +14,7 @@ from dataclasses import dataclass, replace
 import cv2
 import numpy as np
 
-from tsrkit.hookspecs import hookimpl
-from tsrkit.params import Param
-from tsrkit.plugin import Tracker
-from tsrkit.types import Candidate, Detection, Frame
+from tsrkit.api import Candidate, Detection, Frame, Param, Tracker, hookimpl
 
 
 @dataclass(frozen=True)
@@ -158,7 +155,7 @@ class MeanShift(Tracker):
     name = "meanshift"
     summary = "Kernel mean shift on 20x20 hue-saturation histograms, five kernel scales"
     section = "Lee 2017, 3.3 (Eq. 3.2-3.4), 3.6.2"
-    params = (
+    PARAMS = (
         Param(
             "bins",
             "ints",
@@ -266,13 +263,15 @@ class MeanShift(Tracker):
         return True
 
     def _follow(self, frame: Frame) -> Detection | None:
+        target, last, start = self._target, self._window, self._detection
+        assert target is not None and last is not None and start is not None  # a track is on
         grow = 1 + max(self.params["scales"]) / 100
-        planes = self._planes(frame, self._window, 2.0 * grow)
-        best, score = None, -1.0
+        planes = self._planes(frame, last, 2.0 * grow)
+        best, score = last, -1.0
         for percent in self.params["scales"]:
-            window = self._window.scaled(1 + percent / 100)
+            window = last.scaled(1 + percent / 100)
             window, similarity = track_scale(
-                planes, self._target, window, self.params["max_iter"], self.params["epsilon"]
+                planes, target, window, self.params["max_iter"], self.params["epsilon"]
             )
             if similarity > score:
                 best, score = window, similarity
@@ -281,7 +280,6 @@ class MeanShift(Tracker):
             self.reset()
             return None
         self._window = best
-        start = self._detection
         return replace(
             start,
             candidate=Candidate.from_box(best.bbox, score, start.candidate.state),
@@ -296,6 +294,7 @@ class MeanShift(Tracker):
         out = list(detections)
         for i, detection in enumerate(out):
             if self.starts(detection) and self._start(frame, detection):
+                assert self._detection is not None  # _start set it
                 out[i] = self._detection
                 break
         return out

@@ -1,7 +1,7 @@
 """Training-time augmentation of the learned verifier: each real frame at other scales and as
 other cameras would render it.
 
-Why (issue 11, benchmarks/RESULTS.verifier.md): the verifier is judged on cameras it never
+Why (benchmarks/RESULTS.verifier.md): the verifier is judged on cameras it never
 saw, but learns the scale and colour rendering of its few training cameras. Trained without
 cinTA, it gives cinTA's near, large, blurred LED heads a median probability of 0.03-0.42,
 while KR and DTLD hold small distant lights. Two kinds of extra views of every real training
@@ -36,9 +36,7 @@ from dataclasses import dataclass, replace
 import cv2
 import numpy as np
 
-from tsrkit.geometry import Box
-from tsrkit.params import ParamError
-from tsrkit.types import Frame
+from tsrkit.api import Box, Frame, ParamError
 
 #: Exposure gain range of a camera look (drawn log-uniform): darker to brighter than the frame.
 EXPOSURE = (0.6, 1.7)

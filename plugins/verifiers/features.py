@@ -16,7 +16,7 @@ import numpy as np
 from numba import njit
 from skimage.feature._hoghistogram import hog_histograms
 
-from tsrkit.types import Candidate
+from tsrkit.api import Candidate
 from tsrkit_plugins.verifiers.reductions import pairwise_sum
 
 #: Side of the lens context, in lens radii (lens disk: 1 radius, annulus 1-2, surround 2-3).
@@ -131,7 +131,7 @@ def remap_points(image: np.ndarray, map_x: np.ndarray, map_y: np.ndarray) -> np.
     The points go to ``cv2.remap`` as rows of up to :data:`REMAP_ROW` (one row for 50
     candidates; its cost is mostly per row: a tall stack of 12- or 16-pixel rows takes 3x as
     long); each output pixel is a function of its own point alone, so the samples are those of
-    any other layout (``tests/test_verifier_features_oracle.py``).
+    any other layout (``tests/verifiers/test_verifier_features_oracle.py``).
 
     Returns
     -------
@@ -167,7 +167,7 @@ def stacked_hog(lightness: np.ndarray, rows: int) -> np.ndarray:
     The steps are ``hog``'s own (float32 central differences, then the orientation histograms
     of ``skimage.feature._hoghistogram``, the compiled routine ``hog`` calls), with its
     block-by-block L1 normalisation (a Python loop, one pass per cell) done for all cells in
-    one array operation: the same numbers, which ``tests/test_verifier.py`` checks against
+    one array operation: the same numbers, which ``tests/verifiers/test_verifier.py`` checks against
     ``hog`` itself (and so against a change of that private routine).
     """
     n, height, width = lightness.shape
@@ -347,8 +347,9 @@ def colour_features(lens: np.ndarray, housing: np.ndarray) -> np.ndarray:
     ``lens`` (256, N, 8) and ``housing`` (264, N, 8) are :func:`colour_planes` of the samples,
     pixel after pixel (row-major in the 16 x 16 and 22 x 12 samples), candidate inside. The
     values are those of numpy's means, deviations and shares over the pixels (the
-    patch-by-patch computation before it), to the bit (``tests/test_verifier_features_oracle.py``),
-    in one compiled pass (:func:`fill_colour`): a mean over the pixels adds them one after the
+    patch-by-patch computation before it), to the bit
+    (``tests/verifiers/test_verifier_features_oracle.py``), in one compiled pass
+    (:func:`fill_colour`): a mean over the pixels adds them one after the
     other, as numpy adds along an outer axis; the lightness deviations follow numpy's
     reductions of the layouts the patch-by-patch computation had (lens: candidate innermost,
     so pixel after pixel, but pairwise for a single candidate; housing: a row per candidate,

@@ -1,11 +1,11 @@
 """``verifier``: a learned stage that rescores or rejects the candidates of any detector.
 
-Beyond the three documents (issue 11): a gradient-boosted classifier (scikit-learn's
+Beyond the three documents: a gradient-boosted classifier (scikit-learn's
 ``HistGradientBoostingClassifier``) reads features of each candidate and its housing
 (:mod:`features`: HOG, Lab/HSV statistics of lens, annulus, surround and housing, surround
 darkness, geometry, frame position, the detector's score) and gives the probability that the
 candidate is a lit traffic light. The candidate's score is that probability, blended with the
-detector's own score by ``prior`` (issue 11: the ``union`` detector's agreement score holds on
+detector's own score by ``prior`` (the ``union`` detector's agreement score holds on
 cameras the model never saw, where the probability drops); candidates scoring below
 ``threshold``, or below ``relative`` x the best score of their frame, are dropped. Trained by
 ``tsrkit train verifier --detector X`` on that detector's candidates labelled by Zheng's centre
@@ -27,18 +27,24 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from tsrkit.errors import TsrkitError
-from tsrkit.hookspecs import hookimpl
-from tsrkit.models import Model, ModelError, load_model
-from tsrkit.params import Param
-from tsrkit.plugin import Detector, Verifier
-from tsrkit.registry import get_registry
-from tsrkit.types import Candidate, Frame, Sample
+from tsrkit.api import (
+    Candidate,
+    Detector,
+    Frame,
+    Model,
+    ModelError,
+    Param,
+    Sample,
+    TsrkitError,
+    Verifier,
+    hookimpl,
+    load_model,
+)
+from tsrkit_plugins.shared.forest import Forest
+from tsrkit_plugins.shared.persistence import BOX_ARRAY, estimator_arrays, load_estimator
 from tsrkit_plugins.verifiers.augment import Augmentation
 from tsrkit_plugins.verifiers.features import candidate_features, feature_names, layout
-from tsrkit_plugins.verifiers.forest import Forest
 from tsrkit_plugins.verifiers.mining import Labelled, Stage, hard_negatives, labelled_candidates
-from tsrkit_plugins.verifiers.persistence import BOX_ARRAY, estimator_arrays, load_estimator
 
 if TYPE_CHECKING:  # scikit-learn loads when a model is fitted or read, not on import
     from sklearn.ensemble import HistGradientBoostingClassifier
@@ -57,10 +63,10 @@ def passes(scores: Sequence[float], threshold: float, relative: float = 0.0) -> 
     >>> passes([0.25, 0.1], 0.2, 0.5).tolist()
     [True, False]
     """
-    scores = np.asarray(scores, dtype=float)
-    if not len(scores):
+    values = np.asarray(scores, dtype=float)
+    if not len(values):
         return np.zeros(0, bool)
-    return (scores >= threshold) & (scores >= relative * scores.max())
+    return (values >= threshold) & (values >= relative * values.max())
 
 
 class LearnedVerifier(Verifier):
@@ -68,8 +74,8 @@ class LearnedVerifier(Verifier):
 
     name = "verifier"
     summary = "learned candidate verifier: HOG, colour and housing features, gradient boosting"
-    section = "issue 11 (beyond the documents); labels by Zheng 5.2.1"
-    params = (
+    section = "beyond the documents; labels by Zheng 5.2.1"
+    PARAMS = (
         Param(
             "model",
             "path",
@@ -108,12 +114,12 @@ class LearnedVerifier(Verifier):
         ),
         Param(
             "after",
-            "str",
+            "verifier",
             "housing",
             help="a verifier run on the candidates before the features are read, in training "
             "and at run time ('housing': the housing stage fits each candidate's housing, "
-            "whose box the features read and the records report); '' for none. A model "
-            "remembers the stage it was trained after",
+            "whose box the features read and the records report; 'housing pad=2' with its "
+            "own parameters); '' for none. A model remembers the stage it was trained after",
         ),
         Param(
             "box_rank",
@@ -242,11 +248,11 @@ class LearnedVerifier(Verifier):
                     f"this verifier reads version {layout()['version']}); retrain it "
                     "(tsrkit train verifier)"
                 )
-            after = model.info.get("after", "")
-            if after != self.params["after"]:
+            after = str(model.info.get("after", ""))
+            if after.split()[:1] != self._after().split()[:1]:
                 raise ModelError(
                     f"model {where}: trained after the stage {after!r}, but this verifier runs "
-                    f"after {self.params['after']!r}; set -p after={after} or retrain"
+                    f"after {self._after()!r}; set -p after={after} or retrain"
                 )
             self._estimator = load_estimator(model, where)
             if self.params["box_rank"] > 0:
@@ -298,7 +304,7 @@ class LearnedVerifier(Verifier):
         ``relative`` read) and the score it reports (the decision score, scaled by the box
         model where ``box_rank`` > 0). ``gate``: only the candidates that pass ``threshold``
         and ``relative`` (the box model reads those only)."""
-        candidates = self._stage()(frame, list(candidates))
+        candidates = list(self._stage()(frame, list(candidates)))
         if not candidates:
             return candidates, np.zeros(0), np.zeros(0)
         features = candidate_features(frame.image, candidates)
@@ -321,11 +327,15 @@ class LearnedVerifier(Verifier):
             (replace(c, score=float(p)) for c, p in zip(kept, score)), key=lambda c: -c.score
         )
 
+    def _after(self) -> str:
+        """The spec of the stage run before this verifier ('' for none)."""
+        return str(self.params["after"] or "")
+
     def _stage(self) -> Stage:
-        name = self.params["after"]
-        if not name:
+        part = self.params["after"]
+        if part is None:
             return lambda frame, candidates: candidates
-        before = get_registry().create("verifier", name)
+        before = part.plugin
         return lambda frame, candidates: before.verify(frame, candidates) if candidates else []
 
     def fit(self, samples: Iterable[Sample], *, detector: Detector | None = None) -> Model:
@@ -394,7 +404,7 @@ class LearnedVerifier(Verifier):
         arrays = estimator_arrays(estimator)
         info = {
             "layout": layout(),
-            "after": self.params["after"],
+            "after": self._after(),
             "positives": int(len(positives)),
             "negatives": int(len(negatives)),
             "negatives_used": int(len(chosen)),

@@ -17,11 +17,7 @@ from itertools import chain
 
 import numpy as np
 
-from tsrkit.eval.matching import centre_hits
-from tsrkit.geometry import iou_matrix
-from tsrkit.plugin import Detector
-from tsrkit.synth.heads import scatter_heads
-from tsrkit.types import Candidate, Frame, Sample
+from tsrkit.api import Candidate, Detector, Frame, Sample, centre_hits, iou_matrix, scatter_heads
 from tsrkit_plugins.verifiers.augment import Augmentation
 from tsrkit_plugins.verifiers.pasting import crop_frames
 from tsrkit_plugins.verifiers.unlit import no_light_frames
@@ -74,7 +70,7 @@ def centre_labels(candidates: Sequence[Candidate], boxes: Sequence[Sequence[floa
     if not boxes:
         return np.zeros(len(candidates), np.int8)
     hits = centre_hits([(c.x, c.y) for c in candidates], boxes)
-    return hits.any(axis=1).astype(np.int8)
+    return np.asarray(hits.any(axis=1), dtype=np.int8)
 
 
 def box_labels(candidates: Sequence[Candidate], boxes: Sequence[Sequence[float]]) -> np.ndarray:
@@ -104,8 +100,8 @@ def box_labels(candidates: Sequence[Candidate], boxes: Sequence[Sequence[float]]
     box = box[housing]
     hits = centre_hits([(c.x, c.y) for c in candidates], box)
     fits = iou_matrix([c.object_bbox for c in candidates], box) >= 0.5
-    hit = hits.any(axis=1)
-    labels[hit] = (hits & fits).any(axis=1)[hit]
+    hit = np.asarray(hits.any(axis=1))
+    labels[hit] = np.asarray((hits & fits).any(axis=1))[hit]
     return labels
 
 

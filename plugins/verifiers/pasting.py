@@ -1,7 +1,7 @@
 """Real signal heads pasted into scenes: positives of a camera no training set shows.
 
 The verifier's training sets show few cameras; held out, a camera whose housings look otherwise
-(cinTA's veiled grey heads) gets low probabilities (issue 11). The train crops of
+(cinTA's veiled grey heads) gets low probabilities. The train crops of
 ``udacity_mit_tl_crops`` (whole heads, red / yellow / green, many veiled grey) are pasted at
 dash-cam sizes into the real training frames (clear of their boxes) or into synthetic daylight
 no-light road scenes, each crop's box its housing box; the candidates on them are labelled as
@@ -18,9 +18,7 @@ from collections.abc import Iterator, Sequence
 import cv2
 import numpy as np
 
-from tsrkit.datasets import open_datasets
-from tsrkit.errors import TsrkitError
-from tsrkit.types import Frame, Sample
+from tsrkit.api import Frame, Sample, TsrkitError, open_datasets
 from tsrkit_plugins.verifiers.unlit import SYNTH_SIZE, no_light_frames
 
 #: The registry name of the crop set and the split pasted.
@@ -140,9 +138,9 @@ def framed_scenes(
     for k in range(count):
         sample = backgrounds[k * len(backgrounds) // count]
         image = sample.load().image.copy()
-        own = [tuple(float(v) for v in a.bbox) for a in sample.annotations]
+        own: list[Box] = [a.bbox for a in sample.annotations]
         rng = np.random.default_rng([seed, k, zlib.crc32(sample.source.encode())])
-        boxes = paste_crops(image, crops, rng, taken=own)  # type: ignore[arg-type]
+        boxes = paste_crops(image, crops, rng, taken=own)
         yield Frame(image, f"pasted-crops:{seed}:{k}:{sample.source}"), own + boxes
 
 

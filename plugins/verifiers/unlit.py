@@ -5,8 +5,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Sequence
 
-from tsrkit.synth import SynthOptions, render_frame
-from tsrkit.types import Frame
+from tsrkit.api import Frame, SynthOptions, render_frame
 
 #: Frame size of the synthetic no-light frames (a dash-cam's).
 SYNTH_SIZE = (1280, 720)

@@ -10,10 +10,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from tsrkit import ReportWriter, RunResult, hookimpl
-from tsrkit.atomic import write_json
-from tsrkit.eval.coco import coco_run
-from tsrkit_plugins.formats.common import relative_source
+from tsrkit.api import ReportWriter, RunResult, coco_run, hookimpl, write_json
+from tsrkit_plugins.shared.paths import relative_source
 
 
 class CocoFiles(ReportWriter):

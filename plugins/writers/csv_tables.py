@@ -6,10 +6,7 @@ from __future__ import annotations
 import csv
 from pathlib import Path
 
-from tsrkit import ReportWriter, RunResult, hookimpl
-from tsrkit.atomic import atomic_open
-from tsrkit.eval.perframe import frame_score
-from tsrkit.report import HEADLINE, title
+from tsrkit.api import HEADLINE, ReportWriter, RunResult, atomic_open, frame_score, hookimpl, title
 
 FRAME_COLUMNS = (
     "frame",

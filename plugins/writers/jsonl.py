@@ -6,8 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from tsrkit import ReportWriter, RunResult, hookimpl
-from tsrkit.atomic import atomic_open, json_line
+from tsrkit.api import ReportWriter, RunResult, atomic_open, hookimpl, json_line
 
 
 class JsonLines(ReportWriter):

@@ -5,10 +5,18 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from tsrkit import ReportWriter, RunResult, hookimpl
-from tsrkit.atomic import atomic_open
-from tsrkit.eval.categories import radius_label, recall_sort_key
-from tsrkit.report import fmt, headline, markdown_table, title
+from tsrkit.api import (
+    ReportWriter,
+    RunResult,
+    atomic_open,
+    fmt,
+    headline,
+    hookimpl,
+    markdown_table,
+    radius_label,
+    recall_sort_key,
+    title,
+)
 
 
 class MarkdownSummary(ReportWriter):

@@ -10,9 +10,7 @@ from __future__ import annotations
 import functools
 from pathlib import Path
 
-from tsrkit import ReportWriter, RunResult, hookimpl
-from tsrkit.atomic import atomic_open
-from tsrkit.eval.categories import radius_label
+from tsrkit.api import ReportWriter, RunResult, atomic_open, hookimpl, radius_label
 
 
 @functools.cache

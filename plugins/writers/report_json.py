@@ -4,8 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from tsrkit import ReportWriter, RunResult, hookimpl
-from tsrkit.atomic import write_json
+from tsrkit.api import ReportWriter, RunResult, hookimpl, write_json
 
 
 class JsonReport(ReportWriter):

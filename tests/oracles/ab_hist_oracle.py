@@ -8,7 +8,7 @@ import cv2
 import numpy as np
 
 from tsrkit_plugins.classifiers.ab_hist import chroma
-from tsrkit_plugins.classifiers.regions import rings
+from tsrkit_plugins.shared.regions import rings
 
 
 def _histogram(lab, mask, bins, sigma):

@@ -1,15 +1,15 @@
-"""The housing fit as NumPy computed it before it was compiled (session speed5): every box sum
+"""The housing fit as NumPy computed it before it was compiled: every box sum
 of a search step gathered over one array of boxes (``box_sums``), the contrasts, the arg-max
 over layouts and the edge refinement as array operations. The oracle the compiled searches of
-``plugins/housing/fit.py`` and ``lens.py`` must match exactly; the steps the speed-up left alone
-(the radius options, head variants, layout boxes, ``keep_long``) are imported."""
+``plugins/verifiers/housing/fit.py`` and ``lens.py`` must match exactly; the steps the speed-up left
+alone (the radius options, head variants, layout boxes, ``keep_long``) are imported."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from tsrkit_plugins.housing.boxes import box_sums, integral
-from tsrkit_plugins.housing.fit import (
+from tsrkit_plugins.verifiers.housing.boxes import box_sums, integral
+from tsrkit_plugins.verifiers.housing.fit import (
     BAND,
     COARSE,
     FINE,
@@ -21,7 +21,7 @@ from tsrkit_plugins.housing.fit import (
     layout_boxes,
     radius_options,
 )
-from tsrkit_plugins.housing.lens import (
+from tsrkit_plugins.verifiers.housing.lens import (
     FLOOR,
     MIN_CONTRAST,
     OFFSETS,

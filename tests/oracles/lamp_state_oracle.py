@@ -48,8 +48,8 @@ def halved(crop, size, halve_from):
     """``crop`` with each side at least ``halve_from`` times its ``size`` (width, height)
     length halved: its last pixel dropped there when the length is odd, then each 2 x 2 (or
     2 x 1) block's mean by OpenCV's integer-scale area resampling (the mean rounded to the
-    nearest integer, exact ties either way: ``tests/test_lamp_state.py`` checks it against
-    numpy's block sums); ``crop`` itself when no side is that long or one enlarges."""
+    nearest integer, exact ties either way: ``tests/classifiers/test_lamp_state.py`` checks it
+    against numpy's block sums); ``crop`` itself when no side is that long or one enlarges."""
     height, width = crop.shape[:2]
     if width < size[0] or height < size[1]:
         return crop
@@ -202,7 +202,7 @@ def classify(classifier, frame, candidates):
     known = set(states)
     other = np.zeros((len(candidates), len(STATES)))
     if weight > 0:
-        found = classifier._ab_hist.classify(frame, candidates)
+        found = classifier.params["fused"].plugin.classify(frame, candidates)
         known |= {s for d in found for s in d.state_scores}
         other = np.array([[d.state_scores.get(s, 0.0) for s in STATES] for d in found])
     ratio = classifier.params["red_yellow_ratio"]

@@ -1,5 +1,5 @@
-"""The verifier's features as ``plugins/verifiers/features.py`` computed them before the speed-up
-of issue 11 (speed11): each sample stack remapped as a tall image of its patches (one
+"""The verifier's features as ``plugins/verifiers/features.py`` computed them before their speed-up:
+each sample stack remapped as a tall image of its patches (one
 ``cv2.remap`` per stack), the HOG patches framed by ``np.pad``, the colour statistics averaged
 patch by patch (8 channels last). The oracle the faster features must match to the bit. The
 functions the speed-up left alone are imported."""

@@ -19,6 +19,19 @@ from tsrkit.eval.settings import BOX_OPTIONS
 from tsrkit.report import print_table
 from tsrkit.selection import build, build_compare
 
+__all__ = [
+    "DEFAULT_COMPARE",
+    "DEFAULT_OUT",
+    "benchmark_command",
+    "compare_command",
+    "dataset_options",
+    "default_writers",
+    "load_dataset",
+    "run_compare",
+    "run_default",
+    "run_options",
+]
+
 DEFAULT_OUT = "tsrkit-out"
 DEFAULT_COMPARE = ("conspicuity", "gray-tophat", "lab-frst")
 
@@ -265,7 +278,7 @@ def benchmark_command(
 @click.option(
     "--html",
     is_flag=True,
-    help="Also write OUT/compare.html (the `report` verb, when a plugin registers it).",
+    help="Also write OUT/compare.html (as `tsrkit report OUT` does).",
 )
 @run_options
 @click.pass_context
@@ -323,10 +336,9 @@ def compare_command(
         without_verifier=without_verifier,
     )
     if html:
-        report = ctx.find_root().command.get_command(ctx, "report")
-        if report is None:
-            raise click.UsageError("--html needs the `report` verb (the html writer plugin)")
-        ctx.invoke(report, run_dir=out)
+        from tsrkit.cli.report import report_command
+
+        ctx.invoke(report_command, run_dir=out)
 
 
 def run_compare(

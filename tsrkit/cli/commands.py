@@ -1,7 +1,8 @@
 """The built-in verbs, registered through ``register_commands`` exactly like a third-party verb.
 
-The registry loads this module as an internal plugin (:data:`tsrkit.registry.INTERNAL`); the
-command line itself imports a built-in verb only when it runs (:mod:`tsrkit.cli.verbs`).
+The command line registers this module as an internal plugin when it needs every verb
+(:func:`tsrkit.cli.main._add_commands`); it imports a built-in verb only when that verb runs
+(:mod:`tsrkit.cli.verbs`).
 """
 
 import importlib
@@ -9,9 +10,10 @@ import importlib
 from tsrkit.cli.verbs import VERBS
 from tsrkit.hookspecs import hookimpl
 
+__all__ = ["register_commands"]
+
 
 @hookimpl
 def register_commands(cli):
     for name, verb in VERBS.items():
-        if not verb.module.startswith("tsrkit_plugins."):  # plugins register their own verbs
-            cli.add_command(getattr(importlib.import_module(verb.module), verb.attribute), name)
+        cli.add_command(getattr(importlib.import_module(verb.module), verb.attribute), name)

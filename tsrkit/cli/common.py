@@ -11,6 +11,8 @@ import click
 from tsrkit.cli.completion import plugin_names, preset_or_file
 from tsrkit.selection import DEFAULT_DETECTOR
 
+__all__ = ["FiniteFloatRange", "plugin_options"]
+
 
 def plugin_options(func=None, *, tracker: bool = True):
     """Add ``--detector``, ``--verifier``, ``--classifier``, ``--tracker`` (unless

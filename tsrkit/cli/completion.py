@@ -16,6 +16,16 @@ from collections.abc import Callable, Iterable
 import click
 from click.shell_completion import CompletionItem
 
+__all__ = [
+    "Complete",
+    "dataset_names",
+    "plugin_list",
+    "plugin_names",
+    "preset_names_only",
+    "preset_or_file",
+    "trainable_names",
+]
+
 Complete = Callable[[click.Context, click.Parameter, str], list[CompletionItem]]
 
 

@@ -25,6 +25,15 @@ from tsrkit.datasets.registry import GENERATED_SAMPLE
 from tsrkit.errors import TsrkitError
 from tsrkit.types import Dataset
 
+__all__ = [
+    "convert_command",
+    "datasets_group",
+    "info_command",
+    "list_command",
+    "state_changes",
+    "verify_command",
+]
+
 
 @click.group("datasets")
 def datasets_group() -> None:

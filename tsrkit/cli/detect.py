@@ -24,6 +24,8 @@ from tsrkit.selection import build
 from tsrkit.streams import run_pipeline
 from tsrkit.types import Frame, Skipped
 
+__all__ = ["default_inputs", "detect_command", "flushed_output", "run_detect"]
+
 
 def run_detect(
     pipeline: Pipeline,

@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import click
 
+__all__ = ["UserError", "describe_os_error"]
+
 
 class UserError(click.ClickException):
     """Raised by commands for mistakes that need no traceback."""

@@ -15,8 +15,11 @@ from importlib import metadata
 import click
 
 from tsrkit.cli.errors import UserError, describe_os_error
-from tsrkit.cli.verbs import ENTRY_POINT_GROUP, VERBS
+from tsrkit.cli.verbs import VERBS
 from tsrkit.errors import TsrkitError
+from tsrkit.hookspecs import ENTRY_POINT_GROUP
+
+__all__ = ["TsrkitGroup", "cli", "main"]
 
 
 class TsrkitGroup(click.Group):
@@ -101,15 +104,22 @@ def _foreign_entry_points() -> bool:
     )
 
 
+#: The name the built-in verbs (:mod:`tsrkit.cli.commands`) are registered under.
+BUILTIN_VERBS = "tsrkit-commands"
+
+
 def _add_commands() -> None:
-    """Every verb registered through ``register_commands`` (the built-in ones via
-    :mod:`tsrkit.cli.commands`, and the plugins'); runs once."""
-    from tsrkit.registry import INTERNAL, PluginFailure, get_registry
+    """Every verb registered through ``register_commands``: the built-in ones (the CLI
+    registers :mod:`tsrkit.cli.commands` as an internal plugin) and the plugins'; runs once."""
+    from tsrkit.cli import commands
+    from tsrkit.registry import PluginFailure, get_registry
 
     if getattr(cli, "_hooks_done", False):
         return
     cli._hooks_done = True  # type: ignore[attr-defined]
     registry = get_registry()
+    if registry.pm.get_plugin(BUILTIN_VERBS) is None:
+        registry.add(commands, BUILTIN_VERBS, "tsrkit")
     for impl in registry.pm.hook.register_commands.get_hookimpls():
         try:
             impl.function(cli=cli)
@@ -119,7 +129,7 @@ def _add_commands() -> None:
                     impl.plugin_name, "?", f"register_commands: {type(exc).__name__}: {exc}"
                 )
             )
-            if impl.plugin_name in INTERNAL:  # the core's own verbs must not fail silently
+            if impl.plugin_name == BUILTIN_VERBS:  # the core's own verbs must not fail silently
                 raise
 
 

@@ -11,6 +11,8 @@ from rich.table import Table
 import tsrkit
 from tsrkit.registry import KINDS
 
+__all__ = ["plugins_command"]
+
 
 @click.command("plugins")
 @click.option("--json", "as_json", is_flag=True, help="Print JSON (with parameter schemas).")

@@ -9,6 +9,8 @@ from rich.table import Table
 from tsrkit.cli.completion import preset_names_only
 from tsrkit.presets import describe, preset_names, preset_path
 
+__all__ = ["presets_command"]
+
 
 @click.command("presets")
 @click.option(

@@ -11,6 +11,8 @@ from rich.console import Console
 from tsrkit.errors import TsrkitError
 from tsrkit.synth import LIGHTINGS, generate
 
+__all__ = ["synth_command"]
+
 
 @click.command("synth")
 @click.option(

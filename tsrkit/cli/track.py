@@ -15,6 +15,8 @@ from rich.table import Table
 from tsrkit.atomic import atomic_open
 from tsrkit.cli.common import plugin_options
 
+__all__ = ["ACCURACY_NOTE", "track_command"]
+
 
 def _utc(seconds: float) -> str:
     return datetime.fromtimestamp(seconds, UTC).strftime("%Y-%m-%d %H:%M:%S")

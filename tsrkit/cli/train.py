@@ -13,6 +13,8 @@ from tsrkit.params import parse_assignments
 from tsrkit.registry import get_registry
 from tsrkit.training import train
 
+__all__ = ["train_command"]
+
 
 @click.command("train")
 @click.argument("plugin", shell_complete=trainable_names)

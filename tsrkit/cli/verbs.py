@@ -2,7 +2,7 @@
 any of them (or NumPy, OpenCV and the plugins they pull in).
 
 A verb's module is imported when the verb runs; the summary is what ``--help`` shows until then
-(``tests/test_cli_startup.py`` checks it against the command's own help). Verbs of other
+(``tests/cli/test_cli_startup.py`` checks it against the command's own help). Verbs of other
 installed packages come through the ``register_commands`` hook (:mod:`tsrkit.cli.main`).
 """
 
@@ -10,8 +10,7 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
-#: The entry-point group tsrkit plugins declare (loaded by :mod:`tsrkit.registry`).
-ENTRY_POINT_GROUP = "tsrkit"
+__all__ = ["VERBS", "Verb"]
 
 
 class Verb(NamedTuple):
@@ -53,9 +52,8 @@ VERBS = {
         "presets_command",
         "List the shipped presets; use one with --config NAME on detect, benchmark or compare.",
     ),
-    # the html writer plugin's verb (shipped with tsrkit, always loaded: writer-*)
     "report": Verb(
-        "tsrkit_plugins.writers.html.verb",
+        "tsrkit.cli.report",
         "report_command",
         "Write RUN_DIR/report.html (a benchmark folder) or RUN_DIR/compare.html (a compare "
         "folder) from the files the run left, without recomputing.",

@@ -17,6 +17,8 @@ from pathlib import Path
 from tsrkit.errors import TsrkitError
 from tsrkit.types import Dataset
 
+__all__ = ["concat_datasets", "open_datasets", "parse_reference"]
+
 
 def parse_reference(ref: str, split: str | None = None) -> tuple[str, str | None]:
     """Split ``NAME[:SPLIT]`` into the dataset reference and its split (``split`` if none).

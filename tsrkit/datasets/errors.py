@@ -13,6 +13,8 @@ import yaml
 
 from tsrkit.errors import TsrkitError
 
+__all__ = ["DatasetError", "read_text", "read_yaml"]
+
 
 class DatasetError(TsrkitError):
     """A dataset file that is missing, malformed or inconsistent.

@@ -8,6 +8,8 @@ from PIL import Image, UnidentifiedImageError
 
 from tsrkit.datasets.errors import DatasetError
 
+__all__ = ["image_size"]
+
 
 def image_size(path: str | os.PathLike) -> tuple[int, int]:
     """``(width, height)`` of the image at ``path``, read from its header by Pillow.

@@ -8,6 +8,8 @@ from pathlib import Path
 
 from tsrkit.datasets.errors import DatasetError
 
+__all__ = ["CHUNK", "Verification", "read_manifest", "sha256_file", "verify_manifest"]
+
 CHUNK = 1 << 20
 
 

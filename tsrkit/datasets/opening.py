@@ -19,6 +19,8 @@ from tsrkit.errors import TsrkitError
 from tsrkit.registry import get_registry
 from tsrkit.types import Annotation, Dataset
 
+__all__ = ["SAMPLE", "detect_format", "open_dataset", "read_dataset", "relabel", "write_dataset"]
+
 SAMPLE = "sample"
 
 

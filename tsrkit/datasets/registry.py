@@ -17,6 +17,20 @@ from typing import Any
 from tsrkit.datasets.errors import DatasetError, read_yaml
 from tsrkit.datasets.states import check_mapping
 
+__all__ = [
+    "BOXES",
+    "DATA_DIR_ENV",
+    "GENERATED_SAMPLE",
+    "PACKAGED_REGISTRY",
+    "REGISTRY_ENV",
+    "REPO_ROOT",
+    "REQUIRED",
+    "DatasetEntry",
+    "data_dir",
+    "load_registry",
+    "registry_path",
+]
+
 REGISTRY_ENV = "TSRKIT_DATASETS_YAML"
 DATA_DIR_ENV = "TSRKIT_DATA_DIR"
 REPO_ROOT = Path(__file__).resolve().parents[2]

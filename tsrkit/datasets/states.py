@@ -11,6 +11,8 @@ from collections.abc import Mapping
 
 from tsrkit.types import STATES
 
+__all__ = ["PREFIXES", "check_mapping", "to_state"]
+
 #: Label words (lower case, as a prefix of the raw label) and the state they mean. Prefix
 #: matching maps e.g. Bosch ``RedLeft`` to red, LISA ``goLeft`` to green, ``warningLeft`` to
 #: yellow. ``left`` alone (the Korean Roboflow arrow) is NOT here: its colour is a dataset fact

@@ -1,1 +1,3 @@
 """Evaluation metrics."""
+
+__all__: list[str] = []

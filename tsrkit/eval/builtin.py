@@ -1,7 +1,7 @@
 """The built-in metrics, registered through ``register_metrics`` like a third-party metric.
 
 The registry loads this module as an internal plugin (always, whatever ``TSRKIT_LOAD_PLUGINS``
-says), so every report has the sections DESIGN.md promises.
+says), so every report has the sections ``report.json`` keeps (the README lists them).
 """
 
 from tsrkit.eval.categories import LightingBySize
@@ -11,6 +11,8 @@ from tsrkit.eval.overlap import OverlapPR
 from tsrkit.eval.perframe import ZhengPerFrame
 from tsrkit.eval.state import StateMetric
 from tsrkit.hookspecs import hookimpl
+
+__all__ = ["register_metrics"]
 
 
 @hookimpl

@@ -12,6 +12,18 @@ from collections.abc import Sequence
 
 from tsrkit.eval.perframe import FrameScore, FrameScoreMetric, summarise
 
+__all__ = [
+    "PRECISION_BOUNDS",
+    "RADIUS_BIN_STARTS",
+    "LightingBySize",
+    "category_table",
+    "precision_bound",
+    "radius_bin",
+    "radius_label",
+    "recall_label",
+    "recall_sort_key",
+]
+
 #: Lower bounds (percent) of the precision columns; Table 5-2 uses a subset of these 5 % steps.
 PRECISION_BOUNDS = tuple(range(0, 101, 5))
 #: Lower bounds of the max-radius rows. Zheng's Table 5-2 has one row per pixel of radius (2-9 px

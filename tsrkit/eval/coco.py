@@ -19,6 +19,8 @@ from tsrkit.plugin import Metric
 from tsrkit.records import FrameRecord
 from tsrkit.types import Sample
 
+__all__ = ["CATEGORY", "CocoAP", "coco_ap", "coco_dataset", "coco_frame", "coco_run"]
+
 CATEGORY = {"id": 1, "name": "traffic_light", "supercategory": "traffic_signal"}
 
 

@@ -12,6 +12,8 @@ import numpy as np
 
 from tsrkit.geometry import enclosing_circles
 
+__all__ = ["centre_hits", "greedy_match"]
+
 
 def centre_hits(points, boxes) -> np.ndarray:
     """Which candidate centres lie in which boxes' minimum enclosing circles (Zheng 5.2.1).

@@ -9,6 +9,8 @@ from tsrkit.plugin import Metric
 from tsrkit.records import FrameRecord
 from tsrkit.types import Sample
 
+__all__ = ["FrameNotes"]
+
 
 class FrameNotes(Metric):
     """``frame_notes``: the number of frames of each note the plugins wrote into the records;

@@ -20,6 +20,8 @@ from tsrkit.plugin import Metric
 from tsrkit.records import FrameRecord
 from tsrkit.types import Sample
 
+__all__ = ["OverlapPR", "OverlapScore", "match_by_iou", "score_overlap", "summarise_overlap"]
+
 
 @dataclass(frozen=True)
 class OverlapScore:

@@ -5,8 +5,9 @@ ground-truth box of the same frame. Reading chosen for the per-frame figures (th
 of the present traffic signals in a given frame can be correctly detected" and "how many false
 objects are reported among all detections"): recall = boxes whose circle holds at least one
 candidate centre / boxes; precision = candidates inside some circle / candidates.
-Summary definitions follow DESIGN.md; false positives on frames without ground truth are counted
-separately and do not enter ``precision_mean``.
+Summary definitions: ``recall_mean`` is the mean over frames with ground truth,
+``precision_mean`` the mean over frames with detections; false positives on frames without
+ground truth are counted separately and do not enter ``precision_mean``.
 The Table 5-2 grouping is :mod:`tsrkit.eval.categories`.
 """
 
@@ -25,6 +26,17 @@ from tsrkit.eval.stats import bootstrap_interval
 from tsrkit.plugin import Metric
 from tsrkit.records import FrameRecord
 from tsrkit.types import Sample
+
+__all__ = [
+    "FrameScore",
+    "FrameScoreMetric",
+    "ZhengPerFrame",
+    "frame_score",
+    "headline_intervals",
+    "max_target_radius",
+    "score_frame",
+    "summarise",
+]
 
 
 @dataclass(frozen=True)

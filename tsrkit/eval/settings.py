@@ -12,6 +12,8 @@ from typing import Any
 
 from tsrkit.errors import TsrkitError
 
+__all__ = ["BOX_OPTIONS", "NOT_DETECTION", "EvalSettings", "not_exhaustive_note", "resolve_box"]
+
 #: Values of the ``box`` option (``--eval-box``).
 BOX_OPTIONS = ("auto", "housing", "lens")
 

@@ -18,6 +18,17 @@ from tsrkit.plugin import Metric
 from tsrkit.records import FrameRecord
 from tsrkit.types import STATES, Sample
 
+__all__ = [
+    "RATIO_EDGES",
+    "StateMetric",
+    "discriminative_ratio",
+    "label_order",
+    "per_class",
+    "ratio_figures",
+    "red_yellow_errors",
+    "state_metrics",
+]
+
 #: Discriminative-ratio bin edges for the misclassification-rate curve (Zheng Figure 5-15).
 RATIO_EDGES = (0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0)
 

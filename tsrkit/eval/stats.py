@@ -11,6 +11,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
+__all__ = ["ALPHA", "bootstrap_interval", "paired_test"]
+
 ALPHA = 0.05
 
 

@@ -8,6 +8,8 @@ from pathlib import Path
 
 from tsrkit.errors import TsrkitError
 
+__all__ = ["GeoError", "read_text"]
+
 
 class GeoError(TsrkitError):
     """A GPS log or map that is missing or malformed.

@@ -10,6 +10,8 @@ import pynmea2
 
 from tsrkit.geo.gps import Track
 
+__all__ = ["to_gpx", "to_nmea"]
+
 
 def to_gpx(track: Track) -> str:
     """``track`` as a GPX 1.1 document with one track of one segment."""

@@ -9,6 +9,8 @@ from pathlib import Path
 from tsrkit.geo.errors import GeoError
 from tsrkit.geo.osm_pbf import SIGNAL_TAGS
 
+__all__ = ["geojson_nodes"]
+
 _NODE_ID = re.compile(r"(?:node/)?(\d+)")
 
 

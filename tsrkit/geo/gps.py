@@ -16,6 +16,8 @@ from tsrkit.geo.errors import GeoError, read_text
 from tsrkit.geo.gpx import gpx_rows
 from tsrkit.geo.nmea import nmea_rows
 
+__all__ = ["Rows", "Track", "log_format", "read_track"]
+
 
 @dataclass(frozen=True)
 class Track:

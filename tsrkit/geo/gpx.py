@@ -8,10 +8,11 @@ from xml.etree.ElementTree import Element, ParseError
 
 import gpxpy
 import gpxpy.gpx
-from defusedxml import DefusedXmlException
-from defusedxml import ElementTree as SafeTree
+from defusedxml import DefusedXmlException, ElementTree as SafeTree
 
 from tsrkit.geo.errors import GeoError
+
+__all__ = ["gpx_rows"]
 
 
 def _bad_point(root: Element) -> str:

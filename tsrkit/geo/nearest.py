@@ -21,6 +21,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
+__all__ = ["TAU_MIN", "nearest_extended", "nearest_kdtree"]
+
 #: Zheng's conservative minimum stay in a Voronoi region (3.4.2), seconds.
 TAU_MIN = 1.5
 

@@ -10,6 +10,8 @@ import pynmea2
 
 from tsrkit.geo.errors import GeoError
 
+__all__ = ["nmea_rows"]
+
 #: A GGA time further than this from its RMC's time of day lies across midnight.
 _HALF_DAY = 43200.0
 

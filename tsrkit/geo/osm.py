@@ -26,6 +26,8 @@ from tsrkit.geo.geojson import geojson_nodes
 from tsrkit.geo.osm_pbf import SIGNAL_TAGS, pbf_nodes
 from tsrkit.geo.projection import LocalProjection
 
+__all__ = ["MERGE_M", "Signals", "map_format", "read_signals"]
+
 #: Signal nodes closer than this (metres) belong to one intersection.
 MERGE_M = 50.0
 

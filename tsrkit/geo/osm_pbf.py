@@ -7,6 +7,8 @@ from pathlib import Path
 
 from tsrkit.geo.errors import GeoError
 
+__all__ = ["SIGNAL_TAGS", "pbf_nodes"]
+
 #: The tags that make a node a signal (``highway``) or a pedestrian signal (``crossing``).
 SIGNAL_TAGS = (("highway", "traffic_signals"), ("crossing", "traffic_signals"))
 

@@ -6,6 +6,8 @@ from __future__ import annotations
 import numpy as np
 from pyproj import Transformer
 
+__all__ = ["LocalProjection"]
+
 
 class LocalProjection:
     """Latitude / longitude to metres east / north of ``(lat0, lon0)``."""

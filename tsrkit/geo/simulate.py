@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
+__all__ = ["grid_city", "grid_drive"]
+
 _STEPS = np.array([[1, 0], [0, 1], [-1, 0], [0, -1]])
 
 

@@ -20,6 +20,15 @@ from tsrkit.geo.nearest import nearest_extended, nearest_kdtree
 from tsrkit.geo.osm import Signals
 from tsrkit.geo.projection import LocalProjection
 
+__all__ = [
+    "THETA_MIN",
+    "Traversal",
+    "latest_minimum",
+    "movement",
+    "traversals",
+    "vicinity_profile",
+]
+
 #: Zheng's minimum heading change of a turn (3.4.3), degrees.
 THETA_MIN = 20.0
 

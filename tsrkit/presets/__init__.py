@@ -19,6 +19,8 @@ import yaml
 
 from tsrkit.errors import TsrkitError
 
+__all__ = ["PRESET_DIR", "describe", "preset_names", "preset_path", "resolve_config"]
+
 PRESET_DIR = Path(__file__).parent
 
 

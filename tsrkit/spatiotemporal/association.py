@@ -18,6 +18,14 @@ from collections.abc import Mapping
 
 from tsrkit.spatiotemporal.points import COLOURS, Point
 
+__all__ = [
+    "FORWARD",
+    "association_score",
+    "colour_change_score",
+    "pair_score",
+    "position_change_score",
+]
+
 #: Colour changes of the state machine that move the lit lens up / left (Eq. 3.37).
 FORWARD = {("green", "yellow"), ("yellow", "red")}
 

@@ -15,6 +15,8 @@ from tsrkit.spatiotemporal.flow import farneback, project, project_with
 from tsrkit.spatiotemporal.points import Point
 from tsrkit.types import Frame
 
+__all__ = ["CONTEXT_PX", "KEPT_FLOWS", "MIN_REGION_PX", "WHOLE_FLOW_POINTS", "Clip"]
+
 #: Pixels of context around a restricted region given to the detector (its filters need some).
 CONTEXT_PX = 12
 #: The smallest restricted-region radius, pixels (twice a 1.5 px candidate's radius).

@@ -27,6 +27,18 @@ import numpy as np
 from tsrkit.errors import TsrkitError
 from tsrkit.eval.matching import centre_hits
 
+__all__ = [
+    "Truth",
+    "TruthError",
+    "evaluate_traversal",
+    "hit_light",
+    "ratio",
+    "read_truth",
+    "temporal_accuracy",
+    "temporal_section",
+    "track_light",
+]
+
 Truth = dict[int, dict[str, dict[str, Any]]]
 
 

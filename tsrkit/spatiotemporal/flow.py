@@ -18,6 +18,18 @@ import numpy as np
 
 from tsrkit.spatiotemporal.points import Point, frame_status
 
+__all__ = [
+    "CIRCLE_POINTS",
+    "FARNEBACK",
+    "circle_points",
+    "displace",
+    "enclosing_extent",
+    "farneback",
+    "project",
+    "project_with",
+    "window",
+]
+
 #: Farneback settings: pyramid scale, levels, window, iterations, poly_n, poly_sigma.
 FARNEBACK = (0.5, 3, 15, 3, 5, 1.2)
 #: Points sampled on a candidate's circle.

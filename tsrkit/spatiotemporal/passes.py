@@ -15,6 +15,17 @@ from tsrkit.spatiotemporal.association import association_score
 from tsrkit.spatiotemporal.clip import Clip
 from tsrkit.spatiotemporal.points import Point, Track
 
+__all__ = [
+    "TOP_N",
+    "associate",
+    "best_match",
+    "first_pass",
+    "long_range",
+    "recognise",
+    "second_pass",
+    "select",
+]
+
 #: Tracks kept after the first pass (Zheng 5.4: "up to five tracks").
 TOP_N = 5
 

@@ -12,6 +12,8 @@ import numpy as np
 
 from tsrkit.atomic import atomic_open
 
+__all__ = ["STATE_COLOURS", "timeline_plot", "vicinity_plot"]
+
 STATE_COLOURS = {"red": "#d62728", "yellow": "#e6a800", "green": "#2ca02c"}
 
 

@@ -9,6 +9,8 @@ from typing import Any
 
 from tsrkit.types import Detection
 
+__all__ = ["COLOURS", "Point", "Track", "frame_status"]
+
 #: The colours of Zheng's state machine (Eq. 3.35); any other state counts as ``unknown``.
 COLOURS = ("red", "yellow", "green")
 

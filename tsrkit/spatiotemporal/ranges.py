@@ -11,6 +11,17 @@ from tsrkit.geo import Signals, Track, Traversal, traversals
 from tsrkit.geo.projection import LocalProjection
 from tsrkit.geo.vicinity import vicinity_profile
 
+__all__ = [
+    "DOWNSTREAM_M",
+    "UPSTREAM_M",
+    "FrameTraversal",
+    "frame_positions",
+    "frame_profile",
+    "frame_traversals",
+    "short_range",
+    "trajectory_distance",
+]
+
 #: Zheng's default short range: trajectory metres upstream and downstream of the anchor frame.
 UPSTREAM_M, DOWNSTREAM_M = 10.0, 5.0
 

@@ -33,6 +33,17 @@ from tsrkit.spatiotemporal.passes import TOP_N, recognise
 from tsrkit.spatiotemporal.ranges import DOWNSTREAM_M, UPSTREAM_M, FrameTraversal, frame_traversals
 from tsrkit.types import Skipped
 
+__all__ = [
+    "RECORD_VERSION",
+    "TrackSettings",
+    "VideoError",
+    "decode_clip",
+    "identity",
+    "track_video",
+    "traversal_record",
+    "video_facts",
+]
+
 #: Bumped when a traversal's record changes meaning; part of the cache key.
 RECORD_VERSION = 2
 

@@ -17,6 +17,21 @@ from __future__ import annotations
 
 import numpy as np
 
+__all__ = [
+    "DAY_S",
+    "UNIX_EPOCH_JD",
+    "azimuth_from",
+    "day_of_year",
+    "declination_lee",
+    "elevation_from",
+    "equation_of_time_lee",
+    "hour_angle",
+    "local_solar_time",
+    "sun_position",
+    "sun_position_lee",
+    "zenith",
+]
+
 #: Seconds in a day and the Julian date of the Unix epoch.
 DAY_S = 86400.0
 UNIX_EPOCH_JD = 2440587.5

@@ -6,6 +6,16 @@ from __future__ import annotations
 
 import numpy as np
 
+__all__ = [
+    "BOLTZMANN_K",
+    "LIGHT_C",
+    "PLANCK_H",
+    "SENSITIVITY",
+    "WAVELENGTHS",
+    "blackbody_bgr",
+    "planck",
+]
+
 PLANCK_H = 6.62607015e-34  # J s
 LIGHT_C = 2.99792458e8  # m / s
 BOLTZMANN_K = 1.380649e-23  # J / K

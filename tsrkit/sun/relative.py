@@ -26,6 +26,18 @@ from tsrkit.errors import TsrkitError
 from tsrkit.geo.gps import Track
 from tsrkit.sun.geometry import sun_position
 
+__all__ = [
+    "KEYS",
+    "SunMetadataError",
+    "SunView",
+    "bearing",
+    "frame_facts",
+    "relative_azimuth",
+    "sun_view",
+    "track_facts",
+    "utc_seconds",
+]
+
 #: The per-frame metadata keys read, with what they hold.
 KEYS = {
     "utc": "time of the frame: ISO 8601 with a time zone, or UTC seconds since the epoch",

@@ -43,6 +43,52 @@ from tsrkit.synth.heads import LAMP_COLOURS, render_head
 from tsrkit.synth.scenes import LENS_BGR, add_glow
 from tsrkit.synth.video import video_writer
 
+__all__ = [
+    "CAMERA_HEIGHT",
+    "DIRECTIONS",
+    "HALF_ROAD",
+    "HEAD_HEIGHT",
+    "HEAD_PAST",
+    "LANE",
+    "LENS_PITCH",
+    "LENS_RADIUS",
+    "MOVEMENTS",
+    "SIDEWALK",
+    "SKY_HORIZON",
+    "SKY_TOP",
+    "STATE_LENS",
+    "STEP",
+    "TURN_RADIUS",
+    "Camera",
+    "Drive",
+    "DriveOptions",
+    "Face",
+    "Light",
+    "Node",
+    "Route",
+    "Truck",
+    "block_faces",
+    "bloom",
+    "build_route",
+    "draw_signals",
+    "drive_profile",
+    "facade_colour",
+    "gps_log",
+    "ground_colour",
+    "junctions",
+    "light_state",
+    "osm_extract",
+    "plan_drive",
+    "plan_nodes",
+    "plan_trucks",
+    "render_drive",
+    "render_frames",
+    "render_scene",
+    "summary",
+    "to_latlon",
+    "truck_faces",
+]
+
 MOVEMENTS = ("through", "left", "right")
 #: Lane centre (m right of the street's centre line) the camera drives in; the trucks use 5.25.
 LANE = 1.75

@@ -1,5 +1,5 @@
 """Signal heads of known geometry: a dark housing with 3 or 4 lenses, vertical or horizontal, one
-lamp lit, on a textured background (the test bed of the housing stage, issue 11).
+lamp lit, on a textured background (the test bed of the housing stage).
 """
 
 from __future__ import annotations
@@ -8,6 +8,8 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
+
+__all__ = ["LAMP_COLOURS", "Head", "background", "render_head", "scatter_heads"]
 
 #: BGR of lit lamps (a slightly orange red, amber, blue-green) by state.
 LAMP_COLOURS = {"red": (40, 40, 230), "yellow": (20, 170, 250), "green": (170, 230, 40)}
@@ -94,7 +96,7 @@ def scatter_heads(
     image: np.ndarray, rng: np.random.Generator, count: int = 5
 ) -> list[tuple[float, float, float, float]]:
     """Draw ``count`` jittered heads on ``image`` (in place, then blurred and gamma-jittered as a
-    whole) and return their housing boxes: the verifier's rendered positives (issue 11).
+    whole) and return their housing boxes: the verifier's rendered positives.
 
     Each head: lens radius 2-12 px, 3 or 4 lenses, vertical 4 times in 5, any lamp lit, its
     colour a :data:`LAMP_COLOURS` entry scaled 0.7-1.2 per channel, a white over-exposed core

@@ -52,6 +52,49 @@ import numpy as np
 from tsrkit.errors import TsrkitError
 from tsrkit.types import Annotation, Dataset, Sample
 
+__all__ = [
+    "ANNOTATION_FILES",
+    "GENERATOR_VERSION",
+    "LENS_BGR",
+    "LENS_ORDER",
+    "LIGHTING",
+    "LIGHTINGS",
+    "SAMPLE_FRAMES",
+    "SAMPLE_SEED",
+    "STAMP_FILE",
+    "WINDOW_BGR",
+    "Canvas",
+    "Housing",
+    "Lighting",
+    "SynthOptions",
+    "add_glow",
+    "cache_dir",
+    "compress",
+    "draw_buildings",
+    "draw_cars",
+    "draw_lamps",
+    "draw_road",
+    "draw_sign",
+    "draw_signals",
+    "draw_sky",
+    "draw_trees",
+    "encode_jpeg",
+    "expose",
+    "frame_lighting",
+    "frame_split",
+    "generate",
+    "housing_layout",
+    "lens_radius",
+    "noise_field",
+    "place_signals",
+    "render_dataset",
+    "render_frame",
+    "retroreflection",
+    "sample_path",
+    "vignette",
+    "write_annotations",
+]
+
 #: Bumped whenever the rendered pixels or annotations change; names the sample cache folder.
 GENERATOR_VERSION = 2
 LIGHTINGS = ("day", "dusk", "night")
@@ -876,13 +919,16 @@ def render_dataset(
     return Dataset(f"synth-{seed}", tuple(samples), "normalized", str(folder), info)
 
 
-def write_annotations(dataset: Dataset, folder: Path) -> None:
-    """Write ``annotations.json`` (normalised) and ``coco.json`` through the format plugins."""
-    from tsrkit.registry import get_registry
+#: The annotation files of a generated set, and the dataset format each is written in.
+ANNOTATION_FILES = {"annotations.json": "normalized", "coco.json": "coco"}
 
-    registry = get_registry()
-    registry.create("format", "normalized").write(dataset, folder / "annotations.json")
-    registry.create("format", "coco").write(dataset, folder / "coco.json")
+
+def write_annotations(dataset: Dataset, folder: Path) -> None:
+    """Write the :data:`ANNOTATION_FILES` of ``dataset`` into ``folder``."""
+    from tsrkit.datasets import write_dataset
+
+    for file, format_name in ANNOTATION_FILES.items():
+        write_dataset(dataset, format_name, folder / file)
 
 
 def _relocate(dataset: Dataset, old: Path, new: Path) -> Dataset:

@@ -40,6 +40,19 @@ from tsrkit.sun.geometry import sun_position
 from tsrkit.sun.radiance import blackbody_bgr
 from tsrkit.types import Annotation, Dataset, Sample
 
+__all__ = [
+    "ALBEDO",
+    "DEFAULT_PLACE",
+    "EXPOSURE",
+    "LENSES",
+    "Illumination",
+    "Layers",
+    "expose",
+    "illumination",
+    "render_frame",
+    "sweep",
+]
+
 #: Albedos (B, G, R) of the painted or sheeted surfaces.
 ALBEDO = {
     "orange": (0.05, 0.32, 0.85),

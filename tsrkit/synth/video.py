@@ -15,6 +15,8 @@ import numpy as np
 from tsrkit.errors import TsrkitError
 from tsrkit.types import Dataset
 
+__all__ = ["video_writer", "write_video"]
+
 
 @contextlib.contextmanager
 def video_writer(

@@ -21,6 +21,17 @@ import numpy as np
 from tsrkit.depth import PANEL_HEIGHT_M
 from tsrkit.types import Annotation, Dataset, Sample
 
+__all__ = [
+    "ORANGE",
+    "PANEL_BOTTOM_M",
+    "PANEL_WIDTH_M",
+    "STRIPE_M",
+    "WHITE",
+    "Camera",
+    "generate",
+    "render",
+]
+
 PANEL_WIDTH_M = 10 * 0.0254
 #: Height of the panel's bottom edge above the road (its post), metres.
 PANEL_BOTTOM_M = 0.3

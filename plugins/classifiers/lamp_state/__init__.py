@@ -1,10 +1,10 @@
 """``lamp-state``: a trainable state classifier that reads the lit lamp's colour, its rim and its
 position in the housing, learned from several cameras at once.
 
-Beyond the documents (issue 11): Zheng's ab-hist and Lee's hsi-backprojection stay available,
+Beyond the documents: Zheng's ab-hist and Lee's hsi-backprojection stay available,
 unchanged, beside it. Features: :mod:`.features`; model: scikit-learn's
 ``HistGradientBoostingClassifier`` stored with skops (explicit trusted types, no pickle; see
-``tsrkit_plugins.verifiers.persistence``). ``red_yellow`` is a state of its own where the
+``tsrkit_plugins.shared.persistence``). ``red_yellow`` is a state of its own where the
 training data labels it (DTLD); other labels (arrows, off) are passed over in training. Where
 no training set labels it, a light read red or amber whose housing has its top and middle slots
 both lit, the top one red (:func:`~.features.two_lit` above ``red_yellow_ratio``), is read
@@ -18,9 +18,9 @@ a lamp whose colour sits between red and amber (orange-red LEDs, white cores) re
 ``ab_hist_weight`` mixes ab-hist's normalised scores into the learned probabilities (a late
 fusion, :func:`blend`; measured in ``benchmarks/RESULTS.state.md``).
 The model's trees are evaluated for all of a frame's candidates in one pass
-(``tsrkit_plugins.verifiers.forest``) and turned into probabilities by the estimator's own
+(``tsrkit_plugins.shared.forest``) and turned into probabilities by the estimator's own
 loss: scikit-learn's ``predict_proba`` to the bit, without its per-tree calls
-(``tests/test_lamp_state_oracle.py``).
+(``tests/classifiers/test_lamp_state_oracle.py``).
 """
 
 from __future__ import annotations
@@ -31,14 +31,21 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from tsrkit.errors import TsrkitError
-from tsrkit.hookspecs import hookimpl
-from tsrkit.models import Model, ModelError, load_model
-from tsrkit.params import Param
-from tsrkit.plugin import Classifier, Detector
-from tsrkit.registry import get_registry
-from tsrkit.types import Candidate, Detection, Frame, Sample
-from tsrkit_plugins.classifiers.ab_hist import AbHist
+from tsrkit.api import (
+    Candidate,
+    Classifier,
+    Detection,
+    Detector,
+    Frame,
+    Model,
+    ModelError,
+    Param,
+    ParamError,
+    Sample,
+    TsrkitError,
+    hookimpl,
+    load_model,
+)
 from tsrkit_plugins.classifiers.lamp_state.colour import (
     COLOUR,
     COLOUR_ARRAY,
@@ -52,8 +59,8 @@ from tsrkit_plugins.classifiers.lamp_state.features import (
     lamp_features,
     red_amber_rows,
 )
-from tsrkit_plugins.verifiers.forest import Forest
-from tsrkit_plugins.verifiers.persistence import estimator_arrays, load_estimator
+from tsrkit_plugins.shared.forest import Forest
+from tsrkit_plugins.shared.persistence import estimator_arrays, load_estimator
 
 if TYPE_CHECKING:  # scikit-learn loads when a model is fitted or read, not on import
     from sklearn.ensemble import HistGradientBoostingClassifier
@@ -193,8 +200,8 @@ class LampState(Classifier):
 
     name = "lamp-state"
     summary = "learned state: lamp and rim colour plus lit position in the housing (trainable)"
-    section = "issue 11 (beyond the documents)"
-    params = (
+    section = "beyond the documents"
+    PARAMS = (
         Param(
             "model",
             "path",
@@ -231,8 +238,15 @@ class LampState(Classifier):
             0.0,
             min=0.0,
             max=1.0,
-            help="weight of ab-hist's scores (shipped model, normalised) mixed with the learned "
+            help="weight of the fused classifier's scores (normalised) mixed with the learned "
             "probabilities; 0.5 is the late fusion of benchmarks/RESULTS.state.md",
+        ),
+        Param(
+            "fused",
+            "classifier",
+            "ab-hist",
+            help="the classifier whose scores ab_hist_weight mixes in, with its own parameters "
+            "('ab-hist model=PATH'); '' for none (then ab_hist_weight must be 0)",
         ),
         Param(
             "red_prior",
@@ -258,11 +272,14 @@ class LampState(Classifier):
 
     def __init__(self, **params):
         super().__init__(**params)
+        if self.params["ab_hist_weight"] > 0 and self.params["fused"] is None:
+            raise ParamError(
+                "classifier 'lamp-state': ab_hist_weight > 0 needs a 'fused' classifier"
+            )
         self._estimator: HistGradientBoostingClassifier | None = None
         self._forest: Forest | None = None
         self._colour: tuple[HistGradientBoostingClassifier, Forest] | None = None
         self._states: tuple[str, ...] = ()
-        self._ab_hist: Classifier | None = None
 
     @property
     def estimator(self) -> HistGradientBoostingClassifier:
@@ -338,9 +355,7 @@ class LampState(Classifier):
         weight = self.params["ab_hist_weight"]
         known = set(self._states)
         if weight > 0:
-            if self._ab_hist is None:
-                self._ab_hist = get_registry().create("classifier", AbHist.name)
-            found = self._ab_hist.classify(frame, candidates)
+            found = self.params["fused"].plugin.classify(frame, candidates)
             known |= {s for d in found for s in d.state_scores}
             other = np.array([[d.state_scores.get(s, 0.0) for s in STATES] for d in found])
         else:

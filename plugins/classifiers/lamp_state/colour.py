@@ -1,6 +1,6 @@
 """A second opinion for ``lamp-state`` from the lamp's CIELab colour alone.
 
-Beyond the documents (issue 11). The full model reads the hue histograms of the lens disk and
+Beyond the documents. The full model reads the hue histograms of the lens disk and
 rim, where the halo of another camera's lamp weighs as much as its core: of VGIS day's 30
 ambers 23 have their nearest lamps in CIELab colour (core and rim means) among the other
 cameras' ambers, yet the full model, trained on those cameras, reads 14 of them red

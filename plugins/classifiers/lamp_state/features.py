@@ -1,7 +1,7 @@
 """What ``lamp-state`` reads of a candidate: the colour of its lit lamp, the colour of that lamp's
 rim, and where in the housing the light is lit.
 
-Beyond the documents (issue 11). Zheng (3.3) and Lee (5.3.3) read the lens colour only; on
+Beyond the documents. Zheng (3.3) and Lee (5.3.3) read the lens colour only; on
 dash-cam frames the lit lamp is often over-exposed white with a coloured rim, and red-orange
 lamps sit at the hue of other cameras' ambers. Three groups of features make the reading
 robust across cameras:
@@ -34,7 +34,7 @@ from collections.abc import Sequence
 import cv2
 import numpy as np
 
-from tsrkit.types import Candidate
+from tsrkit.api import Candidate
 
 #: OpenCV hue (0-180) bin edges: reds split off at both ends, orange, amber, yellow, greens, blues.
 HUE_EDGES = np.array([0, 6, 12, 18, 24, 32, 45, 70, 95, 130, 165, 181])
@@ -134,8 +134,8 @@ def area_resample(
     its own source cells, with weights set by its index times the scale factor alone (clamped
     only at the far edge): the crop is cut two source pixels past the wanted ones and resampled
     with the whole crop's scale factors (``fx``, ``fy``: the quotients OpenCV takes of the
-    sizes), so less source is read for the same values (``tests/test_lamp_state.py`` compares
-    them with whole resamplings at every crop length up to a frame's width).
+    sizes), so less source is read for the same values (``tests/classifiers/test_lamp_state.py``
+    compares them with whole resamplings at every crop length up to a frame's width).
 
     ``halve_from`` > 1 first halves each side at least ``halve_from`` times its output length:
     the crop is trimmed to an even length there (the last pixel dropped from an odd one) and
@@ -243,7 +243,7 @@ def lit_lenses(
     """The lit lens of each upright housing patch, in image coordinates: the window of
     ``2 * lens_fraction`` short sides along the axis with the highest mean saturation x
     value^2 over the central :func:`band` (the rule of
-    ``tsrkit_plugins.classifiers.regions.find_lens``, on the patch)."""
+    ``tsrkit_plugins.shared.regions.find_lens``, on the patch)."""
     value = hsv[..., 2].astype(np.float32) / 255
     lit = band(hsv[..., 1].astype(np.float32) / 255 * value * value).mean(axis=2)
     across, along = HOUSING_SIZE

@@ -48,10 +48,7 @@ from functools import cache, lru_cache
 import cv2
 import numpy as np
 
-from tsrkit.hookspecs import hookimpl
-from tsrkit.params import Param, ParamError
-from tsrkit.plugin import Detector
-from tsrkit.types import Candidate, Frame
+from tsrkit.api import Candidate, Detector, Frame, Param, ParamError, hookimpl
 from tsrkit_plugins.detectors.conspicuity.colour import lightness_and_saturation
 from tsrkit_plugins.detectors.conspicuity.conspicuity_kernel import (
     BAND_PIXELS,
@@ -566,7 +563,7 @@ class Conspicuity(Detector):
     name = "conspicuity"
     summary = "Zheng's conspicuity map (lightness, quadrant contrast, saturation) + localization"
     section = "Zheng 2016, 3.2.1-3.2.2, Eq. 3.1-3.15, Algorithm 3-1, Table 5-1"
-    params = (
+    PARAMS = (
         Param(
             "weights",
             "floats",

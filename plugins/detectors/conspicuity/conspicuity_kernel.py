@@ -16,7 +16,7 @@ the values are bit for bit the same (other weights use ``powf`` instead of ``cv2
 Integer sums wrap in the buffers like the tables do (modulo 2**32 in int32, 2**16 in int16), so
 the true sums (which are small) come out exact even when the column integrals overflow.
 
-Speed (issue 16): the tables are built in one compiled pass per channel; every term is a flat
+Speed: the tables are built in one compiled pass per channel; every term is a flat
 offset into the flattened tables, so each read is a contiguous run the compiler vectorises; and
 a window adds its terms in groups of four, reading and writing its buffer once per group. When
 every lightness window holds at most :data:`NARROW_PIXELS` pixels (radius + margin <= 10, the

@@ -3,7 +3,7 @@
 A 1280x720 map needs about 17 MB of intermediate arrays (the L and S channels, their mirrored
 copies, two prefix-table stacks and the running maximum). Allocated afresh for every frame,
 they went back to the operating system and were faulted in again: 8-16 ms of system time per
-frame in a plain ``detect`` loop (issue 16). :class:`Workspace` keeps them instead. It is a
+frame in a plain ``detect`` loop. :class:`Workspace` keeps them instead. It is a
 ``threading.local``, so concurrent threads never share a buffer, and ``conspicuity_map`` uses
 it only for arrays that never leave the call: what it returns is always freshly allocated.
 """

@@ -12,7 +12,7 @@ stay in the processor's cache instead of spanning the frame. Each affected pixel
 votes in voter order, the order ``np.bincount`` sums in, and F_n is formed from the same
 float64 values as the per-pixel NumPy expressions: the transform is the same to the last bit
 as the plain array version (``tests/oracles/frst_oracle.py`` checks meaning, the tests of
-``tests/test_frst.py`` check the bits against the earlier vectorised code).
+``tests/detectors/test_frst.py`` check the bits against the earlier vectorised code).
 
 Source: G. Loy and A. Zelinsky, "Fast radial symmetry for detecting points of interest",
 IEEE PAMI 25(8), 2003: the definition of the transform and its refinements
@@ -285,7 +285,7 @@ def frst(
     -------
     ndarray, float32, same shape
         Positive at centres of bright radial symmetry, negative at dark ones. Loy & Zelinsky
-        average S_n over the radii; the sum used here (as tsrkit issue 4 states) differs only by
+        average S_n over the radii; the sum used here (Zheng 5.2.2's reading) differs only by
         the factor 1/len(radii).
 
     Examples

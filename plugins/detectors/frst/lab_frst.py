@@ -10,10 +10,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from tsrkit.hookspecs import hookimpl
-from tsrkit.params import Param
-from tsrkit.plugin import Detector
-from tsrkit.types import Candidate, Frame
+from tsrkit.api import Candidate, Detector, Frame, Param, hookimpl
 from tsrkit_plugins.detectors.frst.frst import frst
 
 
@@ -99,7 +96,7 @@ class LabFrst(Detector):
         "dark (green) spots"
     )
     section = "Zheng 2016, 5.2.2; Loy & Zelinsky 2003"
-    params = (
+    PARAMS = (
         Param(
             "radii",
             "ints",

@@ -16,11 +16,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from tsrkit.hookspecs import hookimpl
-from tsrkit.models import Model, load_model
-from tsrkit.params import Param
-from tsrkit.plugin import Detector
-from tsrkit.types import Candidate, Frame, Sample
+from tsrkit.api import Candidate, Detector, Frame, Model, Param, Sample, hookimpl, load_model
 from tsrkit_plugins.detectors.tl_recognizer import tl_geometry as geo
 from tsrkit_plugins.detectors.tl_recognizer.tl_templates import (
     ORIENTATIONS,
@@ -194,7 +190,7 @@ class TlRecognizer(Detector):
     name = "tl-recognizer"
     summary = "HSV range filters, contour pruning and template NCC validation; assigns the state"
     section = "Mascetti 2016, 3.2-3.5, 4.1-4.2, 5.2, Table 6"
-    params = (
+    PARAMS = (
         Param(
             "green_h",
             "ints",

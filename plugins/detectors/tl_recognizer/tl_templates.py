@@ -26,8 +26,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from tsrkit.errors import TsrkitError
-from tsrkit.inputs import read_image
+from tsrkit.api import TsrkitError, read_image
 
 #: Colours of the generated templates (BGR): a lit lens as a fixed exposure records it.
 LENS_BGR = {"green": (190, 255, 80), "yellow": (40, 200, 255), "red": (60, 40, 255)}

@@ -11,9 +11,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from tsrkit.errors import TsrkitError
-from tsrkit.eval.matching import centre_hits
-from tsrkit.models import Model
+from tsrkit.api import Model, TsrkitError, centre_hits
 from tsrkit_plugins.detectors.tl_recognizer.tl_recognizer import (
     PASSES,
     extract_contours,
@@ -54,7 +52,7 @@ def lens_contour(contour: np.ndarray, scale: np.ndarray, boxes) -> bool:
 
 def annotated_lens_pixels(samples, factor: int) -> dict[str, np.ndarray]:
     """Pixels of broad-range contours that fit a box of their colour, per pass (Figure 16)."""
-    found = {colour: [] for colour in PASSES}
+    found: dict[str, list[np.ndarray]] = {colour: [] for colour in PASSES}
     for sample in samples:
         frame = sample.load()
         hsv = reduced_hsv(frame.image, factor)
@@ -114,14 +112,15 @@ def patch_scores(detector, samples) -> tuple[np.ndarray, np.ndarray]:
     A patch is a light when its centre lies in the minimum enclosing circle of an annotated box
     (Zheng 5.2.1). Returns ``(lights, others)``, two float arrays.
     """
-    lights, others = [], []
+    lights: list[float] = []
+    others: list[float] = []
     for sample in samples:
         candidates = detector.scored(sample.load())
         if not candidates:
             continue
         boxes = [a.bbox for a in sample.annotations]
         centres = [(c.x, c.y) for c in candidates]
-        inside = (
+        inside = np.asarray(
             centre_hits(centres, boxes).any(axis=1) if boxes else np.zeros(len(candidates), bool)
         )
         for candidate, hit in zip(candidates, inside):

@@ -16,10 +16,17 @@ from pathlib import Path
 
 import cv2
 
-from tsrkit import ReportWriter, RunResult, hookimpl
-from tsrkit.atomic import atomic_open
-from tsrkit.eval.categories import radius_label
-from tsrkit.report import fmt, headline, title
+from tsrkit.api import (
+    DetectionRecord,
+    ReportWriter,
+    RunResult,
+    atomic_open,
+    fmt,
+    headline,
+    hookimpl,
+    radius_label,
+    title,
+)
 from tsrkit_plugins.writers.plots import plot_names, write_plots
 
 #: Frames shown in the gallery of worst frames.
@@ -89,7 +96,9 @@ def frame_errors(sample, record) -> tuple[list, list, list, int]:
     """Detections whose centre is in a box, false positives (in none), missed boxes, and the
     detections in a box whose state differs from the box's (both known)."""
     boxes = [a.bbox for a in sample.annotations]
-    hits, false, covered, wrong = [], [], set(), 0
+    hits: list[DetectionRecord] = []
+    false: list[DetectionRecord] = []
+    covered, wrong = set(), 0
     for d in record.detections:
         inside = [
             k for k, (x0, y0, x1, y1) in enumerate(boxes) if x0 <= d.x <= x1 and y0 <= d.y <= y1
@@ -252,14 +261,14 @@ class HtmlReport(ReportWriter):
         with atomic_open(folder / "report.html") as fh:
             fh.write(page(run))
 
+    def write_comparison(self, folder: Path) -> list[str]:
+        from tsrkit_plugins.writers.html.compare import compare_page
+
+        with atomic_open(folder / "compare.html") as fh:
+            fh.write(compare_page(folder))
+        return ["compare.html"]
+
 
 @hookimpl
 def register_report_writers(register):
     register(HtmlReport)
-
-
-@hookimpl
-def register_commands(cli):
-    from tsrkit_plugins.writers.html.verb import report_command
-
-    cli.add_command(report_command)
