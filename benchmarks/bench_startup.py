@@ -11,7 +11,6 @@ measured the same way for comparison.
 from __future__ import annotations
 
 import argparse
-import os
 import statistics
 import subprocess
 import sys
@@ -46,11 +45,10 @@ def main() -> None:
     parser.add_argument("--runs", type=int, default=7)
     args = parser.parse_args()
     harness.announce()
-    print(f"load average before: {os.getloadavg()[0]:.2f}; {args.runs} runs each")
+    print(f"{args.runs} runs each")
     for label, command in COMMANDS.items():
         median_seconds(command, 1)  # warm the file cache
         print(f"{label:48s} median {median_seconds(command, args.runs):6.3f} s")
-    print(f"load average after: {os.getloadavg()[0]:.2f}")
 
 
 if __name__ == "__main__":

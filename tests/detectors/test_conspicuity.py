@@ -494,8 +494,8 @@ def test_unusable_settings_fail_at_construction_as_a_parameter_error():
 
 
 def test_one_pass_conversion_equals_opencv_lightness_and_saturation(shared_datasets):
-    # All 2**24 colours agreed in a scratch run (benchmarks/RESULTS.scaling.md); here a random
-    # sample of 2**20 colours, the grey ramp, the pure hues, and a real frame (as a view).
+    # All 2**24 colours agreed in a scratch run (benchmarks/RESULTS.detector_speed.md); here a
+    # random sample of 2**20 colours, the grey ramp, the pure hues, and a real frame (as a view).
     rng = np.random.default_rng(9)
     sample = rng.integers(0, 256, (1024, 1024, 3), dtype=np.uint8)
     ramps = np.zeros((4, 256, 3), np.uint8)

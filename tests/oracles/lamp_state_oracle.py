@@ -3,10 +3,10 @@ housing resampled upright and again transposed when wide, a colour conversion ov
 stack, ``np.digitize`` hue bins, scikit-learn's ``predict_proba``): the oracle the faster
 classifier must match exactly. The feature functions the speed-up left alone are imported.
 
-Housings are resampled as lamp-state defines it since lampcrop (outputs changed by design):
-a side at least ``HALVE_FROM`` times its output length is first halved (:func:`halved`: an
-odd last pixel dropped, pairs averaged), then the whole crop resampled by OpenCV's area
-rule."""
+Housings are resampled as lamp-state defines it since long housings are halved (outputs
+changed by design): a side at least ``HALVE_FROM`` times its output length is first halved
+(:func:`halved`: an odd last pixel dropped, pairs averaged), then the whole crop resampled by
+OpenCV's area rule."""
 
 from __future__ import annotations
 

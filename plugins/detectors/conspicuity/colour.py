@@ -14,7 +14,7 @@ repeats only OpenCV's own fixed-point steps for L and S (``RGB2Lab_b`` in
 * S: ``((max - min) * round(255 * 2**12 / max) + 2**11) >> 12`` (0 when max is 0).
 
 Equal to ``cv2.cvtColor`` on all 2**24 colours with OpenCV 5.0.0 (checked in a scratch run,
-benchmarks/RESULTS.scaling.md); ``tests/detectors/test_conspicuity.py`` keeps a sampled check
+benchmarks/RESULTS.detector_speed.md); ``tests/detectors/test_conspicuity.py`` keeps a sampled check
 against the installed OpenCV.
 """
 
