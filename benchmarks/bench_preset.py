@@ -30,13 +30,13 @@ from __future__ import annotations
 
 import os
 
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
-    os.environ[_var] = "1"
+import harness
+
+harness.single_thread()
+os.environ["NUMBA_NUM_THREADS"] = "1"
 
 import argparse  # noqa: E402
-import datetime  # noqa: E402
 import json  # noqa: E402
-import platform  # noqa: E402
 import shlex  # noqa: E402
 import site  # noqa: E402
 import statistics  # noqa: E402
@@ -48,8 +48,7 @@ from pathlib import Path  # noqa: E402
 import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
-REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO / "benchmarks"))
+REPO = harness.REPO
 
 from conspicuity_filter2d import conspicuity_filter2d  # noqa: E402
 
@@ -57,21 +56,14 @@ import tsrkit  # noqa: E402
 from tsrkit.atomic import write_json  # noqa: E402
 from tsrkit.types import Frame  # noqa: E402
 
-cv2.setNumThreads(1)
-
 SET = "iwai_japan_tl"
 #: The rows of a 1280x960 frame kept: its middle 720.
 ROWS = (120, 840)
 
 
-def data_dir() -> Path:
-    """The datasets folder: ``$TSRKIT_DATA_DIR``, else ``../shared/datasets``."""
-    return Path(os.environ.get("TSRKIT_DATA_DIR", REPO.parent / "shared" / "datasets"))
-
-
 def frame_files(count: int) -> list[Path]:
     """``count`` of the set's 1280x960 frames, evenly spaced in file order."""
-    root = data_dir() / SET
+    root = harness.data_dir() / SET
     labels = root / "annotations.json"
     try:
         entries = json.loads(labels.read_text())
@@ -173,32 +165,6 @@ def baseline_python(commit: str) -> Path:
     return python
 
 
-def record_block(command: str) -> str:
-    """Machine, commit, command, date and load, for the results page."""
-    head = subprocess.run(
-        ["git", "-C", str(REPO), "rev-parse", "--short", "HEAD"], capture_output=True, text=True
-    ).stdout.strip()
-    dirty = subprocess.run(["git", "-C", str(REPO), "diff", "--quiet", "HEAD", "--"]).returncode
-    cpu = next(
-        (
-            line.split(":", 1)[1].strip()
-            for line in Path("/proc/cpuinfo").read_text().splitlines()
-            if line.startswith("model name")
-        ),
-        platform.processor(),
-    )
-    return "\n".join(
-        [
-            f"machine: {cpu}, {os.cpu_count()} cores; Python {platform.python_version()}; "
-            f"numpy {np.__version__}; opencv {cv2.__version__}",
-            f"commit:  {head}{'-dirty' if dirty else ''}",
-            f"command: {command}",
-            f"date:    {datetime.datetime.now(datetime.UTC):%Y-%m-%d %H:%M} UTC",
-            f"load:    {' '.join(f'{v:.2f}' for v in os.getloadavg())} (start)",
-        ]
-    )
-
-
 def summary(rows: list[dict]) -> dict:
     """Median over frames of every stage's ms, and of its share of the yardstick."""
     names = list(rows[0]["ms"])
@@ -252,8 +218,7 @@ def main() -> None:
         worker(files, args.repeats)
         return
     command = "python benchmarks/bench_preset.py " + shlex.join(sys.argv[1:])
-    print(record_block(command.strip()), flush=True)
-    started = time.time()
+    harness.announce()
     child = None
     if args.baseline:
         script = [str(Path(__file__).resolve()), "--worker", "--frames", str(args.frames)]
@@ -284,8 +249,6 @@ def main() -> None:
     base = summary(base_rows) if base_rows else None
     table = markdown(now, base, args.baseline)
     print(table)
-    end_load = " ".join(f"{v:.2f}" for v in os.getloadavg())
-    print(f"load:    {end_load} (end; {time.time() - started:.0f} s)")
     results = {"command": command, "summary": now, "baseline_summary": base}
     write_json(Path(args.out) / "results.json", {**results, "now": rows, "baseline": base_rows})
 
