@@ -90,7 +90,8 @@ def baseline_detector(commit: str, params: dict):
     """TL-recognizer as of ``commit`` (its ``tl_recognizer.py``), with ``params`` over the
     defaults."""
     cls = module_at(commit, "plugins/detectors/tl_recognizer/tl_recognizer.py").TlRecognizer
-    return cls(**{**{p.name: p.default for p in cls.PARAMS}, **params})
+    schema = vars(cls).get("PARAMS", vars(cls).get("params", ()))  # older trees: ``params``
+    return cls(**{**{p.name: p.default for p in schema}, **params})
 
 
 def reference_comparison(
