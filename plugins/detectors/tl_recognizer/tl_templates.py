@@ -280,8 +280,9 @@ def ncc_batch(patches: np.ndarray, template: np.ndarray, floor: float = 0.0) -> 
     pixels = patches[0].size // channels if count else 1
     x = patches.reshape(count, -1).astype(np.float64)
     t = template.reshape(-1).astype(np.float64)
-    sums = x.reshape(count, pixels, channels).sum(axis=1)
-    t_sums = t.reshape(pixels, channels).sum(axis=0)
+    channel_of = np.tile(np.eye(channels), (pixels, 1))  # sums per channel as a product
+    sums = x @ channel_of
+    t_sums = t @ channel_of
     numerator = x @ t - sums @ t_sums / pixels
     energy = np.einsum("nk,nk->n", x, x) - (sums * sums).sum(axis=1) / pixels
     t_energy = float(t @ t - t_sums @ t_sums / pixels)
