@@ -31,7 +31,7 @@ import numpy as np
 from numba import njit
 
 from tsrkit.api import Candidate, Detector, Frame, Param, hookimpl
-from tsrkit_plugins.detectors.frst.lab_frst import lab_feature_map
+from tsrkit_plugins.detectors.frst.lab_frst import frame_feature_map
 
 
 def gaussian_stack(part: np.ndarray, sigmas: list[float]) -> np.ndarray:
@@ -141,7 +141,7 @@ class LabBlob(Detector):
         """Up to ``top`` red-hinted and ``top`` green-hinted blobs, strongest first."""
         p = self.params
         sigmas = [p["sigma"] * p["step"] ** i for i in range(p["levels"] + 1)]
-        feature = lab_feature_map(frame.image)
+        feature = frame_feature_map(frame)
         found = part_blobs(np.maximum(feature, 0), sigmas, p["fraction"], p["top"], "red")
         found += part_blobs(np.maximum(-feature, 0), sigmas, p["fraction"], p["top"], "green")
         return sorted(found, key=lambda c: -c.score)

@@ -105,16 +105,30 @@ class ScaledMember:
     def __init__(self, detector: Detector, scale: float, top: float):
         self.detector, self.scale, self.top = detector, scale, top
 
-    def detect(self, frame: Frame) -> list[Candidate]:
-        """The member's candidates on the resized region, in ``frame``'s pixels."""
-        image = frame.image[: max(1, int(round(frame.height * self.top)))]
-        h, w = image.shape[:2]
-        size = (max(1, int(round(w * self.scale))), max(1, int(round(h * self.scale))))
-        if size == (w, h):
-            return self.detector.detect(replace(frame, image=image))
-        resized = cv2.resize(image, size, interpolation=cv2.INTER_LINEAR)
-        found = self.detector.detect(replace(frame, image=resized))
-        return [map_back(c, size[0] / w, size[1] / h) for c in found]
+    def view(self, frame: Frame, shared: dict) -> Frame:
+        """The frame the member runs on: ``frame``'s upper ``top`` share of rows
+        (:meth:`Frame.band`, sharing ``frame``'s colour views), resized by ``scale``. Made once
+        per band and size for all the members that ask with the same ``shared`` dict."""
+        rows = max(1, int(round(frame.height * self.top)))
+        size = (max(1, int(round(frame.width * self.scale))), max(1, int(round(rows * self.scale))))
+        if ("band", rows) not in shared:
+            shared["band", rows] = frame if rows == frame.height else frame.band(rows)
+        band = shared["band", rows]
+        if size == (band.width, band.height):
+            return band
+        if (rows, size) not in shared:
+            resized = cv2.resize(band.image, size, interpolation=cv2.INTER_LINEAR)
+            shared[rows, size] = replace(band, image=resized)
+        return shared[rows, size]
+
+    def detect(self, frame: Frame, shared: dict | None = None) -> list[Candidate]:
+        """The member's candidates on its :meth:`view` of ``frame``, in ``frame``'s pixels."""
+        view = self.view(frame, {} if shared is None else shared)
+        found = self.detector.detect(view)
+        rows = max(1, int(round(frame.height * self.top)))
+        if (view.width, view.height) == (frame.width, rows):
+            return found
+        return [map_back(c, view.width / frame.width, view.height / rows) for c in found]
 
 
 def rank_scores(count: int) -> np.ndarray:
@@ -210,8 +224,10 @@ class Union(Detector):
             raise ParamError(f"union: member {twice[0]!r} given twice at the same scale")
 
     def detect(self, frame: Frame) -> list[Candidate]:
-        """Every member's candidates, merged; scores in [0, 1]."""
-        lists = [member.detect(frame) for member in self.members]
+        """Every member's candidates, merged; scores in [0, 1]. Members at one band and
+        scale run on one frame made for them, and all share ``frame``'s colour views."""
+        shared: dict = {}
+        lists = [member.detect(frame, shared) for member in self.members]
         p = self.params
         return merge(lists, p["merge"], p["min_distance"], p["reach_by"])
 

@@ -167,3 +167,25 @@ def test_an_upscaled_member_finds_a_small_lamp_its_full_scale_twin_misses():
 
     assert nearest("conspicuity n_top=15") > 5
     assert nearest("conspicuity n_top=15 scale=2") < 1
+
+
+def test_members_at_one_band_and_scale_share_one_frame_and_its_colour_views():
+    """The union makes each band and size once: members there get the same frame object, and
+    a band reads the whole frame's colour views; each member's candidates are those it finds
+    on its own."""
+    members = (
+        "lab-frst top=15; lab-blob scale_top=0.6; tl-recognizer scale_top=0.6; "
+        "lab-blob scale=0.5; lab-frst top=15 scale=0.5"
+    )
+    union = get_registry().create("detector", "union", {"members": members})
+    image = background(240, 320, seed=2)
+    render_head(image, (160.0, 90.0), 6, 3, 0)
+    frame = Frame(image, "head")
+    shared: dict = {}
+    views = [m.view(frame, shared) for m in union.members]
+    assert views[0] is frame and views[1] is views[2] and views[3] is views[4]
+    assert views[1].height == 144 and views[3].width == 160
+    assert views[1].views._parent is frame.views and views[3].views is not frame.views
+    alone = [m.detect(frame) for m in union.members]
+    assert alone == [m.detect(frame, shared) for m in union.members]
+    assert union.detect(frame) == merge(alone, 1.0, 3.0)

@@ -648,7 +648,9 @@ class TlRecognizer(Detector):
         wanted = [patch_box(b, state, orientation, self.layout) for b, state in zip(boxes, states)]
         reuse = lenses is not None and size == lenses.shape[2:0:-1]
         todo = [i for i, box in enumerate(wanted) if not (reuse and box == boxes[i])]
-        out = lenses.copy() if reuse else np.empty((len(boxes), size[1], size[0], 3), np.uint8)
+        out = np.empty((len(boxes), size[1], size[0], 3), np.uint8)
+        if lenses is not None and reuse:
+            out[:] = lenses
         matrices = warp_matrices(np.array([wanted[i] for i in todo]), roll, centre, size)
         for i, matrix in zip(todo, matrices):
             out[i] = warp_patch(image, matrix, size)

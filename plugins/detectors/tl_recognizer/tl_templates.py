@@ -251,7 +251,7 @@ def extract_patch(
     :func:`tl_geometry.level_coordinates`; the patch is rotated on the fly, as the paper does, by
     one affine warp from patch pixels to image pixels (bilinear, border replicated).
     """
-    shape = (size, size) if isinstance(size, int | np.integer) else tuple(size)
+    shape = (int(size), int(size)) if isinstance(size, int | np.integer) else (size[0], size[1])
     return warp_patch(image, warp_matrices(np.array([box_uv]), roll, centre, shape)[0], shape)
 
 
