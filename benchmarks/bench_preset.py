@@ -22,8 +22,10 @@ dependencies, into a virtual environment that borrows this environment's package
 reused). Only what both trees have is called: the pipeline, the union's ``members`` and the
 module-level ``merge`` beside it.
 
+``--members`` times this tree's preset with other union members (the baseline keeps its own).
+
 Run: python benchmarks/bench_preset.py [--frames 12] [--repeats 3] [--baseline 42dcb98]
-[--out benchmarks/out/bench_preset]
+[--members "lab-blob top=30 scale_top=0.6; ..."] [--out benchmarks/out/bench_preset]
 """
 
 from __future__ import annotations
@@ -97,8 +99,9 @@ def cpu_ms(call, repeats: int) -> tuple[float, object]:
 class Stages:
     """The recommended pipeline and its stages, callable one by one."""
 
-    def __init__(self):
-        self.pipeline = tsrkit.select(config="recommended").pipeline()
+    def __init__(self, members: str = ""):
+        params = [f"detector.members={members}"] if members else []
+        self.pipeline = tsrkit.select(config="recommended", params=params).pipeline()
         union = self.pipeline.detector
         self.members = union.members
         self.merge = sys.modules[type(union).__module__].merge
@@ -128,7 +131,7 @@ class Stages:
 
 def worker(files: list[Path], repeats: int) -> None:
     """Baseline side: warm up on the first frame, then measure frame ``i`` for every line
-    ``i`` read from stdin and answer with one JSON line."""
+    ``i`` read from stdin and answer with one JSON line (the preset as it is at the baseline)."""
     stages = Stages()
     stages.measure(load_frame(files[0]), 1)
     print(json.dumps({"ready": True, "stages": stages.names()}), flush=True)
@@ -209,6 +212,9 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=3, help="calls per frame (default 3)")
     parser.add_argument("--baseline", default="", help="commit measured in a second process")
     parser.add_argument("--out", default="benchmarks/out/bench_preset", help="results folder")
+    parser.add_argument(
+        "--members", default="", help="the union's members in this tree (default: the preset's)"
+    )
     parser.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.repeats < 1:
@@ -231,7 +237,7 @@ def main() -> None:
         )
         assert child.stdin is not None and child.stdout is not None
         json.loads(child.stdout.readline())
-    stages = Stages()
+    stages = Stages(args.members)
     stages.measure(load_frame(files[0]), 1)
     rows, base_rows = [], []
     for i, path in enumerate(files):

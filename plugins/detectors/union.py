@@ -142,21 +142,24 @@ def merge(
     """Merge best-first candidate lists (one per member) by the module's rules, best first;
     ``reach_by`` names which of two radii sets the merging distance (``larger`` or
     ``smaller``)."""
-    pick = max if reach_by == "larger" else min
+    pick_radius = np.maximum if reach_by == "larger" else np.minimum
     pool = []  # (rank score, member, candidate)
     for member, candidates in enumerate(lists):
         ordered = sorted(candidates, key=lambda c: -c.score)
         pool += [(s, member, c) for s, c in zip(rank_scores(len(ordered)), ordered)]
     pool.sort(key=lambda item: (-item[0], item[1]))
     kept: list[tuple[Candidate, dict[int, float], list[float]]] = []
+    at = np.empty((len(pool), 3))  # kept candidates' x, y and own radius, in kept order
     for score, member, c in pool:
-        for other, votes, radii in kept:
-            reach = max(factor * pick(c.radius, other.radius), min_distance)
-            if np.hypot(c.x - other.x, c.y - other.y) <= reach:
-                votes.setdefault(member, score)
-                radii.append(c.radius)
-                break
+        n = len(kept)
+        reach = np.maximum(factor * pick_radius(c.radius, at[:n, 2]), min_distance)
+        near = np.flatnonzero(np.hypot(c.x - at[:n, 0], c.y - at[:n, 1]) <= reach)
+        if len(near):  # the first kept candidate within reach, as a loop over them finds it
+            _, votes, radii = kept[near[0]]
+            votes.setdefault(member, score)
+            radii.append(c.radius)
         else:
+            at[n] = c.x, c.y, c.radius
             kept.append((c, {member: score}, [c.radius]))
     share = 1.0 / max(len(lists), 1)
     merged = [

@@ -189,3 +189,45 @@ def test_members_at_one_band_and_scale_share_one_frame_and_its_colour_views():
     alone = [m.detect(frame) for m in union.members]
     assert alone == [m.detect(frame, shared) for m in union.members]
     assert union.detect(frame) == merge(alone, 1.0, 3.0)
+
+
+def merged_by_loop(lists, factor, min_distance, reach_by):
+    """The merging rule candidate by candidate against each kept one, in Python floats."""
+    pick = max if reach_by == "larger" else min
+    pool = []
+    for member, candidates in enumerate(lists):
+        ordered = sorted(candidates, key=lambda c: -c.score)
+        pool += [(1.0 - k / len(ordered), member, c) for k, c in enumerate(ordered)]
+    pool.sort(key=lambda item: (-item[0], item[1]))
+    kept = []
+    for score, member, c in pool:
+        for other, votes, radii in kept:
+            if np.hypot(c.x - other.x, c.y - other.y) <= max(
+                factor * pick(c.radius, other.radius), min_distance
+            ):
+                votes.setdefault(member, score)
+                radii.append(c.radius)
+                break
+        else:
+            kept.append((c, {member: score}, [c.radius]))
+    return [(c.x, c.y, max(r), sum(v.values()) / len(lists)) for c, v, r in kept]
+
+
+@pytest.mark.parametrize("reach_by", ["larger", "smaller"])
+def test_merge_keeps_what_the_candidate_by_candidate_rule_keeps(reach_by):
+    rng = np.random.default_rng(len(reach_by))
+    for _ in range(100):
+        lists = [
+            [
+                Candidate.from_circle(
+                    *rng.uniform(0, 150, 2), rng.choice([0.5, 2, 6]), rng.random()
+                )
+                for _ in range(rng.integers(0, 25))
+            ]
+            for _ in range(4)
+        ]
+        found = [(c.x, c.y, c.radius, c.score) for c in merge(lists, 1.0, 3.0, reach_by)]
+        expected = merged_by_loop(lists, 1.0, 3.0, reach_by)
+        assert sorted(found, key=lambda t: (-t[3], t[0], t[1])) == sorted(
+            expected, key=lambda t: (-t[3], t[0], t[1])
+        )
