@@ -84,7 +84,11 @@ def blob_peaks(blurs, fraction):
             local = True
             for dr in range(max(r - 1, 0), min(r + 2, height)):
                 for dc in range(max(c - 1, 0), min(c + 2, width)):
-                    local &= best[dr, dc] <= value
+                    if best[dr, dc] > value:
+                        local = False
+                        break
+                if not local:
+                    break
             if local:
                 rows[found], cols[found], levels[found], values[found] = r, c, which[r, c], value
                 found += 1
