@@ -1,10 +1,12 @@
-"""Import one module file as it was at an earlier commit (``git show``), for A/B timings of a
-change in the same run. The module's own imports resolve against the current tree, so this is
-for files whose imports did not change in between."""
+"""Earlier commits for A/B timings in the same run: one module file as it was (``git show``;
+its own imports resolve against the current tree, so this is for files whose imports did not
+change in between), or a whole tree installed in its own virtual environment, for timing whole
+commands (:func:`python_at`)."""
 
 from __future__ import annotations
 
 import importlib.util
+import site
 import subprocess
 import sys
 import tempfile
@@ -32,3 +34,32 @@ def module_at(commit: str, path: str) -> ModuleType:
     sys.modules[name] = module
     spec.loader.exec_module(module)
     return module
+
+
+def python_at(commit: str) -> Path:
+    """The Python of a virtual environment holding the tree of ``commit`` installed in editable
+    mode (its own entry points: plugins that moved since load from where they were), made once
+    under ``benchmarks/out/at-COMMIT/``. It borrows this environment's packages (a ``.pth``
+    file), so only tsrkit differs."""
+    root = REPO / "benchmarks" / "out" / f"at-{commit}"
+    python = root / "venv" / "bin" / "python"
+    if python.exists():
+        return python
+    archive = subprocess.run(["git", "-C", str(REPO), "archive", commit], capture_output=True)
+    if archive.returncode != 0:
+        raise SystemExit(f"no commit {commit} in {REPO}")
+    (root / "src").mkdir(parents=True, exist_ok=True)
+    subprocess.run(["tar", "-x", "-C", str(root / "src")], input=archive.stdout, check=True)
+    subprocess.run([sys.executable, "-m", "venv", "--without-pip", str(root / "venv")], check=True)
+    packages = subprocess.run(
+        [str(python), "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"],
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout.strip()
+    (Path(packages) / "borrowed.pth").write_text("\n".join(site.getsitepackages()) + "\n")
+    install = [sys.executable, "-m", "pip", "--python", str(python), "install", "-q"]
+    subprocess.run(
+        [*install, "--no-deps", "--no-build-isolation", "-e", str(root / "src")], check=True
+    )
+    return python

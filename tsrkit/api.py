@@ -32,8 +32,12 @@ The names, by what they are for:
 - evaluation: :class:`EvalSettings`, :func:`eval_settings`, :func:`centre_hits`,
   :func:`greedy_match`, :func:`frame_score`, :func:`radius_label`,
   :func:`recall_sort_key`, :func:`discriminative_ratio`, :func:`coco_run`;
-- reports: :data:`HEADLINE`, :func:`headline`, :func:`fmt`, :func:`markdown_table`,
-  :func:`title`;
+- metric results, which every report writer renders: :class:`MetricResult` (a metric's
+  ``compute`` returns one) with its :class:`Figure` (headline), :class:`Table` and
+  :class:`Plot` parts;
+- reports: :class:`RunResult`, :func:`heading`, :func:`headline`, :func:`headline_rows`,
+  :func:`headline_table`, :func:`figure_notes`, :func:`fmt`, :func:`format_p`,
+  :func:`markdown_table`, :func:`title`, :func:`read_comparison`;
 - scene facts and synthetic scenes: :data:`PANEL_HEIGHT_M`, :func:`distance_from_height`,
   :func:`frame_facts`, :func:`sun_view`, :class:`Track`, :func:`read_track`,
   :class:`SynthOptions`, :func:`render_frame`, :func:`scatter_heads`.

@@ -43,11 +43,20 @@ from tsrkit.eval.matching import (
 from tsrkit.eval.perframe import (
     frame_score as frame_score,
 )
+from tsrkit.eval.results import (
+    Figure as Figure,
+    MetricResult as MetricResult,
+    Plot as Plot,
+    Table as Table,
+)
 from tsrkit.eval.settings import (
     EvalSettings as EvalSettings,
 )
 from tsrkit.eval.state import (
     discriminative_ratio as discriminative_ratio,
+)
+from tsrkit.eval.stats import (
+    format_p as format_p,
 )
 from tsrkit.geo.gps import (
     Track as Track,
@@ -102,12 +111,18 @@ from tsrkit.records import (
     FrameRecord as FrameRecord,
 )
 from tsrkit.report import (
-    HEADLINE as HEADLINE,
     RunResult as RunResult,
+    figure_notes as figure_notes,
     fmt as fmt,
+    heading as heading,
     headline as headline,
+    headline_rows as headline_rows,
+    headline_table as headline_table,
     markdown_table as markdown_table,
     title as title,
+)
+from tsrkit.runfolder import (
+    read_comparison as read_comparison,
 )
 from tsrkit.sun.relative import (
     frame_facts as frame_facts,

@@ -13,23 +13,26 @@ them after the metrics are computed.
 from __future__ import annotations
 
 import contextlib
+import functools
 import json
 import os
 import time
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from tsrkit.engine import BenchmarkError, Job, default_cache_dir, plugin_identity, run_records
+from tsrkit.eval.guard import Failure, GuardedMetrics
+from tsrkit.eval.runfacts import run_facts
 from tsrkit.eval.settings import EvalSettings, not_exhaustive_note, resolve_box
 from tsrkit.outlock import locked
-from tsrkit.plugin import Classifier, Detector, Metric, ReportWriter, Verifier
+from tsrkit.plugin import Classifier, Detector, ReportWriter, Verifier
 from tsrkit.records import FrameRecord
 from tsrkit.registry import get_registry
-from tsrkit.report import ProgressBar, RunResult, build_report, merge_sections
+from tsrkit.report import REPORT_KEYS, ProgressBar, RunResult, build_report, ordered
+from tsrkit.runfolder import write_run
 from tsrkit.types import Dataset
 
 __all__ = [
@@ -37,7 +40,6 @@ __all__ = [
     "eval_settings",
     "evaluate",
     "metrics_for",
-    "remove_stale_files",
     "run_benchmark",
     "writers_for",
 ]
@@ -57,13 +59,16 @@ def eval_settings(
     )
 
 
-def metrics_for(settings: EvalSettings) -> list[Metric]:
-    """Every registered metric, reset for a new evaluation."""
+def metrics_for(settings: EvalSettings) -> GuardedMetrics:
+    """Every registered metric, reset for a new evaluation (one that fails is left out)."""
     registry = get_registry()
-    metrics = [registry.create("metric", info.name) for info in registry.plugins("metric")]
-    for metric in metrics:
-        metric.reset(settings)
-    return metrics
+    return GuardedMetrics(
+        {
+            info.name: functools.partial(registry.create, "metric", info.name)
+            for info in registry.plugins("metric")
+        },
+        settings,
+    )
 
 
 def writers_for(names: Sequence[str] | None) -> list[ReportWriter]:
@@ -113,12 +118,10 @@ def evaluate(
         if record.skipped is not None:
             skipped.append({"source": record.source, "reason": record.skipped})
             continue
-        sample = dataset.samples[record.index]
-        for metric in metrics:
-            metric.update(sample, record)
+        metrics.update(dataset.samples[record.index], record)
         kept.append(record)
     wall = time.perf_counter() - start
-    sections = merge_sections((m.name, m.compute()) for m in metrics)
+    sections, results, written = metrics.compute(REPORT_KEYS)
     cached = sum(r.cached for r in kept)
     timing = {
         "ms_per_frame_median": float(np.median([r.ms for r in kept])) if kept else None,
@@ -132,46 +135,29 @@ def evaluate(
     counted = sections.get("frame_notes", {}).get("counts", {})
     notes += [f"{n} of {len(kept)} frames: {text}" for text, n in counted.items()]
 
-    def report(files: Sequence[str]) -> dict[str, Any]:
+    def report(files: Sequence[str], failures: Sequence[Failure]) -> dict[str, Any]:
         return build_report(
-            dataset, plugins, settings, sections, len(kept), timing, skipped, files, notes
+            dataset,
+            plugins,
+            settings,
+            sections,
+            len(kept),
+            timing,
+            skipped,
+            files,
+            notes,
+            written,
+            failures,
         )
 
-    run = RunResult(report(()), dataset, settings, tuple(kept))
+    first = report((), metrics.failures)
+    shown = ordered([*run_facts(first), *results])
+    run = RunResult(first, dataset, settings, tuple(kept), shown, list(metrics.failures))
     if out is None:
         return run
-    chosen = writers_for(writers)
-    run = replace(run, report=report([f for w in chosen for f in w.files(run)]))
     folder = Path(out)
     folder.mkdir(parents=True, exist_ok=True)
-    remove_stale_files(folder, {*run.report["files"], *run.report["plots"]})
-    for writer in chosen:
-        writer.write(run, folder)
-    return run
-
-
-def remove_stale_files(folder: Path, keep: set[str]) -> list[str]:
-    """Delete the files an earlier run's ``report.json`` in ``folder`` lists and this run will
-    not write (a rerun with fewer writers or plots replaces the old report completely).
-
-    Only names the old report lists, inside ``folder``, are touched; an unreadable old report
-    removes nothing. Returns the names removed.
-    """
-    try:
-        old = json.loads((folder / "report.json").read_text(encoding="utf-8"))
-        listed = [*old.get("files", []), *old.get("plots", [])]
-    except (OSError, ValueError, AttributeError, TypeError):
-        return []
-    root = folder.resolve()
-    removed = []
-    for name in listed:
-        if not isinstance(name, str) or name in keep:
-            continue
-        path = (folder / name).resolve()
-        if path.is_relative_to(root) and path != root and path.is_file():
-            path.unlink()
-            removed.append(name)
-    return removed
+    return write_run(run, writers_for(writers), folder, report)
 
 
 def run_benchmark(

@@ -19,9 +19,10 @@ from tsrkit.benchmarking import run_benchmark
 from tsrkit.engine import BenchmarkError
 from tsrkit.eval.coco import coco_ap, coco_run
 from tsrkit.eval.perframe import frame_score
-from tsrkit.eval.stats import paired_test
+from tsrkit.eval.results import fmt
+from tsrkit.eval.stats import format_p, paired_test
 from tsrkit.plugin import Classifier, Detector
-from tsrkit.report import HEADLINE, RunResult, fmt, headline, markdown_table, title
+from tsrkit.report import RunResult, headline_rows, markdown_table, title
 from tsrkit.types import Dataset
 
 __all__ = [
@@ -151,12 +152,13 @@ def compare(
 def compare_markdown(comparison: dict) -> str:
     """compare.md: the side-by-side headline table and the paired tests."""
     reports = comparison["reports"]
+    columns, rows = headline_rows(reports)
     lines = [
         f"# Comparison on {comparison['dataset']}",
         "",
         markdown_table(
-            ["method"] + [label for _, _, label, _ in HEADLINE],
-            [[title(r)] + list(headline(r).values()) for r in reports],
+            ["method"] + [f.label for f in columns],
+            [[title(r), *row] for r, row in zip(reports, rows)],
         ),
         "",
         "## Paired tests on the same frames (Wilcoxon signed-rank, per-frame recall)",
@@ -171,7 +173,7 @@ def compare_markdown(comparison: dict) -> str:
                     t["b"],
                     str(t["frames"]),
                     fmt(t["mean_difference"]),
-                    fmt(t["p_value"]),
+                    format_p(t["p_value"]),
                     t["verdict"],
                 ]
                 for t in comparison["paired_tests"]
@@ -192,7 +194,7 @@ def compare_markdown(comparison: dict) -> str:
                         t["metric"],
                         str(t["frames"]),
                         fmt(t["mean_difference"]),
-                        fmt(t["p_value"]),
+                        format_p(t["p_value"]),
                         t["verdict"],
                     ]
                     for t in comparison["verifier_tests"]

@@ -45,9 +45,11 @@ __all__ = [
     "plugin_identity",
     "pool_context",
     "process_sample",
+    "read_cached",
     "run_records",
     "single_thread",
     "source_hash",
+    "start_pool_server",
 ]
 
 ENGINES = ("local", "dask")
@@ -114,14 +116,25 @@ def process_sample(index: int, sample: Sample, job: Job) -> FrameRecord:
     except OSError as exc:
         return FrameRecord(sample.source, index, skipped=f"cannot read: {exc.strerror or exc}")
     path = Path(job.cache_dir, key[:2], f"{key}.json") if job.cache_dir else None
-    if path is not None and path.is_file():
-        with open(path, encoding="utf-8") as fh:
-            return replace(FrameRecord.from_json(json.load(fh)), index=index, cached=True)
+    cached = read_cached(path) if path is not None else None
+    if cached is not None:
+        return replace(cached, index=index, cached=True)
     record = compute_record(index, sample, job)
     if path is not None and record.skipped is None:
-        with atomic_open(path) as fh:
+        with atomic_open(path, sync=False) as fh:
             json.dump(record.to_json(), fh)
     return record
+
+
+def read_cached(path: Path) -> FrameRecord | None:
+    """The record cached at ``path``, or None when there is none or it cannot be read (cut
+    short by a crash, edited by hand...): the frame is then computed again and the entry
+    rewritten."""
+    try:
+        with open(path, encoding="utf-8") as fh:
+            return FrameRecord.from_json(json.load(fh))
+    except (OSError, ValueError, KeyError, TypeError, AttributeError, RecursionError):
+        return None
 
 
 def compute_record(index: int, sample: Sample, job: Job) -> FrameRecord:
@@ -182,11 +195,20 @@ def single_thread() -> None:
 
 def pool_context():
     """The multiprocessing context of every worker pool: workers fork from a clean fork server
-    that preloads the engine, because forking a process whose OpenCV thread pool has started
-    can crash the child."""
+    (forking a process whose OpenCV thread pool has started can crash the child) that has
+    imported the engine and the plugins and initialised numba (:mod:`tsrkit._preload`)."""
     context = multiprocessing.get_context("forkserver")
-    context.set_forkserver_preload(["tsrkit.engine"])
+    context.set_forkserver_preload(["tsrkit.engine", "tsrkit._preload"])
     return context
+
+
+def start_pool_server() -> None:
+    """Start the worker pools' fork server now (if it is not running), so that its imports run
+    on another core while the caller is still starting up, not after the pool is asked for."""
+    from multiprocessing import forkserver
+
+    pool_context()
+    forkserver.ensure_running()
 
 
 def _run_in_worker(index: int, sample: Sample) -> FrameRecord:

@@ -74,7 +74,14 @@ class Pipeline:
             self.tracker.reset()
             self._video = frame.source
         detect = self.tracker is None or self.tracker.needs_detection()
-        candidates = self.detector.detect(frame) if detect else []
+        return self.finish(frame, self.detector.detect(frame) if detect else [], start)
+
+    def finish(
+        self, frame: Frame, candidates: list[Candidate], start: float | None = None
+    ) -> FrameResult:
+        """Verify, track and classify ``candidates`` found on ``frame`` (by the detector, or
+        elsewhere); ``start`` is the :func:`time.perf_counter` time the frame's work began."""
+        start = time.perf_counter() if start is None else start
         if self.verifier is not None and candidates:
             candidates = self.verifier.verify(frame, candidates)
         detections = as_detections(candidates)

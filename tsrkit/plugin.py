@@ -12,10 +12,11 @@ checked value; a plugin-typed parameter (:data:`tsrkit.params.PLUGIN_TYPES`) hol
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar, Protocol, runtime_checkable
 
+from tsrkit.eval.results import MetricResult
 from tsrkit.params import Param
 from tsrkit.records import FrameRecord
 from tsrkit.types import Candidate, Dataset, Detection, Frame, Sample
@@ -159,11 +160,16 @@ class Metric(Plugin):
 
     :meth:`reset` starts an evaluation with its settings (dataset, IoU threshold, which box
     is evaluated, whether false positives count); :meth:`update` folds in one frame's ground
-    truth and record; :meth:`compute` returns report sections, e.g. ``{"iou50": {...}}``.
-    Sections that two metrics share (``iou50``) are merged key by key.
+    truth and record; :meth:`compute` returns a :class:`~tsrkit.eval.results.MetricResult` of
+    the class :attr:`result_type`: the report sections, e.g. ``{"iou50": {...}}``, that know
+    their headline figures, tables and plots, so that every report writer shows them. Sections
+    that two metrics share (``iou50``) are merged key by key.
     """
 
     kind = "metric"
+    #: The class of what :meth:`compute` returns; ``tsrkit report`` rebuilds it from
+    #: ``report.json``. The base class shows every figure of the sections in one table.
+    result_type: ClassVar[type[MetricResult]] = MetricResult
 
     @abstractmethod
     def reset(self, settings: EvalSettings) -> None:
@@ -174,8 +180,9 @@ class Metric(Plugin):
         """Fold in one evaluated frame: ``sample`` is the ground truth, ``record`` the result."""
 
     @abstractmethod
-    def compute(self) -> dict[str, Any]:
-        """The report sections of the frames seen so far."""
+    def compute(self) -> MetricResult | Mapping[str, Any]:
+        """The result of the frames seen so far (a plain mapping is taken as the sections of a
+        :attr:`result_type`)."""
 
 
 class ReportWriter(Plugin):

@@ -16,18 +16,22 @@ from concurrent.futures import ProcessPoolExecutor
 
 from tsrkit.engine import ordered, pool_context, single_thread
 from tsrkit.errors import TsrkitError
+from tsrkit.follow import Follower
 from tsrkit.inputs import Work, iter_frames, plan_work, read_work
 from tsrkit.pipeline import FrameResult, Pipeline
 from tsrkit.types import Frame, Skipped
 
-__all__ = ["CHUNK_FRAMES", "process_frame", "run_pipeline"]
+__all__ = ["CHUNK_FRAMES", "Runner", "chunk_frames", "process_frame", "run_pipeline"]
+
+#: What runs on each frame: a pipeline, or a follower sharing work between video frames.
+Runner = Pipeline | Follower
 
 #: Kept frames of a video per unit of work: long enough that the seek to a chunk's key frame is
 #: a small share of its decoding, short enough to spread a short clip over the workers.
 CHUNK_FRAMES = 64
 
 
-def process_frame(pipeline: Pipeline, frame: Frame) -> FrameResult | Skipped:
+def process_frame(pipeline: Runner, frame: Frame) -> FrameResult | Skipped:
     """The pipeline's result on ``frame``, or the frame skipped with the reason its plugin crashed.
 
     A :class:`~tsrkit.errors.TsrkitError` (a setup problem, such as a mismatched model, that
@@ -43,7 +47,7 @@ def process_frame(pipeline: Pipeline, frame: Frame) -> FrameResult | Skipped:
 
 
 def run_pipeline(
-    pipeline: Pipeline,
+    pipeline: Runner,
     paths: Iterable[str | os.PathLike],
     *,
     every: int = 1,
@@ -55,14 +59,15 @@ def run_pipeline(
 
     Parameters
     ----------
-    pipeline : Pipeline
+    pipeline : Pipeline or Follower
     paths : iterable of path-like
         Images, videos and folders, as :func:`tsrkit.inputs.iter_frames` reads them.
     every, start, end : int
         Video frame selection (see :func:`tsrkit.inputs.iter_frames`).
     workers : int
         Worker processes; 1 runs here. A tracker follows a video frame by frame, so a pipeline
-        with one runs here only.
+        with one runs here only. A follower's chunks are a multiple of its key-frame interval,
+        so that its records do not depend on ``workers``.
     """
     if workers < 1:
         raise TsrkitError(f"workers must be at least 1; got {workers}")
@@ -72,9 +77,9 @@ def run_pipeline(
                 (item, None) if isinstance(item, Skipped) else (process_frame(pipeline, item), item)
             )
         return
-    if pipeline.tracker is not None:
+    if isinstance(pipeline, Pipeline) and pipeline.tracker is not None:
         raise TsrkitError("a tracker follows a video frame by frame: run it with one worker")
-    units = plan_work(paths, every, start, end, chunk=CHUNK_FRAMES)
+    units = plan_work(paths, every, start, end, chunk=chunk_frames(pipeline))
     with ProcessPoolExecutor(
         workers, mp_context=pool_context(), initializer=_init_worker, initargs=(pipeline, every)
     ) as pool:
@@ -88,10 +93,24 @@ def run_pipeline(
                 yield result, None
 
 
-_WORKER: tuple[Pipeline, int] | None = None
+def chunk_frames(pipeline: Runner) -> int:
+    """Kept frames per unit of work: :data:`CHUNK_FRAMES`, rounded down to a multiple of a
+    follower's key-frame interval (each chunk then starts on one of its key frames).
+
+    >>> from tsrkit.pipeline import Pipeline
+    >>> chunk_frames(Follower(Pipeline(None), key_every=5)), chunk_frames(Pipeline(None))
+    (60, 64)
+    """
+    if isinstance(pipeline, Follower):
+        k = pipeline.key_every
+        return max(k, CHUNK_FRAMES // k * k)
+    return CHUNK_FRAMES
 
 
-def _init_worker(pipeline: Pipeline, every: int) -> None:
+_WORKER: tuple[Runner, int] | None = None
+
+
+def _init_worker(pipeline: Runner, every: int) -> None:
     global _WORKER
     _WORKER = (pipeline, every)
     single_thread()

@@ -19,9 +19,13 @@ class CocoFiles(ReportWriter):
     summary = "ground_truth.coco.json and detections.coco.json (class-agnostic, pycocotools)"
 
     def files(self, run: RunResult) -> list[str]:
+        if run.dataset is None:  # a run without ground truth (tsrkit track)
+            return []
         return ["detections.coco.json", "ground_truth.coco.json"]
 
     def write(self, run: RunResult, folder: Path) -> None:
+        if run.dataset is None or run.settings is None:
+            return
         truth, results = coco_run(run.settings.dataset, run.pairs(), run.settings.box)
         if run.dataset.root:
             for image in truth["images"]:

@@ -1,4 +1,5 @@
-"""Report writer ``csv``: the headline figures (``headline.csv``, one row) and one row per
+"""Report writer ``csv``: the headline figures of every result (``headline.csv``, one row, a
+column per figure named by where it is in ``report.json``) and, for a benchmark, one row per
 evaluated frame (``frames.csv``: size, time, lighting, counts, Zheng 5.2.1 recall/precision)."""
 
 from __future__ import annotations
@@ -6,7 +7,7 @@ from __future__ import annotations
 import csv
 from pathlib import Path
 
-from tsrkit.api import HEADLINE, ReportWriter, RunResult, atomic_open, frame_score, hookimpl, title
+from tsrkit.api import ReportWriter, RunResult, atomic_open, frame_score, hookimpl, title
 
 FRAME_COLUMNS = (
     "frame",
@@ -27,17 +28,19 @@ class CsvTables(ReportWriter):
     summary = "headline.csv (the headline figures) and frames.csv (one row per frame)"
 
     def files(self, run: RunResult) -> list[str]:
-        return ["frames.csv", "headline.csv"]
+        return ["frames.csv", "headline.csv"] if run.dataset is not None else ["headline.csv"]
 
     def write(self, run: RunResult, folder: Path) -> None:
-        report = run.report
+        report, figures = run.report, run.headline()
         with atomic_open(folder / "headline.csv") as fh:
             out = csv.writer(fh)
-            out.writerow(["method", "frames", "skipped"] + [f"{s}.{k}" for s, k, _, _ in HEADLINE])
+            out.writerow(["method", "frames", "skipped"] + [f.key for f in figures])
             out.writerow(
-                [title(report), report["frames"], len(report["skipped"])]
-                + [_blank((report.get(s) or {}).get(k)) for s, k, _, _ in HEADLINE]
+                [title(report), report.get("frames"), len(report.get("skipped", []))]
+                + [_blank(f.value) for f in figures]
             )
+        if run.dataset is None or run.settings is None:
+            return
         with atomic_open(folder / "frames.csv") as fh:
             out = csv.writer(fh)
             out.writerow(FRAME_COLUMNS)

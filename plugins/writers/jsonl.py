@@ -14,7 +14,7 @@ class JsonLines(ReportWriter):
     summary = "detections.jsonl: the per-frame records (detect's JSON Lines form)"
 
     def files(self, run: RunResult) -> list[str]:
-        return ["detections.jsonl"]
+        return ["detections.jsonl"] if run.dataset is not None else []
 
     def write(self, run: RunResult, folder: Path) -> None:
         with atomic_open(folder / "detections.jsonl") as fh:

@@ -91,6 +91,7 @@ def test_detect_writes_records_and_reports_skips(example_plugin, mixed_folder, t
         (["--param", "colour=red"], "unknown parameter 'colour'"),
         (["--param", "noequals"], "--param expects key=value"),
         (["--classifier", "nope"], "no classifier called 'nope'"),
+        (["--key-every", "3", "--tracker", "meanshift"], "--key-every and --tracker"),
     ],
 )
 def test_bad_input_is_one_line_exit_2(example_plugin, mixed_folder, args, message):
@@ -159,3 +160,26 @@ def test_setup_error_from_a_plugin_stops_detect_with_one_line(needs_model, mixed
     assert result.exit_code == 2
     assert result.stderr.strip() == "Error: needs-model needs a model: pass --param model=M"
     assert result.stdout == ""
+
+
+def test_agree_drops_a_light_seen_on_one_frame_of_a_video(example_plugin, tmp_path):
+    video = tmp_path / "drive.mp4"
+    writer = cv2.VideoWriter(str(video), cv2.VideoWriter_fourcc(*"mp4v"), 10.0, (64, 48))
+    for t in range(6):
+        image = np.full((48, 64, 3), 30, np.uint8)
+        cv2.circle(image, (14 + t, 20), 4, (40, 40, 255), -1)
+        if t == 2:
+            cv2.circle(image, (48, 30), 4, (40, 40, 255), -1)
+        writer.write(image)
+    writer.release()
+    counts = {}
+    for agree in ("1", "2"):
+        out = tmp_path / f"agree{agree}.jsonl"
+        args = ["detect", str(video), "-d", "brightest-blobs", "-p", "top=2", "-o", str(out)]
+        result = CliRunner().invoke(cli, [*args, "--agree", agree])
+        assert result.exit_code == 0, result.output
+        records = [json.loads(line) for line in out.read_text().splitlines()]
+        assert [r["frame"] for r in records] == list(range(6))
+        counts[agree] = [len(r["detections"]) for r in records]
+    assert counts["1"][2] == 2 and counts["2"][2] == 1
+    assert counts["2"] == [1] * 6

@@ -139,6 +139,11 @@ def test_installed_plugin_benchmarks_real_coco_and_sample(
     error = report["centre_error"]
     assert (error["pairs"] > 0) == (report["per_frame"]["hit_frame_fraction"] > 0)
     assert error["pairs"] == 0 or min(error["mean_px"], error["median_px"]) >= 0
+    # ... and every writer shows the metric's result without knowing it.
+    summary = (out / "summary.md").read_text()
+    assert "| centre px |" in summary and "Centre error" in summary
+    assert "centre_error.mean_px" in (out / "headline.csv").read_text().splitlines()[0]
+    assert ("plots/centre_error.png" in report["plots"]) == (error["pairs"] > 0)
     missed = (out / "missed.csv").read_text().splitlines()
     assert "missed.csv" in report["files"] and missed[0].startswith("frame,source,state")
     assert len(missed) > 1

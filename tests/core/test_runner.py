@@ -127,6 +127,18 @@ def test_cache_is_keyed_by_plugin_parameters(tmp_path):
     assert other["timing"]["frames_computed"] == 4
 
 
+def test_an_unreadable_cache_entry_is_computed_again(tmp_path):
+    data = hand_dataset(3)
+    first = benchmark(data, make(OracleDetector), cache_dir=tmp_path)
+    entries = sorted(tmp_path.glob("*/*.json"))
+    entries[0].write_text('{"source": "cut sho')
+    entries[1].write_text("[]")
+    again = benchmark(data, make(OracleDetector), cache_dir=tmp_path)
+    assert again["timing"]["frames_computed"] == 2 and again["timing"]["frames_cached"] == 1
+    assert without_timing(again) == without_timing(first)
+    assert json.loads(entries[0].read_text())["frame"] in range(3)
+
+
 def test_compare_writes_side_by_side_report_and_paired_test(tmp_path):
     result = compare(
         hand_dataset(12), [make(OracleDetector), make(ShiftedDetector)], out=tmp_path, cache=False

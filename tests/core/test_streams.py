@@ -8,6 +8,7 @@ import pytest
 
 import tsrkit
 from tsrkit.errors import TsrkitError
+from tsrkit.follow import Follower
 from tsrkit.inputs import Work, iter_video, plan_work
 from tsrkit.pipeline import Pipeline
 from tsrkit.streams import CHUNK_FRAMES, run_pipeline
@@ -72,6 +73,15 @@ def test_workers_give_the_serial_records_in_order(video, tmp_path):
     assert records(run_pipeline(pipeline(), [video], workers=2, **stepped)) == records(
         run_pipeline(pipeline(), [video], **stepped)
     )
+
+
+def test_a_follower_gives_the_same_records_whatever_the_workers(video):
+    """Chunks of 60 frames (a multiple of 5) start on key frames: each run of frames after a
+    key frame is processed the same way in one process or in two."""
+    follower = Follower(Pipeline(tsrkit.detector("conspicuity")), key_every=5)
+    serial = records(run_pipeline(follower, [video]))
+    assert records(run_pipeline(follower, [video], workers=2)) == serial
+    assert len(serial) == 150
 
 
 def test_a_tracker_needs_one_worker(video):

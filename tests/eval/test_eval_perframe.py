@@ -95,14 +95,16 @@ def test_large_radii_share_bins_so_full_resolution_sets_give_a_handful_of_rows()
 def test_bubble_figure_stays_compact_whatever_the_radii(tmp_path):
     from PIL import Image
 
-    from tsrkit_plugins.writers.plots import bubble_plot
+    from tsrkit.eval.categories import CategoriesResult
 
     frames = [
         score_frame([(r, r)], [(0, 0, 2 * r, 2 * r)], light)
         for r in range(2, 120)
         for light in ("day", "dusk", "night")
     ]
-    bubble_plot(category_table(frames), tmp_path / "b.png")
+    plots = CategoriesResult({"categories": category_table(frames)}).plots()
+    (bubbles,) = [p for p in plots if p.name == "recall_fpr_bubbles.png"]
+    (tmp_path / "b.png").write_bytes(bubbles.png())
     width, height = Image.open(tmp_path / "b.png").size
     # 15 radius bins x 3 lightings: one axes, not 354 panels (the old layout: 1320 x 29000 px)
     assert width <= 1800 and height <= 500

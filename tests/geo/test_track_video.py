@@ -54,8 +54,16 @@ def test_a_rendered_drive_is_recovered_and_resumes(drive, tmp_path):
     assert temporal["true_tracks"] >= 1
     assert temporal["detected_accuracy"] >= 0.95 and temporal["temporal_accuracy"] >= 0.9
     assert report["clip_frames"] < report["frames"]  # only the clip was decoded
-    assert (out / "vicinity.png").is_file() and (out / "plots" / "traversal_000.png").is_file()
-    assert "| 0 | 0 | through |" in (out / "report.md").read_text()
+    # The report writers of a benchmark write the track run too: plots, summary, HTML, CSV.
+    assert report["plots"] == ["plots/vicinity.png", "plots/traversal_000.png"]
+    assert all((out / name).read_bytes().startswith(b"\x89PNG") for name in report["plots"])
+    assert {"report.json", "summary.md", "report.html", "headline.csv"} <= set(report["files"])
+    assert "| 0 | 0 | through |" in (out / "summary.md").read_text()
+    page = (out / "report.html").read_text()
+    assert 'id="traversals"' in page and "Zheng Figure 3-13" in page
+    assert f"{temporal['temporal_accuracy']:.3f}" in page
+    headline = (out / "headline.csv").read_text().splitlines()
+    assert headline[0].endswith("traversals,temporal.temporal_accuracy,temporal.detected_accuracy")
     again = CliRunner().invoke(cli, args)
     assert again.exit_code == 0, again.output
     resumed = json.loads((out / "report.json").read_text())

@@ -162,6 +162,15 @@ def _run_kwargs(
     }
 
 
+def start_pool_early(workers: int | None, engine: str) -> None:
+    """Start the worker pools' fork server before the plugins and the dataset are loaded, when
+    the run will use a pool (:func:`tsrkit.engine.start_pool_server`)."""
+    if engine == "local" and (workers or os.cpu_count() or 1) > 1:
+        from tsrkit.engine import start_pool_server
+
+        start_pool_server()
+
+
 def default_writers() -> list[str]:
     """The report writers that run when ``--writer`` is not given."""
     from tsrkit.registry import get_registry
@@ -210,6 +219,7 @@ def benchmark_command(
     """
     from tsrkit.benchmarking import benchmark
 
+    start_pool_early(workers, engine)
     chosen = build(detector, verifier, classifier, None, params, config, classifier_alone=True)
     dataset = load_dataset(dataset_ref, format_name, images, split)
     report = benchmark(
@@ -319,6 +329,7 @@ def compare_command(
       tsrkit compare --config recommended --without-verifier --html -o out/verifier
       tsrkit compare -p conspicuity.weights=1,1,2 -p gray-tophat.h_peak=0.8
     """
+    start_pool_early(workers, engine)
     run_compare(
         dataset_ref,
         format_name,

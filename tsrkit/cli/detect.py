@@ -14,21 +14,23 @@ import click
 import cv2
 from rich.console import Console
 
+from tsrkit.agreement import Agreement
 from tsrkit.atomic import atomic_open, json_line
 from tsrkit.cli.common import plugin_options
+from tsrkit.cli.errors import UserError
 from tsrkit.draw import draw_detections
 from tsrkit.errors import TsrkitError
-from tsrkit.pipeline import Pipeline
+from tsrkit.follow import Follower
 from tsrkit.report import ProgressBar
 from tsrkit.selection import build
-from tsrkit.streams import run_pipeline
+from tsrkit.streams import Runner, run_pipeline
 from tsrkit.types import Frame, Skipped
 
 __all__ = ["default_inputs", "detect_command", "flushed_output", "run_detect"]
 
 
 def run_detect(
-    pipeline: Pipeline,
+    pipeline: Runner,
     paths,
     out,
     draw: Path | None = None,
@@ -37,6 +39,7 @@ def run_detect(
     end: int | None = None,
     workers: int = 1,
     progress: bool = False,
+    agree: int = 1,
 ) -> tuple[int, int, list[Skipped]]:
     """Write one JSON Lines record per frame to the text stream ``out``, in input order.
 
@@ -44,7 +47,8 @@ def run_detect(
     :class:`TsrkitError` from a plugin (a setup problem such as a mismatched model) stops it.
     ``workers`` > 1 runs the pipeline in worker processes (:func:`tsrkit.streams.run_pipeline`);
     overlays (``draw``) need the frames here, so they need one worker. ``progress`` shows a
-    progress bar (frames done, frames/s) on stderr.
+    progress bar (frames done, frames/s) on stderr. ``agree`` > 1 keeps only the detections
+    whose light is found on that many consecutive frames (:class:`tsrkit.agreement.Agreement`).
 
     Returns
     -------
@@ -55,6 +59,8 @@ def run_detect(
     frames = detections = 0
     skipped: list[Skipped] = []
     stream = run_pipeline(pipeline, paths, every=every, start=start, end=end, workers=workers)
+    if agree > 1:
+        stream = Agreement(agree).filter(stream)
     with ProgressBar(None, progress, "detect") as bar:  # type: ignore[arg-type]
         for result, frame in bar.track(stream):
             if isinstance(result, Skipped):
@@ -132,6 +138,23 @@ def default_inputs() -> list[str]:
     help="Worker processes; each decodes its own images or 64-frame video chunks.",
 )
 @click.option(
+    "--key-every",
+    type=click.IntRange(min=1),
+    default=1,
+    show_default=True,
+    help="Videos: the whole pipeline on every K-th kept frame only; in between, only around "
+    "the lights of the frame before (a light appearing meanwhile is found at most K-1 frames "
+    "late). 1: the whole pipeline on every frame.",
+)
+@click.option(
+    "--agree",
+    type=click.IntRange(min=1),
+    default=1,
+    show_default=True,
+    help="Videos: report a detection only when its light is found on at least N consecutive "
+    "frames (from its first frame on; the output lags up to N-1 frames). 1: every detection.",
+)
+@click.option(
     "--quiet",
     "-q",
     is_flag=True,
@@ -151,6 +174,8 @@ def detect_command(
     start,
     end,
     workers,
+    key_every,
+    agree,
     quiet,
 ) -> None:
     """Detect lit signal lenses in images, folders (recursive) or videos.
@@ -165,8 +190,12 @@ def detect_command(
       tsrkit detect drive.mp4 -d lab-frst -c ab-hist -t meanshift --every 2 -o drive.jsonl
       tsrkit detect frames/ --config recommended --draw overlays/ -q
       tsrkit detect frames/ -d conspicuity -p weights=1,1,2 -w 2 -o d.jsonl
+      tsrkit detect drive.mp4 --config recommended --agree 3 -w 2 -o drive.jsonl
     """
     pipeline = build(detector, verifier, classifier, tracker, params, config).pipeline()
+    if key_every > 1 and pipeline.tracker is not None:
+        raise UserError("--key-every and --tracker both carry lights between frames: choose one")
+    runner = Follower(pipeline, key_every) if key_every > 1 else pipeline
     inputs = list(paths) or default_inputs()
     draw_dir = Path(draw) if draw else None
     if draw_dir is not None:
@@ -175,7 +204,7 @@ def detect_command(
     progress = not quiet and Console(stderr=True).is_terminal  # no bar in redirected logs
     with sink as stream:
         frames, found, skipped = run_detect(
-            pipeline, inputs, stream, draw_dir, every, start, end, workers, progress
+            runner, inputs, stream, draw_dir, every, start, end, workers, progress, agree
         )
     console = Console(stderr=True, soft_wrap=True)  # one line per skipped input, never wrapped
     console.print(

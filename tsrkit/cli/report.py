@@ -33,17 +33,33 @@ def report_command(run_dir, writers) -> None:
       tsrkit report tsrkit-out                 # a compare folder: compare.html
       tsrkit report runs/kr --writer markdown --writer html
     """
+    from tsrkit.eval.guard import Failure
     from tsrkit.registry import get_registry
-    from tsrkit.report import load_run
+    from tsrkit.runfolder import load_run, read_comparison
 
     folder = Path(run_dir)
     chosen = [get_registry().create("writer", name) for name in writers]
-    if (folder / "compare.json").is_file():
-        written = [name for writer in chosen for name in writer.write_comparison(folder)]
+    failures: list[Failure] = []
+    written: list[str] = []
+    if (folder / "compare.json").exists():
+        read_comparison(folder)  # one clear line when it is not a compare.json
+        for writer in chosen:
+            try:
+                written += writer.write_comparison(folder)
+            except Exception as exc:
+                failures.append(Failure.of(f"writer '{writer.name}'", exc))
     else:
         run = load_run(folder)
         for writer in chosen:
-            writer.write(run, folder)
-        written = [name for writer in chosen for name in writer.files(run)]
+            try:
+                writer.write(run, folder)
+                written += writer.files(run)
+            except Exception as exc:
+                failures.append(Failure.of(f"writer '{writer.name}'", exc))
+        failures = [*run.failures, *failures]
     for name in written:
         click.echo(f"-> {folder / name}")
+    for failure in failures:
+        click.echo(f"error: {failure.note}", err=True)
+    if failures:
+        raise SystemExit(1)

@@ -15,7 +15,7 @@ from rich.table import Table
 from tsrkit.atomic import atomic_open
 from tsrkit.cli.common import plugin_options
 
-__all__ = ["ACCURACY_NOTE", "track_command"]
+__all__ = ["track_command"]
 
 
 def _utc(seconds: float) -> str:
@@ -222,8 +222,8 @@ def _track_video(
     from tsrkit.report import ProgressBar, versions
     from tsrkit.selection import build
     from tsrkit.spatiotemporal.evaluate import evaluate_traversal, read_truth, temporal_section
-    from tsrkit.spatiotemporal.plots import timeline_plot, vicinity_plot
     from tsrkit.spatiotemporal.ranges import frame_profile, frame_traversals
+    from tsrkit.spatiotemporal.results import write_track_run
     from tsrkit.spatiotemporal.run import identity, track_video, video_facts
 
     selection = build(*plugins)
@@ -261,10 +261,6 @@ def _track_video(
         )
         if out is not None:
             _write_jsonl(out / "traversals.jsonl", records)
-            frames, distance = frame_profile(track, signals, start, fps, count)
-            vicinity_plot(frames, distance, settings.vicinity, records, out / "vicinity.png")
-            for record in records:
-                timeline_plot(record, out / "plots" / f"traversal_{record['traversal']:03d}.png")
             report = {
                 "video": str(video),
                 "gps": track.source,
@@ -272,6 +268,7 @@ def _track_video(
                 "frames": count,
                 "fps": fps,
                 "clip_frames": total,
+                "traversals": len(records),
                 **json.loads(identity(selection, settings)),
                 "timing": {
                     "seconds": round(elapsed, 3),
@@ -283,84 +280,27 @@ def _track_video(
             }
             if evaluations is not None:
                 report["temporal"] = temporal_section(evaluations)
-            with atomic_open(out / "report.json") as fh:
-                json.dump(report, fh, indent=1)
-            with atomic_open(out / "report.md") as fh:
-                fh.write(_markdown(report, records, evaluations))
+            profile = frame_profile(track, signals, start, fps, count)
+            written = write_track_run(out, report, records, profile, settings.vicinity).report
     _print_traversals(console, records, evaluations, count, total, elapsed)
     if out is not None:
-        console.print(f"-> {out}/traversals.jsonl, report.json, report.md, vicinity.png, plots/")
-
-
-def _summary_rows(records, evaluations) -> tuple[list[str], list[list[str]]]:
-    """The per-traversal summary: columns and rows (terminal table and report.md)."""
-    columns = ["#", "node", "movement", "anchor", "short range", "tracks"]
-    if evaluations is not None:
-        columns += ["true", "acc."]
-    rows = []
-    for k, record in enumerate(records):
-        row = [
-            str(record["traversal"]),
-            str(record["intersection"]),
-            record["movement"],
-            str(record["anchor_frame"]),
-            "{}-{}".format(*record["short_range"]),
-            str(len(record["tracks"])),
-        ]
-        if evaluations is not None:
-            e = evaluations[k]
-            row += [
-                str(e["true_tracks"]),
-                f"{_ratio(e['temporal_accuracy'])} / {_ratio(e['detected_accuracy'])}",
-            ]
-        rows.append(row)
-    return columns, rows
-
-
-ACCURACY_NOTE = (
-    "acc.: temporal accuracy of the true tracks (Zheng 5.4), all candidates / detected ones"
-)
+        for note in written.get("notes", []):
+            console.print(f"note: {note}", markup=False)
+        shown = ", ".join(["traversals.jsonl", *written["files"]])
+        console.print(f"-> {out}: {shown}, plots/", markup=False)
 
 
 def _print_traversals(console, records, evaluations, frames, clip_frames, elapsed) -> None:
+    from tsrkit.spatiotemporal.results import ACCURACY_NOTE, summary_rows
+
     table = Table(
         title=f"{len(records)} traversals; {clip_frames} of {frames} frames decoded "
         f"({elapsed:.1f} s)",
         caption=ACCURACY_NOTE if evaluations is not None else None,
     )
-    columns, rows = _summary_rows(records, evaluations)
+    columns, rows = summary_rows(records, evaluations)
     for column in columns:
         table.add_column(column, no_wrap=True)
     for row in rows:
         table.add_row(*row)
     console.print(table)
-
-
-def _markdown(report: dict, records, evaluations) -> str:
-    """``report.md``: the run in a few lines and the per-traversal table."""
-    from tsrkit.report import markdown_table
-
-    timing = report["timing"]
-    lines = [
-        f"# tsrkit track: {report['video']}",
-        "",
-        f"{len(records)} traversals; {report['clip_frames']} of {report['frames']} frames "
-        f"decoded; {timing['seconds']} s ({timing['video_frames_per_second']} video frames/s).",
-        "",
-        markdown_table(*_summary_rows(records, evaluations)),
-    ]
-    if evaluations is not None:
-        temporal = report["temporal"]
-        lines += [
-            "",
-            ACCURACY_NOTE + ".",
-            f"Pooled: {_ratio(temporal['temporal_accuracy'])} over {temporal['candidates']} "
-            f"candidates, {_ratio(temporal['detected_accuracy'])} over {temporal['detected']} "
-            f"detected; {temporal['true_tracks']} true and {temporal['false_tracks']} false "
-            "tracks.",
-        ]
-    return "\n".join(lines) + "\n"
-
-
-def _ratio(value: float | None) -> str:
-    return "-" if value is None else f"{value:.3f}"

@@ -49,7 +49,8 @@ def open_dataset(
     -------
     Dataset
         ``info`` carries the registry entry (licence, citation, ``box``, ``task``...) when
-        opened by name.
+        opened by name, and ``opened_as``: the arguments that open it again (the path made
+        absolute), which ``tsrkit report`` uses.
 
     Raises
     ------
@@ -60,6 +61,12 @@ def open_dataset(
     """
     images = Path(images) if images is not None else None
     entry = _registry_entry(ref)
+    opened_as = {
+        "ref": str(ref) if entry is not None or str(ref) == SAMPLE else str(Path(ref).resolve()),
+        "format": format,
+        "images": str(images.resolve()) if images is not None else None,
+        "states": dict(states) if states else None,
+    }
     if entry is None:
         path = _sample_path() if str(ref) == SAMPLE else Path(ref)
         dataset = read_dataset(path, format or detect_format(path), images)
@@ -71,6 +78,7 @@ def open_dataset(
             dataset, name=entry.name, info={**dataset.info, **entry.to_info()}
         )
         states = {**entry.states, **(states or {})}
+    dataset = dataclasses.replace(dataset, info={**dataset.info, "opened_as": opened_as})
     return relabel(dataset, check_mapping(states, "states")) if states else dataset
 
 

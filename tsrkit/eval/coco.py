@@ -11,15 +11,30 @@ from __future__ import annotations
 import contextlib
 import io
 from collections.abc import Iterable, Mapping
-from typing import Any
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, ClassVar
 
+from tsrkit.eval.results import Figure, MetricResult, Plot
 from tsrkit.eval.settings import EvalSettings
 from tsrkit.geometry import xyxy_to_xywh
 from tsrkit.plugin import Metric
 from tsrkit.records import FrameRecord
 from tsrkit.types import Sample
 
-__all__ = ["CATEGORY", "CocoAP", "coco_ap", "coco_dataset", "coco_frame", "coco_run"]
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure as MplFigure
+
+__all__ = [
+    "ABOUT",
+    "CATEGORY",
+    "CocoAP",
+    "CocoResult",
+    "coco_ap",
+    "coco_dataset",
+    "coco_frame",
+    "coco_run",
+    "draw_pr_curve",
+]
 
 CATEGORY = {"id": 1, "name": "traffic_light", "supercategory": "traffic_signal"}
 
@@ -121,6 +136,56 @@ def coco_ap(ground_truth: Mapping[str, Any], results: list[dict[str, Any]]) -> d
     return {"ap50": float(evaluator.stats[1]), "ap": float(evaluator.stats[0]), "curve": curve}
 
 
+def draw_pr_curve(figure: MplFigure, curve: Mapping[str, list] | None, ap: float | None) -> None:
+    """COCOeval's interpolated precision-recall curve at IoU 0.5 (``curve`` of :func:`coco_ap`)."""
+    ax = figure.subplots()
+    if curve:
+        precision = [max(p, 0.0) for p in curve["precision"]]
+        ax.plot(curve["recall"], precision, label="interpolated precision (101 recall points)")
+        ax.legend(fontsize=8, loc="lower left")
+    ax.set_xlabel("recall")
+    ax.set_ylabel("precision")
+    ax.set_xlim(0, 1)
+    ax.set_ylim(0, 1.02)
+    ax.set_title(f"IoU 0.5, AP = {ap:.3f}" if ap is not None else "IoU 0.5")
+
+
+#: What the two AP figures are.
+ABOUT = "pycocotools AP at IoU 0.5 and 0.5:0.95"
+
+
+@dataclass(frozen=True)
+class CocoResult(MetricResult):
+    """``iou50.ap``, ``iou50.ap_50_95`` and ``iou50.pr_curve``: two headline figures and the
+    precision-recall curve (detection runs only)."""
+
+    order: ClassVar[int] = 30
+
+    def headline(self) -> list[Figure]:
+        iou50 = self.sections.get("iou50") or {}
+        return [
+            Figure("iou50.ap", "AP50", iou50.get("ap"), about=ABOUT),
+            Figure("iou50.ap_50_95", "AP", iou50.get("ap_50_95"), about=ABOUT),
+        ]
+
+    def tables(self) -> list:
+        return []
+
+    def plots(self) -> list[Plot]:
+        iou50 = self.sections.get("iou50") or {}
+        if "ap" not in iou50:
+            return []
+        return [
+            Plot(
+                "pr_curve.png",
+                "Precision against recall at IoU 0.5, class-agnostic (pycocotools' interpolated "
+                "curve; AP50 is the mean precision over its 101 recall points).",
+                lambda figure: draw_pr_curve(figure, iou50.get("pr_curve"), iou50["ap"]),
+                (4.0, 4.0),
+            )
+        ]
+
+
 class CocoAP(Metric):
     """``iou50.ap``, ``iou50.ap_50_95`` and ``iou50.pr_curve``: pycocotools on the evaluated box."""
 
@@ -140,12 +205,16 @@ class CocoAP(Metric):
         self.annotations += anns
         self.results += dets
 
-    def compute(self) -> dict:
+    result_type = CocoResult
+
+    def compute(self) -> CocoResult:
         if not self.settings.detection:
-            return {}
+            return CocoResult({})
         ap = coco_ap(
             coco_dataset(self.images, self.annotations, self.settings.dataset), self.results
         )
         if not self.settings.exhaustive:
             ap = {"ap50": None, "ap": None, "curve": None}
-        return {"iou50": {"ap": ap["ap50"], "ap_50_95": ap["ap"], "pr_curve": ap["curve"]}}
+        return CocoResult(
+            {"iou50": {"ap": ap["ap50"], "ap_50_95": ap["ap"], "pr_curve": ap["curve"]}}
+        )

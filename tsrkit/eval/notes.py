@@ -3,13 +3,26 @@
 from __future__ import annotations
 
 from collections import Counter
+from dataclasses import dataclass
+from typing import ClassVar
 
+from tsrkit.eval.results import MetricResult, Table
 from tsrkit.eval.settings import EvalSettings
 from tsrkit.plugin import Metric
 from tsrkit.records import FrameRecord
 from tsrkit.types import Sample
 
-__all__ = ["FrameNotes"]
+__all__ = ["FrameNotes", "FrameNotesResult"]
+
+
+@dataclass(frozen=True)
+class FrameNotesResult(MetricResult):
+    """``frame_notes``: shown as the report's notes (``N of M frames: note``), not again here."""
+
+    order: ClassVar[int] = 60
+
+    def tables(self) -> list[Table]:
+        return []
 
 
 class FrameNotes(Metric):
@@ -28,7 +41,10 @@ class FrameNotes(Metric):
         self.frames += 1
         self.counts.update(set(record.notes))
 
-    def compute(self) -> dict:
+    result_type = FrameNotesResult
+
+    def compute(self) -> FrameNotesResult:
         if not self.counts:
-            return {}
-        return {"frame_notes": {"frames": self.frames, "counts": dict(sorted(self.counts.items()))}}
+            return FrameNotesResult({})
+        counts = dict(sorted(self.counts.items()))
+        return FrameNotesResult({"frame_notes": {"frames": self.frames, "counts": counts}})

@@ -10,17 +10,27 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any, ClassVar
 
 import numpy as np
 
 from tsrkit.eval.matching import greedy_match
+from tsrkit.eval.results import MetricResult, Table, fmt
 from tsrkit.eval.settings import NOT_DETECTION, EvalSettings
 from tsrkit.geometry import box_areas, intersection_matrix, iou_matrix
 from tsrkit.plugin import Metric
 from tsrkit.records import FrameRecord
 from tsrkit.types import Sample
 
-__all__ = ["OverlapPR", "OverlapScore", "match_by_iou", "score_overlap", "summarise_overlap"]
+__all__ = [
+    "COLUMNS",
+    "OverlapPR",
+    "OverlapResult",
+    "OverlapScore",
+    "match_by_iou",
+    "score_overlap",
+    "summarise_overlap",
+]
 
 
 @dataclass(frozen=True)
@@ -70,6 +80,53 @@ def summarise_overlap(scores: Sequence[OverlapScore], threshold: float) -> dict:
     }
 
 
+#: The columns of the overlap table: (key of a section, column label).
+COLUMNS = (
+    ("threshold", "IoU above"),
+    ("precision", "precision"),
+    ("recall", "recall"),
+    ("true_positives", "true positives"),
+    ("detections", "detections"),
+    ("ground_truth", "ground truth"),
+    ("area_precision", "area precision"),
+    ("area_recall", "area recall"),
+)
+
+
+@dataclass(frozen=True)
+class OverlapResult(MetricResult):
+    """``iou50`` and ``iou``: one table row per threshold (``iou`` only when its threshold is
+    not 0.5)."""
+
+    order: ClassVar[int] = 20
+
+    def _sections(self) -> list[dict[str, Any]]:
+        at50, other = self.sections.get("iou50") or {}, self.sections.get("iou") or {}
+        rows = [at50] + ([other] if other.get("threshold", 0.5) != 0.5 else [])
+        return [row for row in rows if "note" not in row and "threshold" in row]
+
+    def remarks(self) -> list[str]:
+        note = (self.sections.get("iou50") or {}).get("note")
+        return [note] if note else []
+
+    def tables(self) -> list[Table]:
+        rows = self._sections()
+        if not rows:
+            return []
+        return [
+            Table(
+                "iou",
+                "Overlap matching (Lee 2017, 3.6.2)",
+                tuple(label for _, label in COLUMNS),
+                tuple(tuple(fmt(row.get(key)) for key, _ in COLUMNS) for row in rows),
+                "A detection's evaluated box matches a ground-truth box of its frame when their "
+                "IoU exceeds the threshold, each box at most once, best score first. Area "
+                "precision (recall): the overlap over the detection's (ground truth's) area, "
+                "averaged over the matched pairs.",
+            )
+        ]
+
+
 class OverlapPR(Metric):
     """``iou50`` and ``iou``: Lee 3.6.2's overlap precision and recall at IoU 0.5 and ``--iou``.
 
@@ -92,13 +149,15 @@ class OverlapPR(Metric):
         self.at50.append(score_overlap(boxes, scores, truth, 0.5))
         self.at_threshold.append(score_overlap(boxes, scores, truth, self.settings.iou_threshold))
 
-    def compute(self) -> dict:
+    result_type = OverlapResult
+
+    def compute(self) -> OverlapResult:
         if not self.settings.detection:
-            return {"iou50": NOT_DETECTION, "iou": NOT_DETECTION}
+            return OverlapResult({"iou50": NOT_DETECTION, "iou": NOT_DETECTION})
         out = {
             "iou50": summarise_overlap(self.at50, 0.5),
             "iou": summarise_overlap(self.at_threshold, self.settings.iou_threshold),
         }
         for section in out.values():
             section["precision"] = self.settings.false_positive_figure(section["precision"])
-        return out
+        return OverlapResult(out)

@@ -16,11 +16,12 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
 from tsrkit.eval.matching import centre_hits
+from tsrkit.eval.results import Figure, MetricResult
 from tsrkit.eval.settings import NOT_DETECTION, EvalSettings
 from tsrkit.eval.stats import bootstrap_interval
 from tsrkit.plugin import Metric
@@ -28,8 +29,10 @@ from tsrkit.records import FrameRecord
 from tsrkit.types import Sample
 
 __all__ = [
+    "FIGURES",
     "FrameScore",
     "FrameScoreMetric",
+    "PerFrameResult",
     "ZhengPerFrame",
     "frame_score",
     "headline_intervals",
@@ -140,6 +143,53 @@ def headline_intervals(scores: Sequence[FrameScore]) -> dict[str, list[float] | 
     }
 
 
+#: The per-frame headline figures: (key of ``per_frame``, label).
+FIGURES = (
+    ("recall_mean", "recall"),
+    ("precision_mean", "prec."),
+    ("hit_frame_fraction", "hit"),
+)
+
+
+@dataclass(frozen=True)
+class PerFrameResult(MetricResult):
+    """``per_frame`` and ``intervals``: three headline figures with their bootstrap intervals,
+    and what happened on the frames without ground truth."""
+
+    order: ClassVar[int] = 10
+
+    def headline(self) -> list[Figure]:
+        figures = self.sections.get("per_frame") or {}
+        intervals = self.sections.get("intervals") or {}
+        return [
+            Figure(
+                f"per_frame.{key}",
+                label,
+                figures.get(key),
+                interval=_pair(intervals.get(key)),
+                about="Zheng 5.2.1 per-frame means",
+            )
+            for key, label in FIGURES
+        ]
+
+    def remarks(self) -> list[str]:
+        figures = self.sections.get("per_frame") or {}
+        if "note" in figures:
+            return [figures["note"]]
+        return [
+            f"Frames without ground truth: {figures['frames_without_gt']} "
+            f"({figures['false_positives_without_gt']} false positives on "
+            f"{figures['frames_without_gt_with_detections']} of them)."
+        ]
+
+    def tables(self) -> list:
+        return []
+
+
+def _pair(interval: Sequence[float] | None) -> tuple[float, float] | None:
+    return (interval[0], interval[1]) if interval else None
+
+
 class FrameScoreMetric(Metric):
     """A metric computed from every frame's :class:`FrameScore` (kept in ``self.scores``)."""
 
@@ -162,13 +212,15 @@ class ZhengPerFrame(FrameScoreMetric):
     summary = "per-frame recall, precision and hit-frame fraction (centre in enclosing circle)"
     section = "Zheng 2016, 5.2.1"
 
-    def compute(self) -> dict:
+    result_type = PerFrameResult
+
+    def compute(self) -> PerFrameResult:
         if not self.settings.detection:
-            return {"per_frame": NOT_DETECTION, "intervals": {}}
+            return PerFrameResult({"per_frame": NOT_DETECTION, "intervals": {}})
         summary: dict[str, Any] = summarise(self.scores)
         intervals: dict[str, Any] = headline_intervals(self.scores)
         for figures in (summary, intervals):
             figures["precision_mean"] = self.settings.false_positive_figure(
                 figures["precision_mean"]
             )
-        return {"per_frame": summary, "intervals": intervals}
+        return PerFrameResult({"per_frame": summary, "intervals": intervals})

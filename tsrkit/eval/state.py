@@ -9,19 +9,27 @@ from __future__ import annotations
 
 from collections import Counter
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
 from tsrkit.eval.matching import centre_hits, greedy_match
+from tsrkit.eval.results import Figure, MetricResult, Plot, Table, fmt
 from tsrkit.eval.settings import EvalSettings
 from tsrkit.plugin import Metric
 from tsrkit.records import FrameRecord
 from tsrkit.types import STATES, Sample
 
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure as MplFigure
+
 __all__ = [
     "RATIO_EDGES",
     "StateMetric",
+    "StateResult",
     "discriminative_ratio",
+    "draw_confusion",
     "label_order",
     "per_class",
     "ratio_figures",
@@ -168,6 +176,103 @@ def ratio_figures(
     return {"mean": float(ratios_a.mean()), "bins": bins}
 
 
+def draw_confusion(
+    figure: MplFigure, labels: Sequence[str], matrix: Sequence[Sequence[int]]
+) -> None:
+    """A confusion matrix (rows: ground truth, columns: predicted), counts annotated."""
+    ax = figure.subplots()
+    image = ax.imshow(matrix, cmap="Blues")
+    for i, row in enumerate(matrix):
+        for j, count in enumerate(row):
+            ax.text(j, i, str(count), ha="center", va="center", fontsize=8)
+    ax.set_xticks(range(len(labels)), labels, rotation=45, ha="right")
+    ax.set_yticks(range(len(labels)), labels)
+    ax.set_xlabel("predicted")
+    ax.set_ylabel("ground truth")
+    figure.colorbar(image, ax=ax, label="matched detections", shrink=0.8)
+
+
+@dataclass(frozen=True)
+class StateResult(MetricResult):
+    """``state``: the accuracy as a headline figure, the confusion and per-class tables, the R-Y
+    errors and discriminative ratio as a remark, and the confusion plot."""
+
+    order: ClassVar[int] = 40
+
+    @property
+    def state(self) -> Mapping[str, Any]:
+        return self.sections.get("state") or {}
+
+    def _shown(self) -> bool:
+        return bool(self.state.get("pairs")) and "note" not in self.state
+
+    def headline(self) -> list[Figure]:
+        return [
+            Figure(
+                "state.accuracy",
+                "state",
+                self.state.get("accuracy"),
+                about="state accuracy of the matched detections",
+            )
+        ]
+
+    def remarks(self) -> list[str]:
+        if "note" in self.state:
+            return [self.state["note"]]
+        if not self._shown():
+            return []
+        ry = self.state["red_yellow_errors"]
+        ratio = (
+            "mean discriminative ratio (Zheng 5.3): "
+            f"{fmt(self.state['discriminative_ratio']['mean'])}."
+        )
+        if not ry:  # sign classes: no red/yellow pair
+            return [ratio[0].upper() + ratio[1:]]
+        return [
+            f"R-Y errors (Mascetti 5.1): {ry['total']} ({ry['red_as_yellow']} red as yellow, "
+            f"{ry['yellow_as_red']} yellow as red); {ratio}"
+        ]
+
+    def tables(self) -> list[Table]:
+        if not self._shown():
+            return []
+        labels, matrix = self.state["confusion"]["labels"], self.state["confusion"]["matrix"]
+        per_class = self.state["per_class"]
+        return [
+            Table(
+                "confusion",
+                "States of matched detections: confusion",
+                ("truth \\ predicted", *labels),
+                tuple((label, *map(str, row)) for label, row in zip(labels, matrix)),
+                "Rows: the ground-truth state; columns: the predicted state; each matched "
+                "detection (centre in a box's enclosing circle, one per box) counts once.",
+            ),
+            Table(
+                "per-class",
+                "States of matched detections: per class",
+                ("state", "precision", "recall", "support"),
+                tuple(
+                    (name, fmt(c["precision"]), fmt(c["recall"]), str(c["support"]))
+                    for name, c in per_class.items()
+                ),
+            ),
+        ]
+
+    def plots(self) -> list[Plot]:
+        if not self._shown():
+            return []
+        labels, matrix = self.state["confusion"]["labels"], self.state["confusion"]["matrix"]
+        return [
+            Plot(
+                "confusion.png",
+                "State confusion of the matched detections: ground truth down, prediction "
+                "across; the diagonal is right.",
+                lambda figure: draw_confusion(figure, labels, matrix),
+                (5.0, 4.0),
+            )
+        ]
+
+
 class StateMetric(Metric):
     """``state``: the states of detections matched to ground truth by Zheng's centre rule.
 
@@ -193,12 +298,16 @@ class StateMetric(Metric):
             self.predicted.append(dets[i].state)
             self.scores.append(dets[i].state_scores)
 
-    def compute(self) -> dict:
+    result_type = StateResult
+
+    def compute(self) -> StateResult:
         if all(p == "unknown" for p in self.predicted):
-            return {
-                "state": {
-                    **state_metrics([], []),
-                    "note": "the method predicts no state (every detection is 'unknown')",
+            return StateResult(
+                {
+                    "state": {
+                        **state_metrics([], []),
+                        "note": "the method predicts no state (every detection is 'unknown')",
+                    }
                 }
-            }
-        return {"state": state_metrics(self.truth, self.predicted, self.scores)}
+            )
+        return StateResult({"state": state_metrics(self.truth, self.predicted, self.scores)})

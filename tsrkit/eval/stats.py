@@ -11,7 +11,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-__all__ = ["ALPHA", "bootstrap_interval", "paired_test"]
+__all__ = ["ALPHA", "bootstrap_interval", "format_p", "paired_test"]
 
 ALPHA = 0.05
 
@@ -42,6 +42,19 @@ def bootstrap_interval(
         random_state=seed,
     )
     return [float(result.confidence_interval.low), float(result.confidence_interval.high)]
+
+
+def format_p(p_value: float | None) -> str:
+    """A p-value for a reader: three decimals, or two significant digits below 0.001.
+
+    Examples
+    --------
+    >>> format_p(0.0421), format_p(7.430843875383497e-14), format_p(1.0), format_p(None)
+    ('0.042', '7.4e-14', '1.000', '-')
+    """
+    if p_value is None:
+        return "-"
+    return f"{p_value:.1e}" if p_value < 0.001 else f"{p_value:.3f}"
 
 
 def paired_test(

@@ -1,38 +1,21 @@
 """Report writer ``html``: ``report.html``, one self-contained offline page of a run.
 
-The headline figures, the Zheng Table 5-2 breakdown (lighting x max target radius), the state
-confusion and per-class tables, the plots and a gallery of the run's worst frames with overlays
-(ground truth in green, detections whose centre is in a box in blue, false positives in red,
-misses marked): inline CSS and JavaScript (every table sorts by a click on its header and
-filters by the text box above it), images embedded as data URIs, nothing fetched.
+Every result of the run, rendered generically: the notes, the headline figures with their 95 %
+intervals, each result's remarks and tables (the run's dataset, split, plugins, parameters and
+versions first), the plots with their captions, and for a benchmark a gallery of the worst
+frames with enlarged crops around each light that went wrong. Inline CSS and JavaScript (every
+table sorts by a click on its header and filters by the text box above it), images embedded as
+data URIs, nothing fetched; links to the run's other files.
 """
 
 from __future__ import annotations
 
-import base64
 import html
-import tempfile
+from collections.abc import Sequence
 from pathlib import Path
 
-import cv2
-
-from tsrkit.api import (
-    DetectionRecord,
-    ReportWriter,
-    RunResult,
-    atomic_open,
-    fmt,
-    headline,
-    hookimpl,
-    radius_label,
-    title,
-)
-from tsrkit_plugins.writers.plots import plot_names, write_plots
-
-#: Frames shown in the gallery of worst frames.
-GALLERY = 8
-#: Width (px) of a gallery image.
-THUMB_WIDTH = 480
+from tsrkit.api import ReportWriter, RunResult, atomic_open, heading, headline_table, hookimpl
+from tsrkit_plugins.writers.html.gallery import data_uri, gallery
 
 STYLE = """
 body{font-family:system-ui,sans-serif;margin:1.5em;color:#222;max-width:1200px}
@@ -40,6 +23,10 @@ table{border-collapse:collapse;margin:.5em 0 1.5em}td,th{border:1px solid #ccc;p
 th{background:#eee;cursor:pointer;user-select:none}td.num{text-align:right}
 input.filter{margin:.2em 0;padding:2px 6px}figure{display:inline-block;margin:.5em}
 figcaption{font-size:.85em;color:#555;max-width:480px}img{max-width:100%}
+p.caption{font-size:.85em;color:#555;margin-top:-1em;max-width:900px}p.note{color:#8a4b00}
+div.frame{border-top:1px solid #ddd;padding:.5em 0;display:flex;flex-wrap:wrap;gap:.5em}
+div.frame p{flex-basis:100%;margin:.2em 0}div.crops{display:flex;flex-wrap:wrap;max-width:700px}
+figure.crop{margin:0 .3em .3em 0}figure.crop figcaption{text-align:center;max-width:160px}
 """
 
 SCRIPT = """
@@ -69,7 +56,7 @@ document.querySelectorAll('input.filter').forEach(function (input) {
 """
 
 
-def table(ident: str, header: list[str], rows: list[list[str]]) -> str:
+def table(ident: str, header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
     """A sortable, filterable HTML table (numbers right-aligned)."""
 
     def cell(value: str) -> str:
@@ -82,167 +69,63 @@ def table(ident: str, header: list[str], rows: list[list[str]]) -> str:
     head = "".join(f"<th>{html.escape(h)}</th>" for h in header)
     body = "".join("<tr>" + "".join(cell(v) for v in row) + "</tr>" for row in rows)
     return (
-        f'<input class="filter" data-table="{ident}" placeholder="filter rows">'
-        f'<table class="sortable" id="{ident}"><thead><tr>{head}</tr></thead>'
+        f'<input class="filter" data-table="{html.escape(ident)}" placeholder="filter rows">'
+        f'<table class="sortable" id="{html.escape(ident)}"><thead><tr>{head}</tr></thead>'
         f"<tbody>{body}</tbody></table>"
     )
 
 
-def data_uri(png_or_jpeg: bytes, kind: str = "png") -> str:
-    return f"data:image/{kind};base64,{base64.b64encode(png_or_jpeg).decode('ascii')}"
+def results_html(run: RunResult) -> str:
+    """The headline table, the remarks and every result's tables, in order."""
+    figures = run.headline()
+    parts, idents = [], set()
+    if figures:
+        parts += ["<h2>Headline</h2>", table("headline", *headline_table(figures))]
+    parts += [f"<p>{html.escape(r)}</p>" for r in run.remarks()]
+    for result in run.results:
+        for t in result.tables():
+            ident = t.ident if t.ident not in idents else f"{result.metric}-{t.ident}"
+            idents.add(ident)
+            parts += [f"<h2>{html.escape(t.title)}</h2>", table(ident, t.columns, t.rows)]
+            if t.caption:
+                parts.append(f'<p class="caption">{html.escape(t.caption)}</p>')
+    return "".join(parts)
 
 
-def frame_errors(sample, record) -> tuple[list, list, list, int]:
-    """Detections whose centre is in a box, false positives (in none), missed boxes, and the
-    detections in a box whose state differs from the box's (both known)."""
-    boxes = [a.bbox for a in sample.annotations]
-    hits: list[DetectionRecord] = []
-    false: list[DetectionRecord] = []
-    covered, wrong = set(), 0
-    for d in record.detections:
-        inside = [
-            k for k, (x0, y0, x1, y1) in enumerate(boxes) if x0 <= d.x <= x1 and y0 <= d.y <= y1
-        ]
-        (hits if inside else false).append(d)
-        covered.update(inside)
-        truth = {sample.annotations[k].state for k in inside} - {"unknown", None}
-        wrong += bool(truth) and d.state != "unknown" and d.state not in truth
-    missed = [b for k, b in enumerate(boxes) if k not in covered]
-    return hits, false, missed, wrong
-
-
-def overlay(sample, hits, false, missed, box: str) -> bytes | None:
-    """The frame with its errors drawn, as a JPEG at most :data:`THUMB_WIDTH` wide."""
-    try:
-        image = sample.load().image.copy()
-    except Exception:
-        return None
-    for a in sample.annotations:
-        x0, y0, x1, y1 = (int(round(v)) for v in a.bbox)
-        cv2.rectangle(image, (x0, y0), (x1, y1), (0, 200, 0), 2)
-    for colour, dets in (((255, 120, 0), hits), ((0, 0, 255), false)):
-        for d in dets:
-            x0, y0, x1, y1 = (int(round(v)) for v in d.box(box))
-            cv2.rectangle(image, (x0, y0), (x1, y1), colour, 2)
-    for x0, _, x1, y1 in missed:
-        cv2.drawMarker(
-            image, (int((x0 + x1) / 2), int(y1) + 8), (0, 200, 255), cv2.MARKER_TRIANGLE_UP, 12, 2
-        )
-    scale = min(1.0, THUMB_WIDTH / image.shape[1])
-    if scale < 1.0:
-        image = cv2.resize(image, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA)
-    ok, encoded = cv2.imencode(".jpg", image, [cv2.IMWRITE_JPEG_QUALITY, 85])
-    return encoded.tobytes() if ok else None
-
-
-def gallery(run: RunResult) -> str:
-    """The :data:`GALLERY` frames with the most misses plus false positives, with overlays."""
-    box = run.report.get("evaluated_box") or "lens"
-    scored = []
-    for sample, record in run.pairs():
-        hits, false, missed, wrong = frame_errors(sample, record)
-        errors = len(missed) + len(false) + wrong
-        scored.append((errors, sample, record, hits, false, missed, wrong))
-    scored.sort(key=lambda s: -s[0])  # stable: equal errors keep dataset order
-    figures = []
-    for errors, sample, _, hits, false, missed, wrong in scored[:GALLERY]:
-        if errors == 0:
-            break
-        image = overlay(sample, hits, false, missed, box)
-        if image is None:
-            continue
-        caption = (
-            f"{Path(sample.source).name}: {len(missed)} missed, {len(false)} false positives, "
-            f"{len(hits)} found, {wrong} wrong states"
-        )
-        figures.append(
-            f'<figure><img class="gallery" alt="{html.escape(caption)}" '
-            f'src="{data_uri(image, "jpeg")}">'
-            f"<figcaption>{html.escape(caption)}</figcaption></figure>"
-        )
-    if not figures:
-        return "<p>No frame with a miss or a false positive.</p>"
-    return (
-        "<p>Green: ground truth; blue: detections in a box; red: false positives; "
-        "orange triangle: a missed light.</p>" + "".join(figures)
+def plots_html(run: RunResult) -> str:
+    """Every plot, embedded, with its caption."""
+    captions = run.captions()
+    return "".join(
+        f'<figure><img alt="{html.escape(name)}" src="{data_uri(png)}">'
+        f"<figcaption>{html.escape(captions.get(name, name))}</figcaption></figure>"
+        for name, png in run.plot_images().items()
     )
 
 
-def plots(report: dict) -> str:
-    """The run's plots, drawn into a temporary folder and embedded."""
-    with tempfile.TemporaryDirectory() as folder:
-        write_plots(Path(folder), report)
-        return "".join(
-            f'<figure><img alt="{name}" src="{data_uri((Path(folder) / name).read_bytes())}">'
-            f"<figcaption>{name}</figcaption></figure>"
-            for name in plot_names(report)
-        )
+def links(report: dict) -> str:
+    """Links to the run's other files that a reader opens (``report.json``, ``summary.md``...)."""
+    names = [f for f in report.get("files", []) if f != "report.html"]
+    if not names:
+        return ""
+    shown = "".join(f'<a href="{html.escape(f)}">{html.escape(f)}</a> ' for f in names)
+    return f'<p class="files">Files of this run: {shown}</p>'
 
 
 def page(run: RunResult) -> str:
     """The whole self-contained page."""
     report = run.report
-    name = f"{title(report)} on {report['dataset']['name']}"
+    name = heading(report)
     parts = [
         f"<h1>{html.escape(name)}</h1>",
-        f"<p>{report['frames']} frames evaluated, {len(report['skipped'])} skipped; evaluated "
-        f"box: {html.escape(str(report.get('evaluated_box') or '-'))}.</p>",
-        *[f"<p><b>Note:</b> {html.escape(n)}</p>" for n in report.get("notes", [])],
-        "<h2>Headline</h2>",
-        table("headline", ["figure", "value"], [[k, v] for k, v in headline(report).items()]),
+        links(report),
+        *[f'<p class="note"><b>Note:</b> {html.escape(n)}</p>' for n in report.get("notes", [])],
+        results_html(run),
     ]
-    if report["categories"]:
-        rows = [
-            [
-                r["lighting"],
-                "all" if r["max_radius"] is None else radius_label(r["max_radius"]),
-                str(r["frames"]),
-                fmt(r["recall_mean"]),
-                fmt(r["precision_mean"]),
-                fmt(r["hit_frame_fraction"]),
-            ]
-            for r in report["categories"]
-        ]
-        parts += [
-            "<h2>Lighting x max target radius (Zheng Table 5-2 layout)</h2>",
-            table(
-                "categories",
-                ["lighting", "max radius", "frames", "recall", "precision", "hit"],
-                rows,
-            ),
-        ]
-    state = report["state"]
-    if state.get("pairs") and "note" not in state:
-        labels, matrix = state["confusion"]["labels"], state["confusion"]["matrix"]
-        parts += [
-            "<h2>State confusion (rows: truth, columns: predicted)</h2>",
-            table(
-                "confusion",
-                ["truth", *labels],
-                [[t, *map(str, row)] for t, row in zip(labels, matrix)],
-            ),
-        ]
-        per_class = state.get("per_class") or {}
-        if per_class:
-            keys = sorted({k for v in per_class.values() for k in v})
-            parts += [
-                "<h2>Per class</h2>",
-                table(
-                    "per-class",
-                    ["state", *keys],
-                    [[s, *(fmt(v.get(k)) for k in keys)] for s, v in per_class.items()],
-                ),
-            ]
-    if report["skipped"]:
-        parts += [
-            "<h2>Skipped</h2>",
-            table(
-                "skipped",
-                ["source", "reason"],
-                [[s["source"], s["reason"]] for s in report["skipped"]],
-            ),
-        ]
-    parts += ["<h2>Plots</h2>", plots(report), "<h2>Worst frames</h2>", gallery(run)]
+    drawn = plots_html(run)
+    if drawn:
+        parts += ["<h2>Plots</h2>", drawn]
+    if run.dataset is not None:
+        parts += ["<h2>Worst frames</h2>", gallery(run)]
     return (
         f'<!DOCTYPE html><html lang="en"><head><meta charset="utf-8"><title>{html.escape(name)}'
         f"</title><style>{STYLE}</style></head><body>{''.join(parts)}<script>{SCRIPT}</script>"
