@@ -1,7 +1,7 @@
 """Candidate recall of each paper detector (loosened) and of their ``union``, per set and size.
 
 Candidate recall is the share of annotated lights with at least one candidate centre inside the
-light's circle (Zheng 5.2.1's centre rule: the circle inscribed in the annotated box), before
+light's circle (Zheng 5.2.1's centre rule: the smallest circle enclosing the annotated box), before
 any verifier: what a verifier can at best keep. Lights are binned by their lens radius r in px:
 half the annotated box's shorter side on the lens-boxed sets (KR, synthetic), that divided by
 :data:`HOUSING_PER_LENS` on the housing-boxed ones (cinTA, DTLD, Japan: a head's width across
