@@ -1,6 +1,7 @@
 """The ``union`` detector: members built by the core, rank-normalised scores, duplicate
 suppression."""
 
+import cv2
 import numpy as np
 import pytest
 
@@ -231,3 +232,22 @@ def test_merge_keeps_what_the_candidate_by_candidate_rule_keeps(reach_by):
         assert sorted(found, key=lambda t: (-t[3], t[0], t[1])) == sorted(
             expected, key=lambda t: (-t[3], t[0], t[1])
         )
+
+
+def test_members_on_one_frame_and_its_band_convert_it_to_lab_once(monkeypatch):
+    """lab-frst and lab-blob on the whole frame and lab-blob on its upper band: one CIELab
+    conversion and one L*(a+b) map for the three (the band slices the frame's); a member at
+    another size converts its own frame once."""
+    conversions = []
+    convert = cv2.cvtColor
+
+    def counted(image, code, *args):
+        conversions.append((code, image.shape[:2]))
+        return convert(image, code, *args)
+
+    monkeypatch.setattr(cv2, "cvtColor", counted)
+    image = background(240, 320, seed=5)
+    render_head(image, (100.0, 60.0), 3, 3, 0)
+    members = "lab-frst top=15; lab-blob; lab-blob levels=3 scale_top=0.6; lab-frst scale=0.5"
+    union(members).detect(Frame(image, "head"))
+    assert conversions == [(cv2.COLOR_BGR2Lab, (240, 320)), (cv2.COLOR_BGR2Lab, (120, 160))]
