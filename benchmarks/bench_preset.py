@@ -17,10 +17,10 @@ absolute time swings.
 
 **Baseline.** ``--baseline COMMIT`` measures the tree of ``COMMIT`` too, in a second process
 that takes turns with this one frame by frame (so both see the same load). Its tree is
-exported with ``git archive`` into ``benchmarks/out/at-COMMIT/src`` and installed there, without
-dependencies, into a virtual environment that borrows this environment's packages (made once,
-reused). Only what both trees have is called: the pipeline, the union's ``members`` and the
-module-level ``merge`` beside it.
+installed, with its own entry points, in a virtual environment under ``benchmarks/out/at-COMMIT``
+that borrows this environment's packages (``at_commit.python_at``, made once, reused). Only
+what both trees have is called: the pipeline, the union's ``members`` and the module-level
+``merge`` beside it.
 
 ``--members`` times this tree's preset with other union members (the baseline keeps its own).
 
@@ -40,7 +40,6 @@ os.environ["NUMBA_NUM_THREADS"] = "1"
 import argparse  # noqa: E402
 import json  # noqa: E402
 import shlex  # noqa: E402
-import site  # noqa: E402
 import statistics  # noqa: E402
 import subprocess  # noqa: E402
 import sys  # noqa: E402
@@ -52,6 +51,7 @@ import numpy as np  # noqa: E402
 
 REPO = harness.REPO
 
+from at_commit import python_at  # noqa: E402
 from conspicuity_filter2d import conspicuity_filter2d  # noqa: E402
 
 import tsrkit  # noqa: E402
@@ -139,35 +139,6 @@ def worker(files: list[Path], repeats: int) -> None:
         print(json.dumps(stages.measure(load_frame(files[int(line)]), repeats)), flush=True)
 
 
-def baseline_python(commit: str) -> Path:
-    """The Python of a virtual environment holding the tree of ``commit`` (made once)."""
-    root = REPO / "benchmarks" / "out" / f"at-{commit}"
-    python = root / "venv" / "bin" / "python"
-    if python.exists():
-        return python
-    src = root / "src"
-    src.mkdir(parents=True, exist_ok=True)
-    archive = subprocess.run(
-        ["git", "-C", str(REPO), "archive", commit], capture_output=True, check=False
-    )
-    if archive.returncode != 0:
-        raise SystemExit(f"bench_preset: no commit {commit!r} in {REPO}")
-    subprocess.run(["tar", "-x", "-C", str(src)], input=archive.stdout, check=True)
-    subprocess.run([sys.executable, "-m", "venv", "--without-pip", str(root / "venv")], check=True)
-    packages = Path(
-        subprocess.run(
-            [str(python), "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"],
-            capture_output=True,
-            text=True,
-            check=True,
-        ).stdout.strip()
-    )
-    (packages / "borrowed.pth").write_text("\n".join(site.getsitepackages()) + "\n")
-    install = [sys.executable, "-m", "pip", "--python", str(python), "install", "-q"]
-    subprocess.run(install + ["--no-deps", "--no-build-isolation", "-e", str(src)], check=True)
-    return python
-
-
 def summary(rows: list[dict]) -> dict:
     """Median over frames of every stage's ms, and of its share of the yardstick."""
     names = list(rows[0]["ms"])
@@ -229,7 +200,7 @@ def main() -> None:
     if args.baseline:
         script = [str(Path(__file__).resolve()), "--worker", "--frames", str(args.frames)]
         child = subprocess.Popen(
-            [str(baseline_python(args.baseline)), *script, "--repeats", str(args.repeats)],
+            [str(python_at(args.baseline)), *script, "--repeats", str(args.repeats)],
             stdin=subprocess.PIPE,
             stdout=subprocess.PIPE,
             text=True,

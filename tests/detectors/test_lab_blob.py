@@ -5,22 +5,13 @@ from __future__ import annotations
 import cv2
 import numpy as np
 import pytest
+from oracles.lamps import street
 
 import tsrkit
-from tsrkit.api import Frame
 from tsrkit_plugins.detectors.lab_blob import blob_peaks, gaussian_stack
 
 RED = (40, 40, 235)
 GREEN = (170, 230, 40)
-
-
-def street(lamps=(), size=(120, 160)) -> Frame:
-    """A grey frame with a dark housing band and lit discs ``(x, y, radius, bgr)``."""
-    image = np.full((*size, 3), 95, np.uint8)
-    cv2.rectangle(image, (10, 20), (150, 60), (35, 35, 35), -1)
-    for x, y, radius, colour in lamps:
-        cv2.circle(image, (x, y), radius, colour, -1, lineType=cv2.LINE_AA)
-    return Frame(image, "synthetic")
 
 
 @pytest.mark.parametrize("radius", [1, 2, 3])

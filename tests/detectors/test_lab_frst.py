@@ -6,6 +6,7 @@ import cv2
 import numpy as np
 import pytest
 from oracles.frst_arrays import frst_arrays
+from oracles.lamps import street
 
 import tsrkit
 from tsrkit.datasets import open_dataset
@@ -15,15 +16,6 @@ from tsrkit_plugins.detectors.frst.lab_frst import lab_feature_map, spot_candida
 
 RED = (40, 40, 235)
 GREEN = (170, 230, 40)
-
-
-def street(lamps=(), size=(120, 160)) -> Frame:
-    """A grey frame with a darker housing band and lit discs ``(x, y, radius, bgr)``."""
-    image = np.full((*size, 3), 95, np.uint8)
-    cv2.rectangle(image, (10, 20), (150, 60), (35, 35, 35), -1)
-    for x, y, radius, colour in lamps:
-        cv2.circle(image, (x, y), radius, colour, -1, lineType=cv2.LINE_AA)
-    return Frame(image, "synthetic")
 
 
 def nearest(candidates, x, y):
