@@ -17,6 +17,8 @@ from collections.abc import Callable, Hashable
 import cv2
 import numpy as np
 
+__all__ = ["FrameViews"]
+
 
 class FrameViews:
     """The views of one image (BGR uint8), computed on first use.
