@@ -6,6 +6,7 @@ the real housing boxes given their lit lens, and housing AP50 / recall after the
     python benchmarks/bench_housing.py --fit       # only: speed and fit quality
     python benchmarks/bench_housing.py --select roboflow_cinta_v2_id:valid dtld_fridtjofs:train
     python benchmarks/bench_housing.py --pads 0 0.5 1 1.5 2 3   # only: fits after a pixel pad
+    python benchmarks/bench_housing.py --rendered  # only: fits on rendered heads of every layout
 
 ``--stages`` fits each test housing from four starts and gives the share at IoU >= 0.5: the
 true lit lens (centre and radius from the box, :func:`find_lens`), the ``union`` detector's
@@ -14,7 +15,14 @@ best-scored candidate whose centre lies in the box's circle (Zheng's rule), and 
 
 ``--pads P...`` gives the share of housings fitted at IoU >= 0.5 from their lit lens after the
 fit is widened by P pixels on every side (the stage's ``pad``), on each housing set's training
-and test split, with the median slack per side between the fit and the annotated box.
+and test split (the Japanese set whole: its split lets near-duplicate frames cross), with the
+median slack per side between the fit and the annotated box, and the share whose fit lies the
+way the box does (horizontal or vertical).
+
+``--rendered`` fits rendered heads of every layout (vertical and horizontal, 3 and 4 lenses,
+each lamp lit, lens radius 4, 6 and 9 px) from their lit lens on a sky-to-road background and on
+a dark one (a hillside), plain and with a light rim around the dark face (as Japan's heads), and
+gives the shares at IoU >= 0.5 and >= 0.8 (the fit itself, without the stage's pad).
 
 ``--select SET:SPLIT...`` asks which of the ``union`` candidates on one light gives its box: the
 share of annotated boxes (housings; lenses on lens-boxed sets) met at IoU >= 0.5 by the
@@ -51,7 +59,7 @@ from tsrkit.eval.coco import coco_ap, coco_dataset  # noqa: E402
 from tsrkit.eval.matching import centre_hits  # noqa: E402
 from tsrkit.geometry import iou_matrix, xyxy_to_xywh  # noqa: E402
 from tsrkit.registry import get_registry  # noqa: E402
-from tsrkit.synth.heads import background, render_head  # noqa: E402
+from tsrkit.synth.heads import LAMP_COLOURS, background, render_head  # noqa: E402
 from tsrkit.types import Candidate, Frame  # noqa: E402
 from tsrkit_plugins.shared.regions import find_lens  # noqa: E402
 from tsrkit_plugins.verifiers.housing.fit import fit_housings  # noqa: E402
@@ -82,6 +90,19 @@ def speed() -> tuple[float, float]:
 #: The training split of each housing set (as in ``verifier_loso.py``): its margin is learned
 #: there, never on the test split.
 TRAIN_SPLIT = {"roboflow_cinta_v2_id": "valid", "dtld_fridtjofs": "train"}
+#: Splits the ``--pads`` and ``--stages`` tables read per housing set (None: the whole set).
+PAD_SPLITS = {
+    "roboflow_cinta_v2_id": ("valid", "test"),
+    "dtld_fridtjofs": ("train", "test"),
+    "iwai_japan_tl": (None,),
+}
+STAGE_SPLITS = {"roboflow_cinta_v2_id": "test", "dtld_fridtjofs": "test", "iwai_japan_tl": None}
+
+
+def split_samples(name: str, split: str | None):
+    """The samples of ``name``'s ``split`` (None: all of them)."""
+    dataset = open_dataset(name)
+    return dataset.samples if split is None else dataset.split(split)
 
 
 def fit_quality(name: str) -> str:
@@ -108,10 +129,10 @@ def fit_quality(name: str) -> str:
     )
 
 
-def lens_fits(name: str, split: str) -> tuple[np.ndarray, np.ndarray]:
+def lens_fits(name: str, split: str | None) -> tuple[np.ndarray, np.ndarray]:
     """The annotated housings of a split and the fits from their lit lens (unwidened)."""
     truth, fits = [], []
-    for sample in open_dataset(name).split(split):
+    for sample in split_samples(name, split):
         boxes = [a.bbox for a in sample.annotations]
         if not boxes:
             continue
@@ -125,7 +146,12 @@ def lens_fits(name: str, split: str) -> tuple[np.ndarray, np.ndarray]:
     return np.asarray(truth, float), np.asarray(fits, float)
 
 
-def pad_row(name: str, split: str, pads: list[float]) -> str:
+def wide(boxes: np.ndarray) -> np.ndarray:
+    """Whether each box (N, 4) is wider than tall."""
+    return boxes[:, 2] - boxes[:, 0] > boxes[:, 3] - boxes[:, 1]
+
+
+def pad_row(name: str, split: str | None, pads: list[float]) -> str:
     """One row of the ``--pads`` table."""
     truth, fits = lens_fits(name, split)
     shares = []
@@ -135,17 +161,57 @@ def pad_row(name: str, split: str, pads: list[float]) -> str:
         shares.append(f"{np.mean(iou >= 0.5):.3f}")
     slack = np.median((fits - truth) * [1, 1, -1, -1], axis=0)
     sides = " / ".join(f"{v:.1f}" for v in slack)
-    return f"| {name} | {split} | {len(truth)} | {' | '.join(shares)} | {sides} |"
+    lying = np.mean(wide(fits) == wide(truth))
+    return (
+        f"| {name} | {split or 'all'} | {len(truth)} | {' | '.join(shares)} | {sides} "
+        f"| {lying:.3f} |"
+    )
 
 
-def stage_starts(name: str) -> str:
-    """Share of ``name`` test housings fitted at IoU >= 0.5 from each start (module docstring)."""
+def dark_background(height: int, width: int, seed: int) -> np.ndarray:
+    """A dark, slightly brown, noisy background (a hillside behind the heads)."""
+    rng = np.random.default_rng(seed)
+    image = np.full((height, width, 3), (45.0, 50.0, 60.0)) + rng.normal(0, 5, (height, width, 3))
+    return np.clip(image, 0, 255).astype(np.uint8)
+
+
+def rendered_row(backdrop: str, rim: bool) -> str:
+    """One row of the ``--rendered`` table (module docstring)."""
+    ious = []
+    for vertical in (True, False):
+        for lenses in (3, 4):
+            for lit in range(lenses):
+                for radius in (4, 6, 9):
+                    seed = lenses * 10 + lit
+                    image = (
+                        background(300, 420, seed)
+                        if backdrop == "sky"
+                        else dark_background(300, 420, seed)
+                    )
+                    colour = list(LAMP_COLOURS.values())[lit % 3]
+                    head = render_head(
+                        image, (210.3, 150.6), radius, lenses, lit, vertical, colour, False,
+                        (200, 200, 200) if rim else None,
+                    )  # fmt: skip
+                    gray = cv2.cvtColor(cv2.GaussianBlur(image, (0, 0), 0.7), cv2.COLOR_BGR2GRAY)
+                    fitted, _, _ = fit_housings(gray, [head.lens])
+                    ious.append(iou_matrix([head.housing], fitted)[0, 0])
+    iou = np.array(ious)
+    return (
+        f"| {backdrop} | {'light rim' if rim else 'plain'} | {len(iou)} | "
+        f"{np.mean(iou >= 0.5):.3f} | {np.mean(iou >= 0.8):.3f} |"
+    )
+
+
+def stage_starts(name: str, split: str | None = "test") -> str:
+    """Share of ``name``'s housings (of ``split``; None: all) fitted at IoU >= 0.5 from each
+    start (module docstring)."""
     union = get_registry().create("detector", "union")
     starts = ("true lens", "true centre, cand. radius", "cand. centre, true radius", "candidate")
     fitted: dict[str, list[float]] = {k: [] for k in starts}
     free: dict[str, list[float]] = {k: [] for k in starts}
     offsets, total = [], 0
-    for sample in open_dataset(name).split("test"):
+    for sample in split_samples(name, split):
         boxes = [a.bbox for a in sample.annotations]
         if not boxes:
             continue
@@ -173,7 +239,10 @@ def stage_starts(name: str) -> str:
         f"({np.sum(np.array(free[k]) >= 0.5) / total:.2f})"
         for k in starts
     )
-    return f"| {name} | {total} | {len(offsets) / total:.2f} | {cells} | {np.median(offsets):.2f} |"
+    return (
+        f"| {name} ({split or 'all'}) | {total} | {len(offsets) / total:.2f} | {cells} "
+        f"| {np.median(offsets):.2f} |"
+    )
 
 
 def matches(out: list[Candidate], boxes: list, lens_boxed: bool) -> tuple[np.ndarray, np.ndarray]:
@@ -255,18 +324,25 @@ def main() -> None:
     parser.add_argument("--fit", action="store_true", help="only the speed and fit quality")
     parser.add_argument("--select", nargs="+", metavar="SET:SPLIT", help="only: which candidate")
     parser.add_argument("--pads", nargs="+", type=float, metavar="P", help="only: fits + P px")
+    parser.add_argument("--rendered", action="store_true", help="only: rendered heads")
     args = parser.parse_args()
     harness.announce()
     if args.pads:
         print(
             "| set | split | housings | "
             + " | ".join(f"pad {p:g} px" for p in args.pads)
-            + " | median slack l / t / r / b (px) |"
+            + " | median slack l / t / r / b (px) | lies as the box |"
         )
-        print("|---|---|---:|" + "---:|" * len(args.pads) + "---|")
-        for name, train in TRAIN_SPLIT.items():
-            for split in (train, "test"):
+        print("|---|---|---:|" + "---:|" * len(args.pads) + "---|---:|")
+        for name, splits in PAD_SPLITS.items():
+            for split in splits:
                 print(pad_row(name, split, args.pads), flush=True)
+        return
+    if args.rendered:
+        print("| background | head | heads | IoU >= 0.5 | IoU >= 0.8 |\n|---|---|---:|---:|---:|")
+        for backdrop in ("sky", "dark"):
+            for rim in (False, True):
+                print(rendered_row(backdrop, rim), flush=True)
         return
     if args.select:
         print(
@@ -279,12 +355,12 @@ def main() -> None:
     if args.stages:
         print("shares at IoU >= 0.5, margin-free in brackets\n")
         print(
-            "| set (test) | housings | union hit | true lens | true centre, cand. radius "
+            "| set (split) | housings | union hit | true lens | true centre, cand. radius "
             "| cand. centre, true radius | candidate | cand. offset (true radii, median) |"
         )
         print("|---|---:|---:|---:|---:|---:|---:|---:|")
-        for name in ("roboflow_cinta_v2_id", "dtld_fridtjofs"):
-            print(stage_starts(name), flush=True)
+        for name, split in STAGE_SPLITS.items():
+            print(stage_starts(name, split), flush=True)
         return
     wall, cpu = speed()
     print(

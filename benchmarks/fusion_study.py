@@ -1,160 +1,136 @@
 """How the recommended pipeline's keep decision should fuse the verifier's probability with the
-union's agreement: held-out candidates dumped once, decision rules compared offline.
+union's agreement: rules replayed offline on the held-out candidates of a ``camera_loso.py`` run.
 
-For each of KR, cinTA and DTLD, the verifier is trained on the two other sets' training splits
-(as ``verifier_loso.py`` does, with the same parameters), and every candidate of the held-out
-set's test split and of synthetic no-light frames is dumped after the housing stage: its
-learned probability ``p``, the union's agreement ``a``, the box model's probability ``b``, its
-Zheng label (centre in a ground-truth box's circle) and its frame. ``--rules`` then replays
-keep decisions offline (threshold and the per-frame ``relative`` gate) for several fusion
-rules, and prints Zheng hit / recall / precision / FP per frame on the held-out test split and
-false lights per synthetic no-light frame, at every threshold.
+A ``camera_loso.py`` run dumps every held-out candidate after the housing stage with its
+decision score ``d = (1 - prior) p + prior a`` (``p`` the verifier's probability, ``a`` the
+union's agreement) and its reported score; this script recovers ``p`` and replays keep rules
+(threshold and the per-frame ``relative`` gate) per held-out camera: Zheng hit, precision
+(exhaustive sets), recall at IoU 0.5, and false lights per frame on the held-out camera's empty
+frames and on synthetic no-light frames.
 
-Run: python benchmarks/fusion_study.py --out benchmarks/out/fusion        # dump (~10 min)
-     python benchmarks/fusion_study.py --out benchmarks/out/fusion --rules  # tables
+Rules that calibrate per camera read only the camera's own candidates, never a label: what a
+video's running statistics would give at run time (``a camera``: all frames of the held-out
+set; its empty frames are calibrated with the set's frames, as one video would mix them).
+
+Run: python benchmarks/camera_loso.py --out benchmarks/out/camera_loso     # the dumps
+     python benchmarks/fusion_study.py benchmarks/out/camera_loso [--rules NAME ...]
 """
 
 from __future__ import annotations
 
-import harness
+import argparse
+import json
+from collections.abc import Callable
+from pathlib import Path
 
-harness.single_thread()
+import numpy as np
+from camera_loso import FAMILIES, figures
 
-import argparse  # noqa: E402
-from collections.abc import Callable  # noqa: E402
-from pathlib import Path  # noqa: E402
-
-import numpy as np  # noqa: E402
-from verifier_loso import SETS, Memo, no_light_dataset  # noqa: E402
-
-from tsrkit.datasets import open_datasets  # noqa: E402
-from tsrkit.eval.matching import centre_hits  # noqa: E402
-from tsrkit.registry import get_registry  # noqa: E402
-from tsrkit.training import train  # noqa: E402
-from tsrkit_plugins.verifiers.features import candidate_features  # noqa: E402
-from tsrkit_plugins.verifiers.learned import passes  # noqa: E402
-
-#: The recommended preset's verifier training parameters (tsrkit/presets/recommended.yaml).
-TRAINING = {"after": "housing", "prior": 0.7, "box_rank": 0.5}
+#: Thresholds each rule is read at.
 THRESHOLDS = (0.2, 0.25, 0.3, 0.35, 0.4, 0.5, 0.6)
 
 
-def dump(samples, detector, verifier) -> dict[str, np.ndarray]:
-    """Per-candidate arrays of ``samples`` (after the housing stage): p, a, b, label, frame,
-    and per frame the number of annotated lights."""
-    rows: dict[str, list] = {k: [] for k in ("p", "a", "b", "label", "frame")}
-    lights = []
-    for index, sample in enumerate(samples):
-        frame = sample.load()
-        truth = [a.bbox for a in sample.annotations]
-        lights.append(len(truth))
-        staged = verifier._stage()(frame, detector.detect(frame))
-        if not staged:
-            continue
-        features = candidate_features(frame.image, staged)
-        rows["p"].append(verifier.forest.probability(features))
-        rows["b"].append(verifier.box_forest.probability(features))
-        rows["a"].append(np.clip([c.score for c in staged], 0.0, 1.0))
-        hits = centre_hits([(c.x, c.y) for c in staged], truth) if truth else None
-        label = np.zeros((len(staged), max(len(truth), 1)), bool) if hits is None else hits
-        # which light each candidate hits (-1: none), to count hit lights per frame
-        rows["label"].append(np.where(label.any(axis=1), label.argmax(axis=1), -1))
-        rows["frame"].append(np.full(len(staged), index))
-    out = {k: np.concatenate(v) if v else np.zeros(0) for k, v in rows.items()}
-    out["lights"] = np.asarray(lights)
-    return out
+def logit(p: np.ndarray) -> np.ndarray:
+    """log(p / (1 - p)), p clipped to [1e-4, 1 - 1e-4]."""
+    clipped = np.clip(p, 1e-4, 1 - 1e-4)
+    return np.log(clipped / (1 - clipped))
 
 
-def collect(out: Path) -> None:
-    """Train the held-out verifiers and dump every fold's candidates to ``out``."""
-    reg = get_registry()
-    detector = Memo(reg.create("detector", "union"))
-    nolight = no_light_dataset(30)
-    for s in SETS:
-        others = [f"{o.name}:{o.train}" for o in SETS if o.key != s.key]
-        model = out / f"verifier_loso_{s.key}"
-        if not (model.with_suffix(".npz")).exists():
-            train("verifier", open_datasets(others), model, TRAINING, detector)
-        verifier = reg.create("verifier", "verifier", {"model": str(model), **TRAINING})
-        test = open_datasets([f"{s.name}:{s.test}"])
-        for part, samples in (("test", test.samples), ("nolight", nolight.samples)):
-            arrays = dump(samples, detector, verifier)
-            np.savez(out / f"{s.key}_{part}.npz", **arrays)
-            print(s.key, part, len(arrays["p"]), "candidates", flush=True)
+def squash(z: np.ndarray) -> np.ndarray:
+    """The logistic function."""
+    return 1.0 / (1.0 + np.exp(-z))
 
 
+#: A rule maps (p, a, the camera's p for calibration) to the decision score.
 Rule = Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]
 RULES: dict[str, Rule] = {
-    "preset 0.3p+0.7a": lambda p, a, b: 0.3 * p + 0.7 * a,
-    "0.5p+0.5a": lambda p, a, b: 0.5 * p + 0.5 * a,
-    "p alone": lambda p, a, b: p,
-    "a alone": lambda p, a, b: a,
-    "sqrt(p a)": lambda p, a, b: np.sqrt(p * a),
-    "p^0.3 a^0.7": lambda p, a, b: p**0.3 * a**0.7,
-    "(0.3p+0.7a) b^0.5": lambda p, a, b: (0.3 * p + 0.7 * a) * np.sqrt(b),
+    "preset 0.3p+0.7a": lambda p, a, cam: 0.3 * p + 0.7 * a,
+    "0.5p+0.5a": lambda p, a, cam: 0.5 * p + 0.5 * a,
+    "p alone": lambda p, a, cam: p,
+    "a alone": lambda p, a, cam: a,
+    "sqrt(p a)": lambda p, a, cam: np.sqrt(p * a),
+    "0.3p+0.7a, p >= 0.05": lambda p, a, cam: np.where(p >= 0.05, 0.3 * p + 0.7 * a, 0.0),
+    "0.3p+0.7a, p >= 0.1": lambda p, a, cam: np.where(p >= 0.1, 0.3 * p + 0.7 * a, 0.0),
+    # per camera: p's logit against the camera's 90th percentile of logits (its negatives)
+    "camera-calibrated p": lambda p, a, cam: squash(logit(p) - np.quantile(logit(cam), 0.9)),
+    "0.3 cal p + 0.7a": lambda p, a, cam: (
+        0.3 * squash(logit(p) - np.quantile(logit(cam), 0.9)) + 0.7 * a
+    ),
 }
 
 
-def figures(d: dict[str, np.ndarray], score: np.ndarray, t: float, relative: float) -> dict:
-    """Zheng per-frame figures of the candidates that ``score`` keeps at ``t`` / ``relative``."""
-    hit, recall, precision, fps = [], [], [], []
-    for index, n in enumerate(d["lights"]):
-        rows = np.flatnonzero(d["frame"] == index)
-        keep = rows[passes(score[rows], t, relative)] if len(rows) else rows
-        labels = d["label"][keep]
-        tp = int(np.count_nonzero(labels >= 0))
-        fps.append(len(keep) - tp)
-        if n:
-            found = len(np.unique(labels[labels >= 0]))
-            hit.append(found > 0)
-            recall.append(found / n)
-            if len(keep):
-                precision.append(tp / len(keep))
-    return {
-        "hit": np.mean(hit) if hit else np.nan,
-        "recall": np.mean(recall) if recall else np.nan,
-        "precision": np.mean(precision) if precision else np.nan,
-        "fp": np.mean(fps),
-    }
+def with_rule(d: dict, rule: Rule, prior: float, camera_p: np.ndarray) -> dict:
+    """The dump ``d`` with its decision scores replaced by ``rule``'s."""
+    return {**d, "decision": rule(probabilities(d, prior), d["agreement"], camera_p)}
 
 
-def tables(out: Path, relative: float) -> None:
-    """Print, per rule and threshold, hit / recall / precision / FP per frame per held-out set
-    and no-light false lights per frame (the mean over the three folds' models)."""
-    data = {
-        s.key: {part: dict(np.load(out / f"{s.key}_{part}.npz")) for part in ("test", "nolight")}
-        for s in SETS
+def probabilities(d: dict, prior: float) -> np.ndarray:
+    """The verifier's probability of each dumped candidate (its decision score without the
+    agreement's share)."""
+    return (d["decision"] - prior * d["agreement"]) / (1.0 - prior)
+
+
+def tables(out: Path, names: list[str], relative: float) -> str:
+    results = json.loads((out / "results.json").read_text())
+    prior = float(results["verifier_params"].get("prior", 0.0))
+    exhaustive = {f.key: f.exhaustive for f in FAMILIES} | {"MIT": True, "VGIS": True}
+    lines = [
+        f"Run {out} ({results['code']['commit']}), relative {relative}; per held-out set: hit / "
+        "precision / recall IoU.5 / empty-frame FP; then mean no-light FP over the folds",
+        "",
+    ]
+    held = []
+    for key, fold in results["folds"].items():
+        for part in fold["sets"]:
+            if part != "no-light" and not part.endswith("-empty"):
+                held.append((key, part))
+    lines.append("| rule | t | " + " | ".join(p for _, p in held) + " | no-light FP |")
+    lines.append("|---|---|" + "---|" * (len(held) + 1))
+    dumps = {
+        (key, part): dict(np.load(out / f"dump_{key}_{part}.npz"))
+        for key, fold in results["folds"].items()
+        for part in fold["sets"]
     }
-    print(
-        "| rule | t | " + " | ".join(f"{s.key} hit/rec/prec/FP" for s in SETS) + " | no-light FP |"
-    )
-    print("|---|---|" + "---|" * (len(SETS) + 1))
-    for name, rule in RULES.items():
+    for name in names:
+        rule = RULES[name]
         for t in THRESHOLDS:
             cells, nolight = [], []
-            for s in SETS:
-                test, nl = data[s.key]["test"], data[s.key]["nolight"]
-                f = figures(test, rule(test["p"], test["a"], test["b"]), t, relative)
-                cells.append(
-                    f"{f['hit']:.2f} / {f['recall']:.2f} / {f['precision']:.2f} / {f['fp']:.2f}"
+            for key, part in held:
+                d = dumps[(key, part)]
+                camera = probabilities(d, prior)
+                f = figures(with_rule(d, rule, prior, camera), t, relative, exhaustive[part])
+                empty = dumps.get((key, f"{part}-empty"))
+                e = (
+                    figures(with_rule(empty, rule, prior, camera), t, relative, True)
+                    if empty is not None
+                    else None
                 )
-                nolight.append(figures(nl, rule(nl["p"], nl["a"], nl["b"]), t, relative)["fp"])
-            print(f"| {name} | {t} | " + " | ".join(cells) + f" | {np.mean(nolight):.2f} |")
+                cells.append(
+                    f"{f['hit']:.2f} / {_f(f['precision'])} / {f['iou50_recall']:.2f} / "
+                    f"{_f(e['fp_per_frame'] if e else None)}"
+                )
+            for key in results["folds"]:
+                nl = dumps[(key, "no-light")]
+                rows = with_rule(nl, rule, prior, probabilities(nl, prior))
+                nolight.append(figures(rows, t, relative, True)["fp_per_frame"])
+            lines.append(f"| {name} | {t} | " + " | ".join(cells) + f" | {np.mean(nolight):.2f} |")
+    return "\n".join(lines) + "\n"
+
+
+def _f(value) -> str:
+    return "n/a" if value is None else f"{value:.2f}"
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", default="benchmarks/out/fusion")
-    parser.add_argument("--rules", action="store_true", help="only the tables of a finished dump")
+    parser.add_argument("run", help="a camera_loso.py output folder")
+    parser.add_argument("--rules", nargs="*", default=list(RULES), choices=list(RULES))
     parser.add_argument("--relative", type=float, default=0.6, help="the per-frame gate")
     args = parser.parse_args()
-    harness.announce()
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    if args.rules:
-        tables(out, args.relative)
-    else:
-        collect(out)
+    out = Path(args.run)
+    if not (out / "results.json").is_file():
+        parser.error(f"{out}: no results.json (run camera_loso.py --out {out} first)")
+    print(tables(out, args.rules, args.relative))
 
 
 if __name__ == "__main__":

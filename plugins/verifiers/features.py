@@ -30,8 +30,10 @@ HOUSING_PX = (12, 22)
 #: as one cell, the housing as three cells, top, middle and bottom (the lamps of a 3-lamp head).
 HOG_SHRINK = 2
 ORIENTATIONS = 9
-#: Version of the feature layout; a model trained on another layout is refused.
-FEATURE_VERSION = 2
+#: Version of the feature layout; a model trained on another layout is refused (3: the housing's
+#: shape and the lens's place in it read upright, as the samples are, so that a horizontal head
+#: and the same head turned vertical give the same geometry).
+FEATURE_VERSION = 3
 
 COLOUR_NAMES = ("L", "a", "b", "S", "V", "hue_cos", "hue_sin", "chroma")
 RINGS = ("lens", "annulus", "surround")
@@ -365,11 +367,17 @@ def colour_features(lens: np.ndarray, housing: np.ndarray) -> np.ndarray:
 def geometry_features(table: np.ndarray, boxes: np.ndarray, width: int, height: int) -> np.ndarray:
     """Radius, housing shape in lens radii, the lens's place in its housing, the frame
     position, and the detector's score (raw, relative to the frame's best, and rank), of the
-    candidates of a :func:`candidate_table` and their housing ``boxes``."""
+    candidates of a :func:`candidate_table` and their housing ``boxes``. The housing is read
+    upright, as its samples are (:func:`box_maps`): its size across and along its long side, and
+    the lens's place across and along it, whichever way the head hangs."""
     x, y, score, fit, has_housing = table[:, [0, 1, 3, 4, 5]].T
     radius = np.maximum(table[:, 2], 0.5)
     hw = np.maximum(boxes[:, 2] - boxes[:, 0], 1e-3)
     hh = np.maximum(boxes[:, 3] - boxes[:, 1], 1e-3)
+    # the housing read upright (as the samples are): along its long side, across its short one
+    wide = hw > hh
+    along, across = np.where(wide, hw, hh), np.where(wide, hh, hw)
+    at_x, at_y = (x - boxes[:, 0]) / hw, (y - boxes[:, 1]) / hh
     best = float(np.max(np.abs(score))) or 1.0
     rank = np.empty(len(score))
     rank[np.argsort(-score, kind="stable")] = np.arange(len(score))
@@ -377,11 +385,11 @@ def geometry_features(table: np.ndarray, boxes: np.ndarray, width: int, height: 
         [
             radius,
             radius / height,
-            hw / radius,
-            hh / radius,
-            np.log(hh / hw),
-            (x - boxes[:, 0]) / hw,
-            (y - boxes[:, 1]) / hh,
+            across / radius,
+            along / radius,
+            np.log(along / across),
+            np.where(wide, at_y, at_x),
+            np.where(wide, at_x, at_y),
             fit,
             has_housing,
             x / width,
@@ -464,11 +472,11 @@ def feature_names() -> list[str]:
     geometry = [
         "radius",
         "radius_over_height",
-        "housing_w_radii",
-        "housing_h_radii",
-        "housing_log_aspect",
-        "lens_x_in_housing",
-        "lens_y_in_housing",
+        "housing_across_radii",
+        "housing_along_radii",
+        "housing_log_elongation",
+        "lens_across_in_housing",
+        "lens_along_in_housing",
         "housing_fit",
         "has_housing",
         "x_over_width",

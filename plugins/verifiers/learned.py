@@ -44,7 +44,14 @@ from tsrkit_plugins.shared.forest import Forest
 from tsrkit_plugins.shared.persistence import BOX_ARRAY, estimator_arrays, load_estimator
 from tsrkit_plugins.verifiers.augment import Augmentation
 from tsrkit_plugins.verifiers.features import candidate_features, feature_names, layout
-from tsrkit_plugins.verifiers.mining import Labelled, Stage, hard_negatives, labelled_candidates
+from tsrkit_plugins.verifiers.mining import (
+    Crops,
+    Heads,
+    Labelled,
+    Stage,
+    hard_negatives,
+    labelled_candidates,
+)
 
 if TYPE_CHECKING:  # scikit-learn loads when a model is fitted or read, not on import
     from sklearn.ensemble import HistGradientBoostingClassifier
@@ -173,6 +180,24 @@ class LearnedVerifier(Verifier):
             "scale, colour, blur and exposure), whose candidates on a head are positives",
         ),
         Param(
+            "head_horizontal",
+            "float",
+            0.5,
+            min=0.0,
+            max=1.0,
+            help="training: the share of the rendered heads hung horizontally (Japan's, "
+            "Korea's heads; 0.2 before horizontal heads were a held-out camera)",
+        ),
+        Param(
+            "head_rims",
+            "float",
+            0.3,
+            min=0.0,
+            max=1.0,
+            help="training: the share of the rendered heads with a light rim around the dark "
+            "face (as Japan's heads show against dark hillsides; 0: none)",
+        ),
+        Param(
             "crop_frames",
             "int",
             80,
@@ -192,6 +217,22 @@ class LearnedVerifier(Verifier):
             help="training: what crop_frames paste into: the real training frames (spread "
             "evenly, clear of their boxes) or synthetic daylight no-light scenes (more false "
             "positives held out)",
+        ),
+        Param(
+            "crop_own",
+            "bool",
+            True,
+            help="training: crop_frames also paste the training sets' own housing boxes, cut "
+            "out (a head of one camera on another camera's frame; lens boxes are not cut)",
+        ),
+        Param(
+            "crop_rotate",
+            "float",
+            0.3,
+            min=0.0,
+            max=1.0,
+            help="training: the share of pasted crops turned a quarter turn (vertical heads "
+            "made horizontal and the reverse; 0: none)",
         ),
         Param(
             "augment_scales",
@@ -365,10 +406,16 @@ class LearnedVerifier(Verifier):
             candidate_features,
             len(feature_names()),
             self.params["synthetic_frames"],
-            self.params["head_frames"],
+            Heads(
+                self.params["head_frames"], self.params["head_horizontal"], self.params["head_rims"]
+            ),
             self._augmentation,
-            self.params["crop_frames"],
-            self.params["crop_backgrounds"] == "real",
+            Crops(
+                self.params["crop_frames"],
+                self.params["crop_backgrounds"] == "real",
+                self.params["crop_own"],
+                self.params["crop_rotate"],
+            ),
         )
         return self.fit_labelled(data)
 

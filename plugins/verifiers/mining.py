@@ -105,15 +105,43 @@ def box_labels(candidates: Sequence[Candidate], boxes: Sequence[Sequence[float]]
     return labels
 
 
-def head_frames(count: int, seed: int = HEADS_SEED) -> Iterator[tuple[Frame, list]]:
-    """``count`` synthetic 1280x720 no-light scenes, each with 5 rendered lit heads of jittered
-    scale, colour, blur and exposure (:func:`tsrkit.synth.heads.scatter_heads`), and their
-    housing boxes: positives of cameras no real training set shows."""
+@dataclass(frozen=True)
+class Heads:
+    """The rendered-head scenes: how many, the share of horizontal heads and of light rims
+    (:func:`tsrkit.synth.heads.scatter_heads`)."""
+
+    count: int = 0
+    horizontal: float = 0.2
+    rims: float = 0.0
+
+    @property
+    def tag(self) -> str:
+        """Names the options in the scenes' sources ('' for the first defaults)."""
+        if (self.horizontal, self.rims) == (0.2, 0.0):
+            return ""
+        return f"+h{self.horizontal:g}r{self.rims:g}"
+
+
+def head_frames(heads: Heads, seed: int = HEADS_SEED) -> Iterator[tuple[Frame, list]]:
+    """``heads.count`` synthetic 1280x720 no-light scenes, each with 5 rendered lit heads of
+    jittered scale, colour, blur and exposure (:func:`tsrkit.synth.heads.scatter_heads`), and
+    their housing boxes: positives of cameras no real training set shows."""
     rng = np.random.default_rng(seed)
-    for frame in no_light_frames(count, seed):
+    for frame in no_light_frames(heads.count, seed):
         image = frame.image.copy()
-        boxes = scatter_heads(image, rng)
-        yield Frame(image, f"synth-heads:{seed}:{frame.source}"), boxes
+        boxes = scatter_heads(image, rng, horizontal=heads.horizontal, rims=heads.rims)
+        yield Frame(image, f"synth-heads{heads.tag}:{seed}:{frame.source}"), boxes
+
+
+@dataclass(frozen=True)
+class Crops:
+    """The pasted-crop scenes (:mod:`pasting`): how many, into the real training frames or
+    synthetic ones, with the training sets' own housings as crops too, the share turned."""
+
+    count: int = 0
+    on_real: bool = False
+    own: bool = False
+    rotate: float = 0.0
 
 
 def labelled_candidates(
@@ -123,20 +151,25 @@ def labelled_candidates(
     features: Callable[[np.ndarray, Sequence[Candidate]], np.ndarray],
     width: int,
     no_light: int,
-    heads: int = 0,
+    heads: Heads = Heads(),
     augmentation: Augmentation | None = None,
-    crops: int = 0,
-    crops_on_real: bool = False,
+    crops: Crops = Crops(),
 ) -> Labelled:
     """Run ``detector`` (then ``stage``) on every sample (on each of its ``augmentation``
-    views: :mod:`augment`), on ``no_light`` synthetic frames (and their camera looks), on
-    ``heads`` synthetic frames with rendered lit heads (:func:`head_frames`) and on ``crops``
-    synthetic frames with pasted real heads (:func:`tsrkit_plugins.verifiers.pasting.crop_frames`,
-    whose crop set is read first; ``crops_on_real``: pasted into the samples rather than into
-    synthetic scenes); return every candidate's features, its Zheng label, its frame index and its
-    box label (:func:`box_labels`)."""
+    views: :mod:`augment`), on ``no_light`` synthetic frames (and their camera looks), on the
+    synthetic frames with rendered lit heads of ``heads`` (:func:`head_frames`) and on the
+    frames with pasted real heads of ``crops``
+    (:func:`tsrkit_plugins.verifiers.pasting.crop_frames`, whose crop set is read first: pasted
+    into the samples or into synthetic scenes, with the samples' own housings as crops or not);
+    return every candidate's features, its Zheng label, its frame index and its box label
+    (:func:`box_labels`)."""
     samples = list(samples)
-    pasted = crop_frames(crops, samples if crops_on_real else ())
+    pasted = crop_frames(
+        crops.count,
+        samples if crops.on_real else (),
+        training=samples if crops.own else (),
+        rotate=crops.rotate,
+    )
     parts = []
     views = augmentation or Augmentation()
     frames: Iterator[tuple[Frame, Sequence[Sequence[float]]]] = (

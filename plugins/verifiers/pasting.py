@@ -8,12 +8,18 @@ no-light road scenes, each crop's box its housing box; the candidates on them ar
 those of the training sets (Zheng's centre rule, :mod:`mining`). The crop's edge is feathered
 so that the paste border is no cue. Measured leave-one-dataset-out in
 ``benchmarks/RESULTS.verifier.md``.
+
+Two options widen what is pasted: the training sets' own housing boxes cut out as crops
+(``training``: a head of one camera on the frames of another, so that neither the head nor the
+scene alone names the camera), and a share of the crops turned a quarter turn (``rotate``:
+vertical heads become horizontal ones, as Japan's and Korea's, and the reverse).
 """
 
 from __future__ import annotations
 
 import zlib
 from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
 
 import cv2
 import numpy as np
@@ -33,6 +39,14 @@ PER_SCENE = 5
 UPPER = 0.55
 #: Width of the alpha ramp at the crop's edge, px.
 FEATHER = 2
+#: A crop is pasted at most this many times its own height (a 15 px housing is not blown up to
+#: 110 px).
+ENLARGE = 3.0
+#: A training box is cut out as a housing crop when its long side is at least this many times
+#: its short side (a lens box, as KR's, is about square) and its short side at least
+#: :data:`MIN_CROP` px.
+HOUSING_ASPECT = 1.5
+MIN_CROP = 6
 
 Box = tuple[float, float, float, float]
 
@@ -91,57 +105,76 @@ def place(
 
 def paste_crops(
     image: np.ndarray,
-    crops: Sequence[Sample],
+    crops: Sequence[np.ndarray],
     rng: np.random.Generator,
     count: int = PER_SCENE,
     taken: Sequence[Box] = (),
+    rotate: float = 0.0,
 ) -> list[Box]:
-    """Paste ``count`` crops drawn from ``crops`` into ``image`` (in place), each with a housing
-    height log-uniform in :data:`HEIGHTS` (scaled to the frame's height against 720 px) and its
-    own aspect ratio, clear of the ``taken`` boxes, and return their boxes (x0, y0, x1, y1)."""
+    """Paste ``count`` crops (BGR images) drawn from ``crops`` into ``image`` (in place), each
+    turned a quarter turn either way with probability ``rotate``, with a housing height along
+    the frame's rows log-uniform in :data:`HEIGHTS` (scaled to the frame's height against
+    720 px, at most :data:`ENLARGE` x the crop's own) and its own aspect ratio, clear of the
+    ``taken`` boxes, and return their boxes (x0, y0, x1, y1). ``rotate`` 0 draws exactly what
+    it drew before the option existed."""
     scale = image.shape[0] / SYNTH_SIZE[1]
     boxes: list[Box] = list(taken)
     for _ in range(count):
-        crop = crops[int(rng.integers(0, len(crops)))].load().image
-        height = max(4, int(round(scale * np.exp(rng.uniform(*np.log(HEIGHTS))))))
+        crop = crops[int(rng.integers(0, len(crops)))]
+        if rotate > 0 and rng.random() < rotate:
+            crop = np.rot90(crop, 1 if rng.random() < 0.5 else 3)
+        drawn = scale * np.exp(rng.uniform(*np.log(HEIGHTS)))
+        height = max(4, int(round(min(drawn, ENLARGE * crop.shape[0]))))
         width = max(2, int(round(height * crop.shape[1] / crop.shape[0])))
         box = place(rng, image.shape[:2], (width, height), boxes)
         if box is None:
             continue
-        paste(image, crop[:, :, :3], box)
+        paste(image, np.ascontiguousarray(crop[:, :, :3]), box)
         boxes.append(tuple(float(v) for v in box))  # type: ignore[arg-type]
     return boxes[len(taken) :]
 
 
+@dataclass(frozen=True)
+class CropPool:
+    """The crops a run pastes, the share of them turned, and a tag naming both (it enters the
+    scenes' sources, so that a source names one image)."""
+
+    images: Sequence[np.ndarray]
+    rotate: float = 0.0
+    tag: str = ""
+
+
 def pasted_scenes(
-    count: int, crops: Sequence[Sample], seed: int = CROPS_SEED
+    count: int, pool: CropPool, seed: int = CROPS_SEED
 ) -> Iterator[tuple[Frame, list[Box]]]:
     """``count`` synthetic 1280x720 daylight road scenes without a lit light (the crops are
     daylight photographs; the no-light generator of :mod:`mining`, drawn with ``seed``), each
-    with :data:`PER_SCENE` pasted ``crops`` (:func:`paste_crops`), and their housing boxes; a
-    deterministic function of the arguments.
+    with :data:`PER_SCENE` pasted crops of ``pool`` (:func:`paste_crops`), and their housing
+    boxes; a deterministic function of the arguments.
     """
     rng = np.random.default_rng(seed)
-    for frame in no_light_frames(count, seed, lighting=("day",), name="pasted-crops"):
-        boxes = paste_crops(frame.image, crops, rng)
+    name = f"pasted-crops{pool.tag}"
+    for frame in no_light_frames(count, seed, lighting=("day",), name=name):
+        boxes = paste_crops(frame.image, pool.images, rng, rotate=pool.rotate)
         yield frame, boxes
 
 
 def framed_scenes(
-    count: int, crops: Sequence[Sample], backgrounds: Sequence[Sample], seed: int = CROPS_SEED
+    count: int, pool: CropPool, backgrounds: Sequence[Sample], seed: int = CROPS_SEED
 ) -> Iterator[tuple[Frame, list[Box]]]:
     """``count`` real training frames (``backgrounds``, spread evenly over them, each kept
-    whole) with :data:`PER_SCENE` ``crops`` pasted clear of their own boxes, and all their
-    boxes (their own, then the pasted ones). A scene's pasting is seeded by ``seed``, its
-    index and its frame's source, so that its source names one image.
+    whole) with :data:`PER_SCENE` crops of ``pool`` pasted clear of their own boxes, and all
+    their boxes (their own, then the pasted ones). A scene's pasting is seeded by ``seed``, its
+    index and its frame's source, so that its source (with the pool's tag) names one image.
     """
     for k in range(count):
         sample = backgrounds[k * len(backgrounds) // count]
         image = sample.load().image.copy()
         own: list[Box] = [a.bbox for a in sample.annotations]
         rng = np.random.default_rng([seed, k, zlib.crc32(sample.source.encode())])
-        boxes = paste_crops(image, crops, rng, taken=own)
-        yield Frame(image, f"pasted-crops:{seed}:{k}:{sample.source}"), own + boxes
+        boxes = paste_crops(image, pool.images, rng, taken=own, rotate=pool.rotate)
+        source = f"pasted-crops{pool.tag}:{seed}:{k}:{sample.source}"
+        yield Frame(image, source), own + boxes
 
 
 def crop_samples() -> list[Sample]:
@@ -164,13 +197,61 @@ def crop_samples() -> list[Sample]:
     return sorted(samples, key=lambda s: s.source)
 
 
+def housing_crops(samples: Sequence[Sample]) -> list[tuple[str, np.ndarray]]:
+    """Every housing box of ``samples`` (:data:`HOUSING_ASPECT`, :data:`MIN_CROP`) cut out of
+    its frame, with a name (source and box) for the pool's tag."""
+    out = []
+    for sample in samples:
+        boxes = [a.bbox for a in sample.annotations]
+        long_enough = [
+            b
+            for b in boxes
+            if max(b[2] - b[0], b[3] - b[1]) >= HOUSING_ASPECT * min(b[2] - b[0], b[3] - b[1])
+            and min(b[2] - b[0], b[3] - b[1]) >= MIN_CROP
+        ]
+        if not long_enough:
+            continue
+        image = sample.load().image
+        height, width = image.shape[:2]
+        for b in long_enough:
+            x0, y0 = max(int(round(b[0])), 0), max(int(round(b[1])), 0)
+            x1, y1 = min(int(round(b[2])), width), min(int(round(b[3])), height)
+            if x1 - x0 >= MIN_CROP and y1 - y0 >= MIN_CROP:
+                out.append((f"{sample.source}{b}", image[y0:y1, x0:x1].copy()))
+    return out
+
+
+def crop_pool(training: Sequence[Sample] = (), rotate: float = 0.0) -> CropPool:
+    """MIT's train crops (:func:`crop_samples`), with the housings of ``training``
+    (:func:`housing_crops`), a share ``rotate`` of them turned when pasted.
+
+    Raises
+    ------
+    TsrkitError
+        The crop set is missing (:func:`crop_samples`).
+    """
+    images = [s.load().image for s in crop_samples()]
+    own = housing_crops(training)
+    tag = f"+up{ENLARGE:g}"
+    if own:
+        names = "".join(name for name, _ in own)
+        tag += f"+own{len(own)}.{zlib.crc32(names.encode()):08x}"
+    if rotate > 0:
+        tag += f"+turn{rotate:g}"
+    return CropPool(images + [image for _, image in own], rotate, tag)
+
+
 def crop_frames(
-    count: int, backgrounds: Sequence[Sample] = (), seed: int = CROPS_SEED
+    count: int,
+    backgrounds: Sequence[Sample] = (),
+    seed: int = CROPS_SEED,
+    training: Sequence[Sample] = (),
+    rotate: float = 0.0,
 ) -> Iterator[tuple[Frame, list[Box]]]:
-    """``count`` scenes with pasted real crops: synthetic (:func:`pasted_scenes`), or real
-    training frames when ``backgrounds`` are given (:func:`framed_scenes`). The crop set is
-    read now (not when the first scene is drawn), so a missing set fails before any training
-    work.
+    """``count`` scenes with pasted real crops (:func:`crop_pool` of ``training`` and
+    ``rotate``): synthetic (:func:`pasted_scenes`), or real training frames when
+    ``backgrounds`` are given (:func:`framed_scenes`). The crops are read now (not when the
+    first scene is drawn), so a missing set fails before any training work.
 
     Raises
     ------
@@ -179,6 +260,7 @@ def crop_frames(
     """
     if count <= 0:
         return iter(())
+    pool = crop_pool(training, rotate)
     if backgrounds:
-        return framed_scenes(count, crop_samples(), backgrounds, seed)
-    return pasted_scenes(count, crop_samples(), seed)
+        return framed_scenes(count, pool, backgrounds, seed)
+    return pasted_scenes(count, pool, seed)

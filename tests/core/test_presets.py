@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 import pytest
 from click.testing import CliRunner
 
@@ -10,6 +12,7 @@ from tsrkit.cli.main import cli
 from tsrkit.errors import TsrkitError
 from tsrkit.params import load_config
 from tsrkit.presets import describe, preset_names, preset_path, resolve_config
+from tsrkit.registry import get_registry
 
 
 def test_every_preset_loads_and_names_installed_plugins():
@@ -58,8 +61,11 @@ def test_recommended_verifier_model_was_trained_on_the_presets_candidates():
     preset = load_config("recommended")
     training = load_model(DEFAULT_MODEL, "verifier").meta["training"]["detector"]
     assert training["name"] == preset["detector"]["name"]
-    for key, value in preset["detector"]["params"].items():
-        assert training["params"][key] == value
+    # the model records the detector's validated parameters (members: their specs)
+    name, params = preset["detector"]["name"], preset["detector"]["params"]
+    detector = get_registry().create("detector", name, params)
+    for key in params:
+        assert json.loads(json.dumps(detector.params[key], default=str)) == training["params"][key]
 
 
 def test_detect_runs_the_recommended_preset_on_a_video(tmp_path):

@@ -16,6 +16,7 @@ REAL = [
     "lisa_vgis_bulb_crops",
     "gtsrb_test_35px_subset",
     "dtld_fridtjofs",
+    "iwai_japan_tl",
 ]
 
 
@@ -35,6 +36,17 @@ def test_repository_registry_lists_the_real_sets_and_sample(shared_datasets):
         assert entry.annotation_path().exists()
         assert (entry.root_path() / entry.manifest).is_file()
     assert registry["roboflow_traffic_light_kr"].states == {"left": "green"}
+
+
+def test_the_japanese_set_is_one_fold_of_horizontal_housings_not_exhaustive(shared_datasets):
+    dataset = open_dataset("iwai_japan_tl")
+    assert dataset.info["exhaustive"] is False and dataset.info["box"] == "housing"
+    boxes = [a.bbox for s in dataset.samples for a in s.annotations]
+    assert (len(dataset.samples), len(boxes)) == (453, 658)
+    wide = [b[2] - b[0] > b[3] - b[1] for b in boxes]
+    assert sum(wide) >= 0.95 * len(boxes)  # horizontal heads
+    states = {a.state for s in dataset.samples for a in s.annotations}
+    assert states == {"red", "yellow", "green", "unknown"}
 
 
 def test_relative_root_resolves_against_data_dir(tmp_path, monkeypatch):

@@ -106,6 +106,10 @@ def geometry_features(candidates, boxes, width, height):
     x, y, radius, score, fit, has_housing = xyrs.T
     hw = np.maximum(boxes[:, 2] - boxes[:, 0], 1e-3)
     hh = np.maximum(boxes[:, 3] - boxes[:, 1], 1e-3)
+    # the housing read upright (as the samples are): along its long side, across its short one
+    wide = hw > hh
+    along, across = np.where(wide, hw, hh), np.where(wide, hh, hw)
+    at_x, at_y = (x - boxes[:, 0]) / hw, (y - boxes[:, 1]) / hh
     best = float(np.max(np.abs(score))) or 1.0
     rank = np.empty(len(score))
     rank[np.argsort(-score, kind="stable")] = np.arange(len(score))
@@ -113,11 +117,11 @@ def geometry_features(candidates, boxes, width, height):
         [
             radius,
             radius / height,
-            hw / radius,
-            hh / radius,
-            np.log(hh / hw),
-            (x - boxes[:, 0]) / hw,
-            (y - boxes[:, 1]) / hh,
+            across / radius,
+            along / radius,
+            np.log(along / across),
+            np.where(wide, at_y, at_x),
+            np.where(wide, at_x, at_y),
             fit,
             has_housing,
             x / width,

@@ -115,3 +115,20 @@ def test_every_fitted_housing_holds_its_lens():
     cx, cy, _ = np.array(lenses).T  # and the candidate's own centre
     assert np.all((boxes[:, 0] <= cx) & (cx <= boxes[:, 2]))
     assert np.all((boxes[:, 1] <= cy) & (cy <= boxes[:, 3]))
+
+
+@pytest.mark.parametrize(
+    "frame,lens,box",
+    [
+        ("im1.jpg", (340.0, 184.0, 1.0), (328.0, 183.0, 358.0, 194.0)),
+        ("im11.jpg", (162.0, 238.0, 1.5), (159.0, 235.0, 172.0, 241.0)),
+    ],
+)
+def test_a_distant_lamp_keeps_a_housing_of_its_size(shared_datasets, frame, lens, box):
+    # union candidates on distant Japanese heads (800x600): a point (radius 1-1.5 px) on the
+    # lamp; the fit once took the ladder's 53-75 px steps for it (a housing 20x too large)
+    image = cv2.imread(str(shared_datasets / "iwai_japan_tl" / "images" / frame))
+    fitted, _, used = fit_housings(cv2.cvtColor(image, cv2.COLOR_BGR2GRAY), [lens])
+    x0, y0, x1, y1 = fitted[0]
+    assert used[0, 2] <= 16
+    assert max(x1 - x0, y1 - y0) <= 3 * (box[2] - box[0])

@@ -116,15 +116,35 @@ def test_colour_and_geometry_features_of_a_lit_red_lamp_in_its_housing():
     assert col["lens_L"] > col["annulus_L"] + 20  # the lit lens is brighter than its ring
     assert col["lens_a"] > 150  # red: Lab a well above neutral 128
     assert col["lens_hue_cos"] > 0.5  # hue near 0 (red), weighted by saturation
-    assert col["housing_h_radii"] == pytest.approx(10.0)
-    assert col["housing_w_radii"] == pytest.approx(20 / 6)
-    assert col["lens_y_in_housing"] == pytest.approx(1 / 6)
+    assert col["housing_along_radii"] == pytest.approx(10.0)
+    assert col["housing_across_radii"] == pytest.approx(20 / 6)
+    assert col["lens_along_in_housing"] == pytest.approx(1 / 6)
     assert col["housing_fit"] == pytest.approx(0.9)
     assert col["score_rank"] == 0 and rows[1, names.index("score_rank")] == 1
     # without a housing stage the lens context stands in: a 6-radius square
     assert rows[1, names.index("has_housing")] == 0
-    assert rows[1, names.index("housing_h_radii")] == pytest.approx(F.CONTEXT)
+    assert rows[1, names.index("housing_along_radii")] == pytest.approx(F.CONTEXT)
     assert F.candidate_features(image, []).shape == (0, len(names))
+
+
+def test_a_horizontal_head_reads_as_the_same_head_hung_vertically():
+    # the frame mirrored across its diagonal turns the vertical head horizontal (lamp at the
+    # left): the housing is read upright, so its geometry and colour columns are unchanged
+    image = lamp_scene()
+    lamp = dataclasses.replace(
+        Candidate.from_circle(80, 30, 6, 2.0), housing=(70, 20, 90, 80), housing_score=0.9
+    )
+    turned = dataclasses.replace(
+        Candidate.from_circle(30, 80, 6, 2.0), housing=(20, 70, 80, 90), housing_score=0.9
+    )
+    names = F.feature_names()
+    upright = F.candidate_features(image, [lamp])[0]
+    lying = F.candidate_features(np.ascontiguousarray(image.transpose(1, 0, 2)), [turned])[0]
+    same = [n for n in names if n.startswith("housing_") or n.startswith("lens_a")]
+    same += ["lens_across_in_housing", "lens_along_in_housing", "radius"]
+    for name in same:
+        assert lying[names.index(name)] == pytest.approx(upright[names.index(name)]), name
+    assert lying[names.index("x_over_width")] != upright[names.index("x_over_width")]
 
 
 def test_centre_labels_follow_zheng_and_no_light_frames_are_unlit():

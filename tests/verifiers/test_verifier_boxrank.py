@@ -18,8 +18,9 @@ from tsrkit_plugins.shared.persistence import BOX_ARRAY, load_estimator
 from tsrkit_plugins.verifiers import features as F
 from tsrkit_plugins.verifiers.mining import box_labels
 
-#: Two scenes of rendered heads: candidates on them whose housing fits and one whose misses.
-BOXED = dict(FAST, head_frames=2, box_rank=0.5)
+#: Two scenes of rendered heads (mostly vertical, no rims): candidates on them whose housing fits
+#: and one whose misses.
+BOXED = dict(FAST, head_frames=2, head_horizontal=0.2, head_rims=0.0, box_rank=0.5)
 
 
 @pytest.fixture(scope="module")

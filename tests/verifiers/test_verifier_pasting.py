@@ -14,11 +14,15 @@ from tsrkit.types import Annotation, Candidate, Sample
 from tsrkit_plugins.verifiers.mining import centre_labels
 from tsrkit_plugins.verifiers.pasting import (
     CROP_SET,
+    ENLARGE,
     FEATHER,
+    CropPool,
     crop_frames,
+    crop_pool,
     crop_samples,
     feathered_alpha,
     framed_scenes,
+    housing_crops,
     paste,
     paste_crops,
     pasted_scenes,
@@ -32,11 +36,12 @@ def head_crop(colour=(40, 40, 230)) -> np.ndarray:
     return crop
 
 
-def crops(n: int = 3) -> list[Sample]:
-    return [
-        Sample(f"crop{k}", (), 20, 40, "train", image=head_crop((40, 40 + 60 * k, 230)))
-        for k in range(n)
-    ]
+def crops(n: int = 3) -> list[np.ndarray]:
+    return [head_crop((40, 40 + 60 * k, 230)) for k in range(n)]
+
+
+def pool(n: int = 3, rotate: float = 0.0) -> CropPool:
+    return CropPool(crops(n), rotate, "+test")
 
 
 def test_feathered_alpha_ramps_every_side_and_is_opaque_inside():
@@ -64,7 +69,7 @@ def test_pasted_crops_lie_at_their_boxes_in_the_upper_frame_without_overlap():
     assert len(boxes) == 5
     for x0, y0, x1, y1 in boxes:
         height, width = y1 - y0, x1 - x0
-        assert 10 <= height <= 110 and y1 <= 0.55 * 720
+        assert 10 <= height <= min(110, ENLARGE * 40) and y1 <= 0.55 * 720
         assert width == pytest.approx(height / 2, abs=1)  # the crops' aspect
         inner = image[int(y0) + FEATHER : int(y1) - FEATHER, int(x0) + FEATHER : int(x1) - FEATHER]
         assert inner.any(axis=2).all()  # every inner pixel is the crop's (none is black)
@@ -81,9 +86,9 @@ def test_pasted_crops_lie_at_their_boxes_in_the_upper_frame_without_overlap():
 
 
 def test_scenes_are_a_function_of_the_seed():
-    first = list(pasted_scenes(2, crops(), seed=5))
-    again = list(pasted_scenes(2, crops(), seed=5))
-    other = list(pasted_scenes(2, crops(), seed=6))
+    first = list(pasted_scenes(2, pool(), seed=5))
+    again = list(pasted_scenes(2, pool(), seed=5))
+    other = list(pasted_scenes(2, pool(), seed=6))
     assert [f.source for f, _ in first] == [f.source for f, _ in again]
     for (a, boxes_a), (b, boxes_b) in zip(first, again):
         assert a.image.shape == (720, 1280, 3)
@@ -95,7 +100,7 @@ def test_the_crop_set_is_read_through_the_registry(shared_datasets):
     samples = crop_samples()
     assert len(samples) == 1187 and all(s.split == "train" for s in samples)
     frame, boxes = next(crop_frames(1))
-    assert frame.source.startswith("pasted-crops:") and len(boxes) == 5
+    assert frame.source.startswith("pasted-crops+up") and len(boxes) == 5
 
 
 def test_a_missing_crop_set_fails_training_at_once_with_one_clear_error(tmp_path, monkeypatch):
@@ -129,6 +134,7 @@ def test_training_reads_the_pasted_scenes(shared_datasets, tmp_path, backgrounds
 def test_the_defaults_are_the_measured_ones():
     params = make().params
     assert params["crop_frames"] == 80 and params["crop_backgrounds"] == "real"
+    assert params["crop_own"] and params["crop_rotate"] == 0.3
 
 
 def test_real_backgrounds_keep_their_boxes_and_take_crops_clear_of_them():
@@ -144,8 +150,8 @@ def test_real_backgrounds_keep_their_boxes_and_take_crops_clear_of_them():
         )
         for k in range(2)
     ]
-    scenes = list(framed_scenes(4, crops(), backgrounds, seed=5))
-    again = list(framed_scenes(4, crops(), backgrounds, seed=5))
+    scenes = list(framed_scenes(4, pool(), backgrounds, seed=5))
+    again = list(framed_scenes(4, pool(), backgrounds, seed=5))
     assert [f.source.rsplit(":", 1)[1] for f, _ in scenes] == ["frame0"] * 2 + ["frame1"] * 2
     for (frame, boxes), (same, boxes_again) in zip(scenes, again):
         assert np.array_equal(frame.image, same.image) and boxes == boxes_again
@@ -155,3 +161,38 @@ def test_real_backgrounds_keep_their_boxes_and_take_crops_clear_of_them():
             assert 6 <= y1 - y0 <= 64  # heights scaled to the 416 px frame
             assert x1 <= own[0] or own[2] <= x0 or y1 <= own[1] or own[3] <= y0
     assert not backgrounds[0].image.any()  # pasted into a copy
+
+
+def test_turned_crops_lie_across_and_are_named_apart():
+    image = np.zeros((720, 1280, 3), np.uint8)
+    boxes = paste_crops(image, crops(), np.random.default_rng(1), count=5, rotate=1.0)
+    assert boxes
+    for x0, y0, x1, y1 in boxes:  # the 20x40 crops, turned: twice as wide as tall
+        assert x1 - x0 == pytest.approx(2 * (y1 - y0), abs=1)
+    upright = next(pasted_scenes(1, pool(), seed=5))[0].source
+    turned = next(pasted_scenes(1, CropPool(crops(), 0.5, "+turn0.5"), seed=5))[0].source
+    assert upright != turned
+
+
+def test_training_housings_are_cut_out_and_lens_boxes_are_not():
+    image = np.zeros((100, 200, 3), np.uint8)
+    image[10:70, 20:40] = 90  # a 20x60 housing
+    housing, lens = (20.0, 10.0, 40.0, 70.0), (100.0, 10.0, 112.0, 22.0)
+    sample = Sample(
+        "f", (Annotation(housing, "red"), Annotation(lens, "red")), 200, 100, "train", image=image
+    )
+    ((name, crop),) = housing_crops([sample])
+    assert crop.shape == (60, 20, 3) and np.all(crop == 90) and name.startswith("f")
+
+
+def test_the_pool_names_its_training_housings(shared_datasets):
+    image = np.zeros((100, 200, 3), np.uint8)
+
+    def frame(box):
+        return Sample("f", (Annotation(box, "red"),), 200, 100, "train", image=image)
+
+    mit = crop_pool()
+    one = crop_pool([frame((20.0, 10.0, 40.0, 70.0))], rotate=0.3)
+    other = crop_pool([frame((22.0, 10.0, 42.0, 70.0))], rotate=0.3)
+    assert len(one.images) == len(mit.images) + 1 and one.rotate == 0.3
+    assert len({mit.tag, one.tag, other.tag}) == 3

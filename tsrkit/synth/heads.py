@@ -1,5 +1,7 @@
 """Signal heads of known geometry: a dark housing with 3 or 4 lenses, vertical or horizontal, one
-lamp lit, on a textured background (the test bed of the housing stage).
+lamp lit, on a textured background (the test bed of the housing stage and the verifier's rendered
+positives). A head may have a light rim around its dark face, as the horizontal heads of Japan's
+cameras show against dark hillsides.
 """
 
 from __future__ import annotations
@@ -9,10 +11,12 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-__all__ = ["LAMP_COLOURS", "Head", "background", "render_head", "scatter_heads"]
+__all__ = ["LAMP_COLOURS", "RIM_WIDTH", "Head", "background", "render_head", "scatter_heads"]
 
 #: BGR of lit lamps (a slightly orange red, amber, blue-green) by state.
 LAMP_COLOURS = {"red": (40, 40, 230), "yellow": (20, 170, 250), "green": (170, 230, 40)}
+#: Width of a light rim, in lens radii (the dark face is inset by it; cells stay 2.8 radii).
+RIM_WIDTH = 0.35
 
 
 @dataclass(frozen=True)
@@ -32,12 +36,14 @@ def render_head(
     vertical: bool = True,
     colour: tuple[int, int, int] = LAMP_COLOURS["red"],
     white_core: bool = False,
+    rim: tuple[int, int, int] | None = None,
 ) -> Head:
     """Draw a head whose lamp ``lit`` (0 = top or left) has its centre at ``centre``.
 
     The housing is ``2.8 radius`` across and ``2.8 radius`` per lens along its axis (cells as
-    wide as the housing), dark grey; unlit lenses are darker discs. Drawn in place on ``image``
-    with 4x sub-pixel precision.
+    wide as the housing), dark grey; unlit lenses are darker discs. With ``rim`` (a BGR colour)
+    the housing's outer :data:`RIM_WIDTH` radii are drawn in that colour around the dark face.
+    Drawn in place on ``image`` with 4x sub-pixel precision.
     """
     pitch = width = 2.8 * radius
     cx, cy = centre
@@ -52,15 +58,19 @@ def render_head(
     def fixed(v: float) -> int:
         return int(round(v * scale))
 
-    cv2.rectangle(
-        image,
-        (fixed(box[0]), fixed(box[1])),
-        (fixed(box[2]) - 1, fixed(box[3]) - 1),
-        (28, 28, 30),
-        -1,
-        cv2.LINE_AA,
-        shift,
-    )
+    inset = 0.0 if rim is None else RIM_WIDTH * radius
+    for fill, grow in ((rim, 0.0), ((28, 28, 30), inset)):
+        if fill is None:
+            continue
+        cv2.rectangle(
+            image,
+            (fixed(box[0] + grow), fixed(box[1] + grow)),
+            (fixed(box[2] - grow) - 1, fixed(box[3] - grow) - 1),
+            fill,
+            -1,
+            cv2.LINE_AA,
+            shift,
+        )
     for k in range(lenses):
         offset = (k - lit) * pitch
         x, y = (cx, cy + offset) if vertical else (cx + offset, cy)
@@ -93,15 +103,21 @@ def background(height: int, width: int, seed: int = 0) -> np.ndarray:
 
 
 def scatter_heads(
-    image: np.ndarray, rng: np.random.Generator, count: int = 5
+    image: np.ndarray,
+    rng: np.random.Generator,
+    count: int = 5,
+    horizontal: float = 0.2,
+    rims: float = 0.0,
 ) -> list[tuple[float, float, float, float]]:
     """Draw ``count`` jittered heads on ``image`` (in place, then blurred and gamma-jittered as a
     whole) and return their housing boxes: the verifier's rendered positives.
 
-    Each head: lens radius 2-12 px, 3 or 4 lenses, vertical 4 times in 5, any lamp lit, its
-    colour a :data:`LAMP_COLOURS` entry scaled 0.7-1.2 per channel, a white over-exposed core
-    2 times in 5, anywhere in the upper 55 % of the frame; then a Gaussian blur of sigma 0.7
-    (optics) and a gamma of 0.7-1.4 (exposure).
+    Each head: lens radius 2-12 px, 3 or 4 lenses, horizontal with probability ``horizontal``
+    (else vertical), any lamp lit, its colour a :data:`LAMP_COLOURS` entry scaled 0.7-1.2 per
+    channel, a white over-exposed core 2 times in 5, anywhere in the upper 55 % of the frame,
+    with probability ``rims`` a light grey rim (grey level 140-230); then a Gaussian blur of
+    sigma 0.7 (optics) and a gamma of 0.7-1.4 (exposure). ``rims`` 0 draws exactly what it
+    drew before the option existed (no extra random draw).
     """
     height, width = image.shape[:2]
     boxes = []
@@ -109,12 +125,17 @@ def scatter_heads(
         radius = float(rng.uniform(2, 12))
         lenses = int(rng.integers(3, 5))
         lit = int(rng.integers(0, lenses))
-        vertical = bool(rng.random() < 0.8)
+        vertical = bool(rng.random() < 1.0 - horizontal)
         base = np.array(list(LAMP_COLOURS.values())[int(rng.integers(0, 3))])
         blue, green, red = (int(c) for c in np.clip(base * rng.uniform(0.7, 1.2, 3), 0, 255))
         colour = (blue, green, red)
         centre = (float(rng.uniform(0.05, 0.95) * width), float(rng.uniform(0.05, 0.55) * height))
-        head = render_head(image, centre, radius, lenses, lit, vertical, colour, rng.random() < 0.4)
+        core = rng.random() < 0.4
+        rim = None
+        if rims > 0 and rng.random() < rims:
+            grey = int(rng.uniform(140, 230))
+            rim = (grey, grey, grey)
+        head = render_head(image, centre, radius, lenses, lit, vertical, colour, core, rim)
         boxes.append(head.housing)
     blurred = cv2.GaussianBlur(image, (0, 0), 0.7)
     gamma = rng.uniform(0.7, 1.4)

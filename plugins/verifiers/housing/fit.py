@@ -44,6 +44,10 @@ PITCHES = (0.65, 0.8, 1.0)
 #: Lens radii (px) tried besides the detector's own: many detectors (FRST, top-hat) give a centre
 #: but no reliable radius, and one lens radius is the unit of every layout.
 RADIUS_LADDER = (2.0, 3.0, 4.0, 6.0, 8.0, 11.0, 16.0, 23.0, 32.0, 45.0, 64.0)
+#: Largest ladder step tried around a detector's point (a candidate without a radius estimate
+#: whose lit lens was not measured either): a 16-px lens is a near head, which every detector
+#: gives a radius.
+POINT_REACH = 16.0
 #: Span of the ladder around the lens radius: a detector's radius (0.5-3x), or a measured lit
 #: lens's (0.6-1.8x: a large dark region several lens sizes away no longer wins).
 SPAN_GIVEN = (0.5, 3.0)
@@ -233,16 +237,20 @@ def keep_long(refined: np.ndarray, searched: np.ndarray) -> np.ndarray:
 
 
 def radius_options(r: np.ndarray, measured: np.ndarray) -> np.ndarray:
-    """(N, K) lens radii to try per candidate: its radius and 0.8 / 1.25 of it, and the
-    :data:`RADIUS_LADDER` steps within :data:`SPAN_MEASURED` of a measured lens's radius or
-    :data:`SPAN_GIVEN` of a detector's (all steps when that is below 2 px, a detector without
-    a radius estimate); unused slots are NaN."""
+    """(N, K) lens radii to try per candidate: its radius (and 0.8 / 1.25 of it when it was not
+    measured), and the :data:`RADIUS_LADDER` steps within :data:`SPAN_MEASURED` of a measured
+    lens's radius or :data:`SPAN_GIVEN` of a detector's; a detector's radius below 2 px (a
+    detector without a radius estimate) tries every step up to :data:`POINT_REACH` instead.
+    A measured lens below 2 px is a small lens, not a missing estimate: it keeps its span (a
+    1-px lamp of a distant head once reached the 64-px step, and a housing 20x its size).
+    Unused slots are NaN."""
     ladder = np.array(RADIUS_LADDER)[None, :]
     low = np.where(measured, SPAN_MEASURED[0], SPAN_GIVEN[0])[:, None] * r[:, None]
     high = np.where(measured, SPAN_MEASURED[1], SPAN_GIVEN[1])[:, None] * r[:, None]
-    steps = np.where((r[:, None] < 2) | ((ladder >= low) & (ladder <= high)), ladder, np.nan)
+    point = (r[:, None] < 2) & ~measured[:, None] & (ladder <= POINT_REACH)
+    steps = np.where(point | ((ladder >= low) & (ladder <= high)), ladder, np.nan)
     factors = np.where(measured[:, None], [np.nan, 1.0, np.nan], [0.8, 1.0, 1.25])
-    own = np.where(r[:, None] >= 2, r[:, None] * factors, np.nan)
+    own = np.where((r[:, None] >= 2) | measured[:, None], r[:, None] * factors, np.nan)
     return np.concatenate([own, steps], axis=1)
 
 
