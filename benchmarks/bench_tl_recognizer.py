@@ -7,6 +7,11 @@ machine load falls on all of them alike) and the per-frame recall and precision 
 runner measures on those frames. Usage: ``python benchmarks/bench_tl_recognizer.py
 [-p context=housing ...]``.
 
+``--cluttered N`` times the detector on the N most cluttered real frames at 1413x1884: of all
+frames of the KR, cinTA and Japan sets (``iwai_japan_tl``) stretched to that size, those with
+the most contours that survive pruning (city streets, signs, tail lights, foliage), against
+the detector of ``--baseline`` (its ``tl_recognizer.py``, interleaved, outputs compared).
+
 ``--reference`` instead times the detector against its straightforward version
 (``tl_recognizer_straightforward.py``) at 1280x720, separately on the road scenes and on
 synthetic cluttered scenes (``--blobs`` saturated red, yellow and green blobs of 2-23 px on a
@@ -132,6 +137,42 @@ def reference_comparison(
             )
 
 
+def cluttered_frames(count: int) -> list[Frame]:
+    """The ``count`` real frames with the most pruned contours at WIDTH x HEIGHT (module
+    docstring), most cluttered first."""
+    detector = tsrkit.detector("tl-recognizer")
+    ranked = []
+    for name in ("roboflow_traffic_light_kr", "roboflow_cinta_v2_id", "iwai_japan_tl"):
+        for sample in tsrkit.dataset(str(harness.data_dir() / name), format="normalized"):
+            image = cv2.resize(sample.load().image, (WIDTH, HEIGHT), interpolation=cv2.INTER_LINEAR)
+            ranked.append((len(detector.scored(Frame(image, sample.source))), sample.source))
+    ranked.sort(key=lambda item: (-item[0], item[1]))
+    frames = []
+    for contours, source in ranked[:count]:
+        image = cv2.resize(cv2.imread(source), (WIDTH, HEIGHT), interpolation=cv2.INTER_LINEAR)
+        frames.append(Frame(image, source))
+        print(f"  {contours:4d} contours  {Path(source).name}")
+    return frames
+
+
+def cluttered_comparison(params: dict, count: int, repeats: int, baseline: str) -> None:
+    """This tree's detector against ``baseline``'s on the cluttered real frames."""
+    print(f"the {count} most cluttered real frames at {WIDTH}x{HEIGHT}:")
+    frames = cluttered_frames(count)
+    detectors = {"this tree": tsrkit.detector("tl-recognizer", **params)}
+    if baseline:
+        detectors[baseline] = baseline_detector(baseline, params)
+        differ = sum(
+            detectors[baseline].detect(f) != detectors["this tree"].detect(f) for f in frames
+        )
+        print(f"frames whose candidates differ from {baseline}'s: {differ} of {len(frames)}")
+    cpu = interleaved_ms(detectors, frames, repeats, clock=time.process_time)
+    for key, ms in cpu.items():
+        print(
+            f"{key:>12}: {ms:.1f} ms CPU per frame (median over frames of the median of {repeats})"
+        )
+
+
 def stretched(dataset: Dataset) -> Dataset:
     """The dataset's frames and boxes resized to WIDTH x HEIGHT, held in memory."""
     samples = []
@@ -151,8 +192,9 @@ def stretched(dataset: Dataset) -> Dataset:
     return Dataset(f"{dataset.name}@{WIDTH}x{HEIGHT}", tuple(samples), dataset.format)
 
 
-def interleaved_ms(detectors: dict, frames, repeats: int) -> dict:
-    """Median over frames of each frame's median detection time (ms), per detector.
+def interleaved_ms(detectors: dict, frames, repeats: int, clock=time.perf_counter) -> dict:
+    """Median over frames of each frame's median detection time (ms, by ``clock``), per
+    detector.
 
     Every repetition of every frame runs all detectors back to back, so slow spells of a shared
     machine hit each of them, not whichever happened to be measured then.
@@ -162,9 +204,9 @@ def interleaved_ms(detectors: dict, frames, repeats: int) -> dict:
         times = {key: [] for key in detectors}
         for _ in range(repeats):
             for key, detector in detectors.items():
-                start = time.perf_counter()
+                start = clock()
                 (detector if callable(detector) else detector.detect)(frame)
-                times[key].append((time.perf_counter() - start) * 1000)
+                times[key].append((clock() - start) * 1000)
         for key in detectors:
             per_frame[key].append(statistics.median(times[key]))
     return {key: statistics.median(values) for key, values in per_frame.items()}
@@ -187,6 +229,9 @@ def main() -> None:
         help="detector parameter KEY=VALUE (repeatable)",
     )
     parser.add_argument("--reference", action="store_true", help="time against the reference")
+    parser.add_argument(
+        "--cluttered", type=int, default=0, metavar="N", help="time on the N most cluttered frames"
+    )
     harness.add_frames(parser, 5, help="frames per set (--reference)")
     parser.add_argument("--blobs", type=int, default=1500, help="blobs per cluttered scene")
     parser.add_argument(
@@ -195,6 +240,9 @@ def main() -> None:
     args = parser.parse_args()
     harness.announce()
     params = parsed(args.param)
+    if args.cluttered:
+        cluttered_comparison(params, args.cluttered, args.repeats, args.baseline)
+        return
     if args.reference:
         print(f"tl-recognizer params {params or 'default'}, {args.repeats} repetitions, one thread")
         reference_comparison(params, args.frames, args.blobs, args.repeats, args.baseline)

@@ -17,8 +17,9 @@ The names, by what they are for:
   :class:`Trainable`, :class:`Plugin`, :data:`hookimpl`;
 - parameters: :class:`Param`, :class:`ParamError`, :class:`Part`, :data:`PLUGIN_TYPES`,
   :func:`validate`, :func:`parse_assignments`;
-- types: :class:`Frame`, :class:`Candidate`, :class:`Detection`, :class:`Annotation`,
-  :class:`Sample`, :class:`Dataset`, :class:`Skipped`, :data:`STATES`,
+- types: :class:`Frame` (and its shared colour views, :class:`FrameViews`), :class:`Candidate`,
+  :class:`Detection`, :class:`Annotation`, :class:`Sample`, :class:`Dataset`, :class:`Skipped`,
+  :data:`STATES`,
   :class:`FrameRecord`, :class:`DetectionRecord`, :class:`RunResult`;
 - geometry: :data:`Box`, :func:`box_centre`, :func:`circle_box`, :func:`clip_box`,
   :func:`iou_matrix`, :func:`xywh_to_xyxy`, :func:`xyxy_to_xywh`;

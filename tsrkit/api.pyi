@@ -146,3 +146,6 @@ from tsrkit.types import (
     Sample as Sample,
     Skipped as Skipped,
 )
+from tsrkit.views import (
+    FrameViews as FrameViews,
+)

@@ -382,7 +382,7 @@ def _known_keys(mapping: Mapping[str, Any], known: Sequence[str], owner: str) ->
         if key not in known:
             close = difflib.get_close_matches(key, known, n=1)
             hint = f"; did you mean '{close[0]}'?" if close else ""
-            raise ParamError(f"{owner}: unknown key '{key}'{hint} (known: {', '.join(known)})")
+            raise ParamError(f"{owner}: unknown key {key!r}{hint} (known: {', '.join(known)})")
 
 
 def _string_keys(mapping: Mapping[Any, Any], owner: str) -> None:

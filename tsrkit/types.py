@@ -17,6 +17,7 @@ from tsrkit.files import not_regular
 from tsrkit.geometry import Box, box_centre, circle_box, inscribed_circle
 from tsrkit.images import ImageReadError, read_image
 from tsrkit.records import DetectionRecord
+from tsrkit.views import FrameViews
 
 __all__ = [
     "STATES",
@@ -146,6 +147,18 @@ class Frame:
     index: int = 0
     timestamp: float | None = None
     metadata: Mapping[str, Any] = field(default_factory=dict)
+    #: Colour conversions and per-pixel maps of ``image``, computed once for every stage
+    #: (:mod:`tsrkit.views`); a frame made with ``dataclasses.replace`` starts its own.
+    views: FrameViews = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "views", FrameViews(self.image))
+
+    def band(self, rows: int) -> Frame:
+        """The frame's upper ``rows`` rows, whose views slice what this frame's hold."""
+        upper = Frame(self.image[:rows], self.source, self.index, self.timestamp, self.metadata)
+        object.__setattr__(upper, "views", FrameViews(upper.image, parent=self.views))
+        return upper
 
     @property
     def height(self) -> int:

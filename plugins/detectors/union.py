@@ -25,14 +25,27 @@ parameters, and merges their candidates:
 Members are written ``NAME [KEY=VALUE ...]; NAME ...``, e.g.
 ``lab-frst top=15; conspicuity n_top=15``; values are checked by each member's own schema.
 
-**Default members** (:data:`DEFAULT_MEMBERS`): lab-frst binarises each symmetry map at
-``fraction`` of its maximum (Zheng 5.2.2: 0.5), so on a frame whose strongest dark spot is a
-blue sign or a patch of sky (a + b far below zero) the green lamps fall under the cut (a KR
-frame with two lit teal lamps on a dark head got 2 lab-frst candidates, neither on them). At
-``fraction=0.1`` the union's candidate recall on the test splits rises KR 0.82 -> 0.88, cinTA
-0.95 -> 0.95, DTLD 0.71 -> 0.91 (lights of radius 3-4 px 0.43 -> 0.86), synthetic 0.82 -> 0.95,
-at no cost in time (about 35 instead of 20 candidates per frame;
+**Default members** (:data:`DEFAULT_MEMBERS`, the recommended preset's): lab-frst binarises
+each symmetry map at ``fraction`` of its maximum (Zheng 5.2.2: 0.5), so on a frame whose
+strongest dark spot is a blue sign or a patch of sky (a + b far below zero) the green lamps fall
+under the cut (a KR frame with two lit teal lamps on a dark head got 2 lab-frst candidates,
+neither on them). At ``fraction=0.1`` the union's candidate recall on the test splits rises KR
+0.82 -> 0.88, cinTA 0.95 -> 0.95, DTLD 0.71 -> 0.91 (lights of radius 3-4 px 0.43 -> 0.86),
+synthetic 0.82 -> 0.95, at no cost in time (about 35 instead of 20 candidates per frame;
 ``benchmarks/candidate_recall.py --extra``, ``RESULTS.verifier.md``).
+
+**Members in the band above the horizon.** A member with ``scale_top=0.6`` searches the upper
+60 % of the rows only: a traffic light stands above the camera, so from a dash-cam it is seen
+above the horizon, near the middle row. Members at one band and scale run on one frame made for
+them, and every member reads the colour conversions of the one frame (:attr:`Frame.views`).
+The members ``lab-blob top=30 levels=2 scale_top=0.6; lab-frst top=15 fraction=0.1
+radii=1,2,3,4,5,6 scale=0.5 scale_top=0.6; adaboost-hsv max_boxes=10 scale=0.5`` (lab-blob for
+lenses of radius 1-4 px at full resolution in the band, lab-frst for radii 2-12 px on the
+half-size band, adaboost-hsv for large lamps anywhere at half size) find more lights than the
+default on every set, the smallest too, at a fraction of its time; what the band costs in
+recall against the whole frame, per member and set, and the times:
+``benchmarks/RESULTS.verifier.md``, ``benchmarks/RESULTS.detector_speed.md``. They are not the
+default while the shipped verifier model is trained on the default members' candidates.
 
 **Upscaled members** (multi-resolution, after Mascetti et al. 2016, 4.2, who run extraction
 and pruning on a resized frame; here the frame is enlarged so that 2-3 px lenses reach the
@@ -105,16 +118,30 @@ class ScaledMember:
     def __init__(self, detector: Detector, scale: float, top: float):
         self.detector, self.scale, self.top = detector, scale, top
 
-    def detect(self, frame: Frame) -> list[Candidate]:
-        """The member's candidates on the resized region, in ``frame``'s pixels."""
-        image = frame.image[: max(1, int(round(frame.height * self.top)))]
-        h, w = image.shape[:2]
-        size = (max(1, int(round(w * self.scale))), max(1, int(round(h * self.scale))))
-        if size == (w, h):
-            return self.detector.detect(replace(frame, image=image))
-        resized = cv2.resize(image, size, interpolation=cv2.INTER_LINEAR)
-        found = self.detector.detect(replace(frame, image=resized))
-        return [map_back(c, size[0] / w, size[1] / h) for c in found]
+    def view(self, frame: Frame, shared: dict) -> Frame:
+        """The frame the member runs on: ``frame``'s upper ``top`` share of rows
+        (:meth:`Frame.band`, sharing ``frame``'s colour views), resized by ``scale``. Made once
+        per band and size for all the members that ask with the same ``shared`` dict."""
+        rows = max(1, int(round(frame.height * self.top)))
+        size = (max(1, int(round(frame.width * self.scale))), max(1, int(round(rows * self.scale))))
+        if ("band", rows) not in shared:
+            shared["band", rows] = frame if rows == frame.height else frame.band(rows)
+        band = shared["band", rows]
+        if size == (band.width, band.height):
+            return band
+        if (rows, size) not in shared:
+            resized = cv2.resize(band.image, size, interpolation=cv2.INTER_LINEAR)
+            shared[rows, size] = replace(band, image=resized)
+        return shared[rows, size]
+
+    def detect(self, frame: Frame, shared: dict | None = None) -> list[Candidate]:
+        """The member's candidates on its :meth:`view` of ``frame``, in ``frame``'s pixels."""
+        view = self.view(frame, {} if shared is None else shared)
+        found = self.detector.detect(view)
+        rows = max(1, int(round(frame.height * self.top)))
+        if (view.width, view.height) == (frame.width, rows):
+            return found
+        return [map_back(c, view.width / frame.width, view.height / rows) for c in found]
 
 
 def rank_scores(count: int) -> np.ndarray:
@@ -128,21 +155,24 @@ def merge(
     """Merge best-first candidate lists (one per member) by the module's rules, best first;
     ``reach_by`` names which of two radii sets the merging distance (``larger`` or
     ``smaller``)."""
-    pick = max if reach_by == "larger" else min
+    pick_radius = np.maximum if reach_by == "larger" else np.minimum
     pool = []  # (rank score, member, candidate)
     for member, candidates in enumerate(lists):
         ordered = sorted(candidates, key=lambda c: -c.score)
         pool += [(s, member, c) for s, c in zip(rank_scores(len(ordered)), ordered)]
     pool.sort(key=lambda item: (-item[0], item[1]))
     kept: list[tuple[Candidate, dict[int, float], list[float]]] = []
+    at = np.empty((len(pool), 3))  # kept candidates' x, y and own radius, in kept order
     for score, member, c in pool:
-        for other, votes, radii in kept:
-            reach = max(factor * pick(c.radius, other.radius), min_distance)
-            if np.hypot(c.x - other.x, c.y - other.y) <= reach:
-                votes.setdefault(member, score)
-                radii.append(c.radius)
-                break
+        n = len(kept)
+        reach = np.maximum(factor * pick_radius(c.radius, at[:n, 2]), min_distance)
+        near = np.flatnonzero(np.hypot(c.x - at[:n, 0], c.y - at[:n, 1]) <= reach)
+        if len(near):  # the first kept candidate within reach, as a loop over them finds it
+            _, votes, radii = kept[near[0]]
+            votes.setdefault(member, score)
+            radii.append(c.radius)
         else:
+            at[n] = c.x, c.y, c.radius
             kept.append((c, {member: score}, [c.radius]))
     share = 1.0 / max(len(lists), 1)
     merged = [
@@ -210,8 +240,10 @@ class Union(Detector):
             raise ParamError(f"union: member {twice[0]!r} given twice at the same scale")
 
     def detect(self, frame: Frame) -> list[Candidate]:
-        """Every member's candidates, merged; scores in [0, 1]."""
-        lists = [member.detect(frame) for member in self.members]
+        """Every member's candidates, merged; scores in [0, 1]. Members at one band and
+        scale run on one frame made for them, and all share ``frame``'s colour views."""
+        shared: dict = {}
+        lists = [member.detect(frame, shared) for member in self.members]
         p = self.params
         return merge(lists, p["merge"], p["min_distance"], p["reach_by"])
 

@@ -56,7 +56,8 @@ def complete(words: str) -> list[str]:
 def test_shell_completion_offers_plugin_dataset_and_preset_names():
     assert "gray-tophat" in complete("tsrkit detect -d gray")
     assert complete("tsrkit detect -c ab-") == ["ab-hist"]
-    assert complete("tsrkit compare --detectors conspicuity,lab-") == ["conspicuity,lab-frst"]
+    assert complete("tsrkit compare --detectors conspicuity,lab-f") == ["conspicuity,lab-frst"]
+    assert "conspicuity,lab-blob" in complete("tsrkit compare --detectors conspicuity,lab-")
     assert "ab-hist" in complete("tsrkit train ")
     assert "gray-tophat" not in complete("tsrkit train ")
     assert complete("tsrkit benchmark --dataset roboflow_traffic") == ["roboflow_traffic_light_kr"]

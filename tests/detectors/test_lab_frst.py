@@ -5,22 +5,17 @@ from __future__ import annotations
 import cv2
 import numpy as np
 import pytest
+from oracles.frst_arrays import frst_arrays
+from oracles.lamps import street
 
 import tsrkit
+from tsrkit.datasets import open_dataset
+from tsrkit.synth import SynthOptions, render_frame
 from tsrkit.types import Frame
 from tsrkit_plugins.detectors.frst.lab_frst import lab_feature_map, spot_candidates
 
 RED = (40, 40, 235)
 GREEN = (170, 230, 40)
-
-
-def street(lamps=(), size=(120, 160)) -> Frame:
-    """A grey frame with a darker housing band and lit discs ``(x, y, radius, bgr)``."""
-    image = np.full((*size, 3), 95, np.uint8)
-    cv2.rectangle(image, (10, 20), (150, 60), (35, 35, 35), -1)
-    for x, y, radius, colour in lamps:
-        cv2.circle(image, (x, y), radius, colour, -1, lineType=cv2.LINE_AA)
-    return Frame(image, "synthetic")
 
 
 def nearest(candidates, x, y):
@@ -81,3 +76,41 @@ def test_spot_candidates_rank_by_peak_and_binarise_at_the_fraction():
 def test_rejects_non_bgr_images():
     with pytest.raises(ValueError, match="BGR uint8"):
         lab_feature_map(np.zeros((10, 10), np.uint8))
+
+
+@pytest.fixture(scope="module")
+def oracle_frames(shared_datasets):
+    """Real frames of four cameras (a 1280x720 cut of a 1280x960 Japanese dash-cam frame
+    among them) and a rendered 1280x720 scene."""
+    frames = []
+    for name, size in (
+        ("roboflow_traffic_light_kr", None),
+        ("dtld_fridtjofs", None),
+        ("roboflow_cinta_v2_id", None),
+        ("iwai_japan_tl", (1280, 960)),
+    ):
+        samples = open_dataset(shared_datasets / name, format="normalized")
+        sample = next(s for s in samples if size is None or (s.width, s.height) == size)
+        image = sample.load().image
+        frames.append(image[120:840] if size else image)
+    frames += [render_frame(seed, 11, 1280, 720, SynthOptions())[0] for seed in (1,)]
+    return frames
+
+
+def test_candidates_equal_those_of_the_array_transform(oracle_frames):
+    """The detector's candidates (positions, radii, scores, states) at the defaults and at the
+    union's setting are those of the whole-image array transform, bit for bit."""
+    settings = ({}, {"top": 15, "fraction": 0.1})
+    for image in oracle_frames:
+        feature = lab_feature_map(image)
+        args = dict(radii=tuple(range(1, 11)), alpha=3.0, beta=0.0)
+        bright = frst_arrays(np.maximum(feature, 0), mode="bright", **args)
+        dark = -frst_arrays(np.minimum(feature, 0), mode="dark", **args)
+        for params in settings:
+            detector = tsrkit.detector("lab-frst", **params)
+            p = detector.params
+            expected = spot_candidates(bright, p["fraction"], p["top"], "red")
+            expected += spot_candidates(dark, p["fraction"], p["top"], "green")
+            found = detector.detect(Frame(image, "oracle"))
+            assert found == sorted(expected, key=lambda c: -c.score)
+            assert len(found) >= 2

@@ -1,6 +1,7 @@
 """The ``union`` detector: members built by the core, rank-normalised scores, duplicate
 suppression."""
 
+import cv2
 import numpy as np
 import pytest
 
@@ -167,3 +168,86 @@ def test_an_upscaled_member_finds_a_small_lamp_its_full_scale_twin_misses():
 
     assert nearest("conspicuity n_top=15") > 5
     assert nearest("conspicuity n_top=15 scale=2") < 1
+
+
+def test_members_at_one_band_and_scale_share_one_frame_and_its_colour_views():
+    """The union makes each band and size once: members there get the same frame object, and
+    a band reads the whole frame's colour views; each member's candidates are those it finds
+    on its own."""
+    members = (
+        "lab-frst top=15; lab-blob scale_top=0.6; tl-recognizer scale_top=0.6; "
+        "lab-blob scale=0.5; lab-frst top=15 scale=0.5"
+    )
+    union = get_registry().create("detector", "union", {"members": members})
+    image = background(240, 320, seed=2)
+    render_head(image, (160.0, 90.0), 6, 3, 0)
+    frame = Frame(image, "head")
+    shared: dict = {}
+    views = [m.view(frame, shared) for m in union.members]
+    assert views[0] is frame and views[1] is views[2] and views[3] is views[4]
+    assert views[1].height == 144 and views[3].width == 160
+    assert views[1].views._parent is frame.views and views[3].views is not frame.views
+    alone = [m.detect(frame) for m in union.members]
+    assert alone == [m.detect(frame, shared) for m in union.members]
+    assert union.detect(frame) == merge(alone, 1.0, 3.0)
+
+
+def merged_by_loop(lists, factor, min_distance, reach_by):
+    """The merging rule candidate by candidate against each kept one, in Python floats."""
+    pick = max if reach_by == "larger" else min
+    pool = []
+    for member, candidates in enumerate(lists):
+        ordered = sorted(candidates, key=lambda c: -c.score)
+        pool += [(1.0 - k / len(ordered), member, c) for k, c in enumerate(ordered)]
+    pool.sort(key=lambda item: (-item[0], item[1]))
+    kept = []
+    for score, member, c in pool:
+        for other, votes, radii in kept:
+            if np.hypot(c.x - other.x, c.y - other.y) <= max(
+                factor * pick(c.radius, other.radius), min_distance
+            ):
+                votes.setdefault(member, score)
+                radii.append(c.radius)
+                break
+        else:
+            kept.append((c, {member: score}, [c.radius]))
+    return [(c.x, c.y, max(r), sum(v.values()) / len(lists)) for c, v, r in kept]
+
+
+@pytest.mark.parametrize("reach_by", ["larger", "smaller"])
+def test_merge_keeps_what_the_candidate_by_candidate_rule_keeps(reach_by):
+    rng = np.random.default_rng(len(reach_by))
+    for _ in range(100):
+        lists = [
+            [
+                Candidate.from_circle(
+                    *rng.uniform(0, 150, 2), rng.choice([0.5, 2, 6]), rng.random()
+                )
+                for _ in range(rng.integers(0, 25))
+            ]
+            for _ in range(4)
+        ]
+        found = [(c.x, c.y, c.radius, c.score) for c in merge(lists, 1.0, 3.0, reach_by)]
+        expected = merged_by_loop(lists, 1.0, 3.0, reach_by)
+        assert sorted(found, key=lambda t: (-t[3], t[0], t[1])) == sorted(
+            expected, key=lambda t: (-t[3], t[0], t[1])
+        )
+
+
+def test_members_on_one_frame_and_its_band_convert_it_to_lab_once(monkeypatch):
+    """lab-frst and lab-blob on the whole frame and lab-blob on its upper band: one CIELab
+    conversion and one L*(a+b) map for the three (the band slices the frame's); a member at
+    another size converts its own frame once."""
+    conversions = []
+    convert = cv2.cvtColor
+
+    def counted(image, code, *args):
+        conversions.append((code, image.shape[:2]))
+        return convert(image, code, *args)
+
+    monkeypatch.setattr(cv2, "cvtColor", counted)
+    image = background(240, 320, seed=5)
+    render_head(image, (100.0, 60.0), 3, 3, 0)
+    members = "lab-frst top=15; lab-blob; lab-blob levels=3 scale_top=0.6; lab-frst scale=0.5"
+    union(members).detect(Frame(image, "head"))
+    assert conversions == [(cv2.COLOR_BGR2Lab, (240, 320)), (cv2.COLOR_BGR2Lab, (120, 160))]

@@ -1,11 +1,12 @@
-"""Synthetic lamps for the state-classifier tests: lit disks on a dark housing, as samples."""
+"""Synthetic lamps: lit disks on a dark housing, as samples (state-classifier tests) or on a
+street frame (detector tests)."""
 
 from __future__ import annotations
 
 import cv2
 import numpy as np
 
-from tsrkit.types import Annotation, Sample
+from tsrkit.types import Annotation, Frame, Sample
 
 #: Pure lamp colours (BGR) as a camera roughly images them.
 COLOURS = {"red": (40, 30, 230), "yellow": (20, 200, 240), "green": (170, 220, 30)}
@@ -55,3 +56,12 @@ def training_set(per_state: int = 4, radii=(5, 7, 9)) -> list[Sample]:
                 crop_sample(lamp(colour, size=2 * r, radius=r, seed=i), state, f"{state}{i}")
             )
     return samples
+
+
+def street(lamps=(), size=(120, 160)) -> Frame:
+    """A grey frame with a darker housing band and lit discs ``(x, y, radius, bgr)``."""
+    image = np.full((*size, 3), 95, np.uint8)
+    cv2.rectangle(image, (10, 20), (150, 60), (35, 35, 35), -1)
+    for x, y, radius, colour in lamps:
+        cv2.circle(image, (x, y), radius, colour, -1, lineType=cv2.LINE_AA)
+    return Frame(image, "synthetic")

@@ -1,11 +1,18 @@
-"""The fast radial symmetry transform of Loy & Zelinsky (2003), vectorised with NumPy and OpenCV.
+"""The fast radial symmetry transform of Loy & Zelinsky (2003), with compiled voting.
 
 Every pixel with a strong enough gradient votes for the pixels ``n`` steps along (and against)
 its gradient direction; the votes, clipped and sharpened, are smoothed and summed over radii.
-Reusable: any detector may call :func:`frst` on a 2-D float map. The votes are cast by a
-compiled loop (:func:`cast_votes`) that finds each affected pixel and adds to it in one pass, with
-no per-radius index arrays; it sums in the order ``np.bincount`` does, so the transform is the
-same to the last bit.
+Reusable: any detector may call :func:`frst` on a 2-D float map.
+
+How it is computed: the voters (:func:`select_voters`) are listed once, in raster order. For
+each radius a compiled pass (:func:`radial_strength_map`) walks them row by row and adds each
+vote to a ring buffer that holds only the ``2n + 1`` rows a voter row can reach; a row whose
+votes are all in (``n`` voter rows later) is turned into F_n and cleared, so the accumulators
+stay in the processor's cache instead of spanning the frame. Each affected pixel receives its
+votes in voter order, the order ``np.bincount`` sums in, and F_n is formed from the same
+float64 values as the per-pixel NumPy expressions: the transform is the same to the last bit
+as the plain array version (``tests/oracles/frst_oracle.py`` checks meaning, the tests of
+``tests/detectors/test_frst.py`` check the bits against the earlier vectorised code).
 
 Source: G. Loy and A. Zelinsky, "Fast radial symmetry for detecting points of interest",
 IEEE PAMI 25(8), 2003: the definition of the transform and its refinements
@@ -19,7 +26,6 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from functools import reduce
 
 import cv2
 import numpy as np
@@ -27,34 +33,26 @@ from numba import njit
 
 #: Which affected pixels receive votes: both, positively-affected only, negatively-affected only.
 MODES = ("both", "bright", "dark")
+#: The signs of the affected pixels each mode votes at (p+ve is +1, p-ve is -1).
+SIGNS = {"both": (1, -1), "bright": (1,), "dark": (-1,)}
 
 
 @dataclass(frozen=True)
 class Voters:
     """The pixels whose gradient takes part in the vote (``||g|| > beta * max ||g||``).
 
-    Votes are cast on a working grid that pads the image by ``pad`` pixels on every side, so
-    that a vote leaving the image needs no bounds check: it lands in the margin, which is cut
-    away afterwards. ``index`` is each voter's flat index on that grid, ``ux``/``uy`` its unit
-    gradient, ``magnitude`` the norm ``||g(p)||``; ``shape`` is the image shape.
+    In raster order: ``row`` and ``col`` are each voter's pixel, ``ux``/``uy`` its unit
+    gradient, ``magnitude`` the norm ``||g(p)||``; the voters of image row ``r`` are
+    ``starts[r]:starts[r + 1]``. ``shape`` is the image shape.
     """
 
-    index: np.ndarray
+    row: np.ndarray
+    col: np.ndarray
     ux: np.ndarray
     uy: np.ndarray
     magnitude: np.ndarray
+    starts: np.ndarray
     shape: tuple[int, int]
-    pad: int
-
-    @property
-    def grid(self) -> tuple[int, int]:
-        """Shape of the padded working grid."""
-        return self.shape[0] + 2 * self.pad, self.shape[1] + 2 * self.pad
-
-    def crop(self, flat: np.ndarray) -> np.ndarray:
-        """The image part of a flat array over the working grid, as a 2-D view."""
-        height, width = self.shape
-        return flat.reshape(self.grid)[self.pad : self.pad + height, self.pad : self.pad + width]
 
 
 def sobel_gradient(image: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -68,38 +66,124 @@ def sobel_gradient(image: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return gx, gy
 
 
-def select_voters(gx: np.ndarray, gy: np.ndarray, beta: float, pad: int) -> Voters:
+@njit(cache=True, nogil=True)
+def _list_voters(gx, gy, magnitude, limit):
+    """Raster-order arrays of the pixels whose ``magnitude`` exceeds ``limit`` (and row starts)."""
+    height, width = gx.shape
+    row = np.empty(height * width, np.int32)
+    col = np.empty(height * width, np.int32)
+    ux = np.empty(height * width)
+    uy = np.empty(height * width)
+    mag = np.empty(height * width)
+    starts = np.empty(height + 1, np.intp)
+    i = 0
+    for r in range(height):
+        starts[r] = i
+        for c in range(width):
+            m = magnitude[r, c]
+            if m > limit:
+                row[i], col[i], mag[i] = r, c, m
+                ux[i] = gx[r, c] / m
+                uy[i] = gy[r, c] / m
+                i += 1
+    starts[height] = i
+    return row[:i], col[:i], ux[:i], uy[:i], mag[:i], starts
+
+
+def select_voters(gx: np.ndarray, gy: np.ndarray, beta: float) -> Voters:
     """Keep the pixels whose gradient norm exceeds ``beta`` times the largest one.
 
     This is Loy & Zelinsky's gradient threshold beta for ignoring small gradients, read as a
     fraction of the image's largest gradient norm; zero gradients never vote, whatever beta.
-    ``pad`` must be at least the largest radius. The gradients are zero-padded to the working
-    grid first, so the selected flat indices are already grid indices.
+    The norm is OpenCV's ``magnitude``; the unit gradient is ``g / ||g||`` in float64.
     """
-    shape = gx.shape
-    gx = cv2.copyMakeBorder(gx, pad, pad, pad, pad, cv2.BORDER_CONSTANT).ravel()
-    gy = cv2.copyMakeBorder(gy, pad, pad, pad, pad, cv2.BORDER_CONSTANT).ravel()
-    magnitude = cv2.magnitude(gx, gy).ravel()
-    index = np.flatnonzero(magnitude > beta * float(magnitude.max()))
-    mag = magnitude[index]
-    return Voters(index, gx[index] / mag, gy[index] / mag, mag, shape, pad)
+    magnitude = cv2.magnitude(gx, gy)
+    limit = beta * float(magnitude.max())
+    row, col, ux, uy, mag, starts = _list_voters(gx, gy, magnitude, limit)
+    return Voters(row, col, ux, uy, mag, starts, (gx.shape[0], gx.shape[1]))
 
 
 @njit(cache=True, nogil=True)
-def cast_votes(index, ux, uy, magnitude, n, width, sign, counts, sums):
-    """Add one vote per voter at its affected pixel ``p +- round(g(p)/||g(p)|| * n)``.
+def cast_votes(row, col, ux, uy, magnitude, lo, hi, n, sign, slot_of, span, counts, sums, index):
+    """Add the votes of voters ``lo:hi`` (all in one image row) at ``p + sign * round(u n)``.
 
-    ``sign=+1`` votes at the positively-affected pixels p+ve, ``-1`` at the negatively-affected
-    p-ve; ``round`` is to the nearest integer with ties to even (``np.rint``). ``counts[q]``
-    gains 1 and ``sums[q]`` gains ``||g(p)||`` for every voter whose affected pixel is the flat
-    grid index ``q`` (several voters hitting one pixel all count), in voter order, so the sums
-    are those ``np.bincount`` would give. O_n and M_n are ``sign`` times these.
+    ``round`` is to the nearest integer with ties to even (``np.rint``). ``counts`` and
+    ``sums`` are flat ring buffers of rows of ``span`` pixels: image row ``row + d`` lives in
+    slot ``slot_of[d + n]``, column ``x`` at ``x + n``. Each affected pixel gains 1 and
+    ``||g(p)||`` per voter, in voter order (so the sums are those ``np.bincount`` gives); O_n
+    and M_n are ``sign`` times these. ``index`` is scratch space for the row's targets.
     """
-    for i in range(index.shape[0]):
-        step = np.rint(uy[i] * n) * width + np.rint(ux[i] * n)
-        target = index[i] + sign * np.intp(step)
-        counts[target] += 1
-        sums[target] += magnitude[i]
+    for i in range(lo, hi):
+        dy = sign * np.intp(np.rint(uy[i] * n))
+        dx = sign * np.intp(np.rint(ux[i] * n))
+        index[i - lo] = slot_of[dy + n] * span + col[i] + dx + n
+    for i in range(hi - lo):
+        counts[index[i]] += 1
+    for i in range(hi - lo):
+        sums[index[i]] += magnitude[lo + i]
+
+
+@njit(cache=True, nogil=True)
+def emit_row(counts, sums, signs, start, table, signed, out):
+    """F_n of one image row from its ring-buffer row (flat offset ``start``), into ``out``.
+
+    Per pixel ``O_n = counts(+) - counts(-)`` and ``M_n = sums(+) + (-sums(-))``, as NumPy adds
+    the signed parts; F_n is ``table[min(|O_n|, len(table) - 1)]`` times ``M_n``
+    (:func:`radial_strength`) or, when ``signed``, times ``sign(O_n)``
+    (:func:`orientation_strength`), rounded to float32 once.
+    """
+    top = table.shape[0] - 1
+    if signs.shape[0] == 1:  # the common case, one polarity: a loop without branches
+        c, s, sign = counts[0], sums[0], signs[0]
+        for x in range(out.shape[0]):
+            level = table[min(c[start + x], top)]
+            if signed:
+                out[x] = np.float32(sign * np.sign(c[start + x]) * level)
+            else:
+                out[x] = np.float32(level * (sign * s[start + x]))
+        return
+    for x in range(out.shape[0]):
+        orientation = counts[0, start + x] - counts[1, start + x]
+        projection = sums[0, start + x] + -sums[1, start + x]
+        level = table[min(abs(orientation), top)]
+        out[x] = np.float32(np.sign(orientation) * level if signed else level * projection)
+
+
+@njit(cache=True, nogil=True)
+def radial_strength_map(row, col, ux, uy, magnitude, starts, n, signs, table, signed, out):
+    """F_n of every image pixel into ``out`` (float32, the image shape), for radius ``n``.
+
+    ``signs`` holds the affected pixels voted at (+1: p+ve, -1: p-ve; both: ``(1, -1)``).
+    Voter rows are cast in order (:func:`cast_votes`) into a ring of ``2n + 1`` rows; image row
+    ``y`` is complete once voter row ``y + n`` is in, and is then emitted (:func:`emit_row`)
+    and cleared.
+    """
+    height, width = out.shape
+    slots = 2 * n + 1
+    span = width + 2 * n
+    counts = np.zeros((signs.shape[0], slots * span), np.int32)
+    sums = np.zeros((signs.shape[0], slots * span))
+    longest = 1
+    for r in range(height):
+        longest = max(longest, starts[r + 1] - starts[r])
+    index = np.empty(longest, np.intp)
+    slot_of = np.empty(slots, np.intp)
+    for step in range(height + 2 * n):
+        if step < height:
+            for d in range(-n, n + 1):
+                slot_of[d + n] = (step + d) % slots
+            for k in range(signs.shape[0]):
+                lo, hi = starts[step], starts[step + 1]
+                cast_votes(
+                    row, col, ux, uy, magnitude, lo, hi, n, signs[k], slot_of, span,
+                    counts[k], sums[k], index,
+                )  # fmt: skip
+        done = step - n  # no voter row after ``step`` reaches image row ``done``
+        start = (done % slots) * span
+        if 0 <= done < height:
+            emit_row(counts, sums, signs, start + n, table, signed, out[done])
+        counts[:, start : start + span] = 0
+        sums[:, start : start + span] = 0.0
 
 
 def kappa(n: int) -> float:
@@ -107,27 +191,29 @@ def kappa(n: int) -> float:
     return 8.0 if n == 1 else 9.9
 
 
-def clipped_orientation(orientation: np.ndarray, k: float) -> np.ndarray:
-    """O~_n: O_n where ``|O_n| < k_n``, else ``k_n * sign(O_n)``."""
-    return np.sign(orientation) * np.minimum(np.abs(orientation), k)
+def strength_levels(k: float, alpha: float, magnitude: bool) -> np.ndarray:
+    """F_n per clipped vote count ``|O~_n|`` = 0, 1, ..., ceil(k_n).
+
+    With ``magnitude``: ``(|O~_n| / k_n) ** alpha / k_n``, the factor of M_n in
+    F_n = (M_n / k_n) (|O~_n| / k_n) ** alpha; else ``(|O~_n| / k_n) ** alpha``, the
+    orientation-based F_n up to its sign. O_n holds integer counts, so these values are all
+    F_n needs: computed once and looked up, they are the numbers the power gives per pixel.
+    """
+    levels = np.arange(math.ceil(k) + 1)
+    table = (np.minimum(levels, k) / k) ** alpha
+    return table / k if magnitude else table
 
 
 def radial_strength(
     magnitude: np.ndarray, orientation: np.ndarray, k: float, alpha: float
 ) -> np.ndarray:
-    """F_n = (M_n / k_n) * (|O~_n| / k_n) ** alpha.
+    """F_n = (M_n / k_n) * (|O~_n| / k_n) ** alpha, with O~_n = O_n clipped to ``[-k_n, k_n]``.
 
-    O_n holds integer vote counts, so ``(|O~_n| / k_n) ** alpha / k_n`` takes at most
-    ``ceil(k_n) + 1`` values: they are computed once and looked up, which gives the same numbers
-    as the power.
+    Array version of what :func:`radial_strength_map` computes per pixel.
     """
-    levels = np.arange(math.ceil(k) + 1)
-    table = (np.minimum(levels, k) / k) ** alpha / k
-    counts = np.abs(orientation)
-    np.minimum(counts, levels[-1], out=counts)
-    strength = np.take(table, counts)
-    strength *= magnitude
-    return strength
+    table = strength_levels(k, alpha, magnitude=True)
+    counts = np.minimum(np.abs(orientation), len(table) - 1)
+    return np.take(table, counts) * magnitude
 
 
 def orientation_strength(orientation: np.ndarray, k: float, alpha: float) -> np.ndarray:
@@ -136,8 +222,9 @@ def orientation_strength(orientation: np.ndarray, k: float, alpha: float) -> np.
     The orientation-based variant Loy & Zelinsky describe: gradient magnitude is ignored, so the
     result does not change when the image contrast is scaled.
     """
-    clipped = clipped_orientation(orientation, k)
-    return np.sign(clipped) * (np.abs(clipped) / k) ** alpha
+    table = strength_levels(k, alpha, magnitude=False)
+    counts = np.minimum(np.abs(orientation), len(table) - 1)
+    return np.sign(orientation) * np.take(table, counts)
 
 
 def gaussian_kernel(n: int) -> np.ndarray:
@@ -147,11 +234,9 @@ def gaussian_kernel(n: int) -> np.ndarray:
 
 
 def spread(strength: np.ndarray, n: int) -> np.ndarray:
-    """S_n = F_n * A_n: separable Gaussian smoothing, zero outside the image."""
+    """S_n = F_n * A_n: separable Gaussian smoothing of float32 F_n, zero outside the image."""
     kernel = gaussian_kernel(n).astype(np.float32)
-    return cv2.sepFilter2D(
-        strength.astype(np.float32), cv2.CV_32F, kernel, kernel, borderType=cv2.BORDER_CONSTANT
-    )
+    return cv2.sepFilter2D(strength, cv2.CV_32F, kernel, kernel, borderType=cv2.BORDER_CONSTANT)
 
 
 def check_frst_args(
@@ -213,37 +298,24 @@ def frst(
     """
     image = np.asarray(image, dtype=np.float32)
     check_frst_args(image, radii, alpha, beta, mode)
-    voters = select_voters(*sobel_gradient(image), beta, max(radii))
-    signs = {"both": (1, -1), "bright": (1,), "dark": (-1,)}[mode]
+    voters = select_voters(*sobel_gradient(image), beta)
+    signs = np.array(SIGNS[mode], np.intp)
     total = np.zeros(image.shape, np.float32)
-    for n in radii:
-        orientation, magnitude = projections(voters, int(n), signs)
-        k = kappa(int(n))
-        strength = (
-            orientation_strength(orientation, k, alpha)
-            if orientation_only
-            else radial_strength(magnitude, orientation, k, alpha)
-        )
-        total += spread(voters.crop(strength), int(n))
-    return total
-
-
-def projections(voters: Voters, n: int, signs: Sequence[int]) -> tuple[np.ndarray, np.ndarray]:
-    """O_n and M_n (flat, working grid) for radius ``n``, voting at the pixels of ``signs``."""
-    size = voters.grid[0] * voters.grid[1]
-    parts = []
-    for sign in signs:
-        counts, sums = np.zeros(size, np.int64), np.zeros(size)
-        cast_votes(
-            voters.index,
+    strength = np.empty(image.shape, np.float32)
+    for n in (int(n) for n in radii):
+        table = strength_levels(kappa(n), alpha, magnitude=not orientation_only)
+        radial_strength_map(
+            voters.row,
+            voters.col,
             voters.ux,
             voters.uy,
             voters.magnitude,
+            voters.starts,
             n,
-            voters.grid[1],
-            sign,
-            counts,
-            sums,
+            signs,
+            table,
+            orientation_only,
+            strength,
         )
-        parts.append((counts, sums) if sign > 0 else (np.negative(counts), np.negative(sums)))
-    return reduce(np.add, (o for o, _ in parts)), reduce(np.add, (m for _, m in parts))
+        total += spread(strength, n)
+    return total

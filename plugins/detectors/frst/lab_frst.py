@@ -22,12 +22,29 @@ def lab_feature_map(image: np.ndarray) -> np.ndarray:
     ``b = (b8 - 128) / 128`` in [-1, 1), so the map lies in [-2, 2). Red and yellow light is
     positive, green (and blue) light negative, grey and dark pixels near zero.
     """
+    check_bgr(image)
+    return feature_from_lab(cv2.cvtColor(image, cv2.COLOR_BGR2Lab))
+
+
+def check_bgr(image: np.ndarray) -> None:
+    """Raise ValueError unless ``image`` is BGR uint8."""
     if image.ndim != 3 or image.shape[2] != 3 or image.dtype != np.uint8:
         raise ValueError(f"lab-frst needs a BGR uint8 image; got {image.dtype} {image.shape}")
-    lab = cv2.cvtColor(image, cv2.COLOR_BGR2Lab)
+
+
+def feature_from_lab(lab: np.ndarray) -> np.ndarray:
+    """:func:`lab_feature_map` from OpenCV's 8-bit CIELab image."""
     lightness = lab[..., 0].astype(np.float32)
     chroma = lab[..., 1].astype(np.float32) + lab[..., 2] - 256.0
     return lightness * chroma * np.float32(1.0 / (255.0 * 128.0))
+
+
+def frame_feature_map(frame: Frame) -> np.ndarray:
+    """:func:`lab_feature_map` of a frame, computed once for all its detectors (its views:
+    the CIELab conversion and the map are shared; read-only)."""
+    check_bgr(frame.image)
+    views = frame.views
+    return views.map("L*(a+b)", lambda image: feature_from_lab(views.colour(cv2.COLOR_BGR2Lab)))
 
 
 def symmetry_maps(
@@ -154,7 +171,7 @@ class LabFrst(Detector):
     def detect(self, frame: Frame) -> list[Candidate]:
         """Up to ``top`` red-hinted and ``top`` green-hinted candidates, strongest first."""
         p = self.params
-        feature = lab_feature_map(frame.image)
+        feature = frame_feature_map(frame)
         bright, dark = symmetry_maps(
             feature, p["radii"], p["alpha"], p["beta"], p["orientation_only"]
         )

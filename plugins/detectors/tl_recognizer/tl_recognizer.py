@@ -21,17 +21,25 @@ from tsrkit_plugins.detectors.tl_recognizer import tl_geometry as geo
 from tsrkit_plugins.detectors.tl_recognizer.tl_templates import (
     ORIENTATIONS,
     Layout,
-    extract_patch,
     load_templates,
     ncc,
+    ncc_batch,
     patch_box,
     patch_size,
+    warp_matrices,
+    warp_patch,
 )
 
 #: Filters of the ranges array: rows of ``ranges[k] = [[h, s, v]_min, [h, s, v]_max]``.
 FILTERS = ("green", "yellowred_first", "yellowred_second")
 #: The colour passes of 4.1 and the filter rows each one ORs together.
 PASSES = {"green": (0,), "yellowred": (1, 2)}
+#: How far below the threshold T a contour's float64 NCC may lie and still be scored by OpenCV
+#: (the two differ by float rounding, orders of magnitude less).
+NCC_MARGIN = 0.02
+#: Patches whose summed squared deviation from their channel means is at most this are flat
+#: enough for rounding to decide OpenCV's NCC: always scored by OpenCV.
+FLAT_ENERGY = 1000.0
 
 
 def table6_ranges(green_h, yellowred_h, s_range, v_range) -> np.ndarray:
@@ -143,14 +151,30 @@ def red_or_yellow(
     """Red when the lit pixels of a patch hold more red hues than yellow ones, else yellow (4.1).
 
     Only pixels with S >= ``s_min`` and V >= ``v_min`` are counted (our reading: the hue of the
-    dark background screen is noise).
+    dark background screen is noise). One patch of :func:`red_or_yellow_states`.
     """
-    hsv = cv2.cvtColor(patch_bgr, cv2.COLOR_BGR2HSV)
+    return red_or_yellow_states(patch_bgr[None], s_min, v_min, red_h, yellow_h)[0]
+
+
+def red_or_yellow_states(
+    patches_bgr: np.ndarray,
+    s_min: float,
+    v_min: float,
+    red_h: tuple[int, int],
+    yellow_h: tuple[int, int],
+) -> list[str]:
+    """:func:`red_or_yellow` of each patch of a stack ``(N, h, w, 3)``, in one HSV conversion
+    (per pixel, so the same values as patch by patch)."""
+    count, height, width = patches_bgr.shape[:3]
+    if count == 0:
+        return []
+    hsv = cv2.cvtColor(patches_bgr.reshape(count * height, width, 3), cv2.COLOR_BGR2HSV)
+    hsv = hsv.reshape(count, height * width, 3)
     lit = (hsv[..., 1] >= s_min) & (hsv[..., 2] >= v_min)
-    hue = hsv[..., 0][lit]
-    reds = np.count_nonzero((hue >= red_h[0]) & (hue <= red_h[1]))
-    yellows = np.count_nonzero((hue >= yellow_h[0]) & (hue <= yellow_h[1]))
-    return "red" if reds > yellows else "yellow"
+    hue = hsv[..., 0]
+    reds = np.count_nonzero(lit & (hue >= red_h[0]) & (hue <= red_h[1]), axis=1)
+    yellows = np.count_nonzero(lit & (hue >= yellow_h[0]) & (hue <= yellow_h[1]), axis=1)
+    return ["red" if r > y else "yellow" for r, y in zip(reds, yellows)]
 
 
 @dataclass(frozen=True)
@@ -464,14 +488,19 @@ class TlRecognizer(Detector):
 
     def detect(self, frame: Frame) -> list[Candidate]:
         """Lit lenses whose NCC exceeds T, best first; ``state`` is red, yellow or green."""
-        return [c for c in self.scored(frame) if c.score > self.threshold]
+        return [c for c in self._found(frame, self.threshold) if c.score > self.threshold]
 
     def scored(self, frame: Frame) -> list[Candidate]:
         """Every contour that survives pruning, scored by NCC but not thresholded, best first."""
+        return self._found(frame, None)
+
+    def _found(self, frame: Frame, threshold: float | None) -> list[Candidate]:
+        """The candidates of both colour passes, best first; with ``threshold``, only those
+        whose NCC exceeds it (see :meth:`_scores`)."""
         image = frame.image
         hsv = reduced_hsv(image, self.params["resize_factor"])
         camera = self.camera(frame)
-        jobs = [(hsv, image, colour, camera) for colour in PASSES]
+        jobs = [(hsv, image, colour, camera, threshold) for colour in PASSES]
         if self.params["threads"] > 1:
             with ThreadPoolExecutor(self.params["threads"]) as pool:
                 found = list(pool.map(lambda job: self._colour_pass(*job), jobs))
@@ -480,7 +509,12 @@ class TlRecognizer(Detector):
         return sorted((c for part in found for c in part), key=lambda c: -c.score)
 
     def _colour_pass(
-        self, hsv: np.ndarray, image: np.ndarray, colour: str, camera: Camera
+        self,
+        hsv: np.ndarray,
+        image: np.ndarray,
+        colour: str,
+        camera: Camera,
+        threshold: float | None = None,
     ) -> list[Candidate]:
         """Extraction, pruning and validation for one colour (Algorithm 1, lines 3-16)."""
         mask = range_mask(hsv, self.ranges, PASSES[colour])
@@ -489,13 +523,28 @@ class TlRecognizer(Detector):
         scale = (image.shape[1] / hsv.shape[1], image.shape[0] / hsv.shape[0])
         centre = ((image.shape[1] - 1) / 2, (image.shape[0] - 1) / 2)
         boxes = levelled_boxes(extract_contours(mask), scale, camera.roll, centre)
-        kept = [box for box in map(tuple, boxes) if self._passes_pruning(box, camera)]
-        validated = [self._validate(image, box, colour, camera.roll, centre) for box in kept]
-        frame_boxes = image_boxes(np.array(kept).reshape(-1, 4), camera.roll, centre)
+        kept = [tuple(box) for box in boxes[self._pruned(boxes, camera)]]
+        if not kept:
+            return []
+        states, lenses = self._states(image, kept, colour, camera.roll, centre)
+        scores = self._scores(image, kept, states, lenses, camera.roll, centre, threshold)
+        frame_boxes = image_boxes(np.array(kept), camera.roll, centre)
         return [
             Candidate.from_box(tuple(box), score, state)
-            for box, (score, state) in zip(frame_boxes, validated)
+            for box, score, state in zip(frame_boxes, scores, states)
+            if score is not None
         ]
+
+    def _pruned(self, boxes_uv: np.ndarray, camera: Camera) -> np.ndarray:
+        """Which levelled boxes ``(N, 4)`` pass :meth:`_passes_pruning` (the pixel size and
+        aspect bounds compared for all boxes at once when the focal length is unknown)."""
+        if camera.focal_px is not None:
+            return np.array([self._passes_pruning(tuple(b), camera) for b in boxes_uv], bool)
+        width, height = boxes_uv[:, 2] - boxes_uv[:, 0], boxes_uv[:, 3] - boxes_uv[:, 1]
+        aspect = width / height
+        low, high = self.params["size_px"]
+        least = self.params["min_aspect"]
+        return (low <= height) & (height <= high) & (least <= aspect) & (aspect <= 1 / least)
 
     def _passes_pruning(self, box_uv, camera: Camera) -> bool:
         """Property 2 and 3 with a known focal length, else pixel size and aspect bounds (3.4)."""
@@ -521,53 +570,91 @@ class TlRecognizer(Detector):
             width_slack=p["width_slack"],
         )
 
-    def _validate(
-        self, image: np.ndarray, box_uv, colour: str, roll: float, centre: tuple[float, float]
-    ) -> tuple[float, str]:
-        """Red/yellow split on the lens patch, then NCC with the state's template (3.5, 4.1).
-
-        Returns the score, the best over the allowed orientations, and the state.
-        """
-        size = self.params["template_size"]
-        state = colour
-        lens = None
-        if colour == "yellowred":
-            lens = extract_patch(image, box_uv, roll, centre, size)
-            state = red_or_yellow(
-                lens,
-                self.ranges[1, 0, 1],
-                self.ranges[1, 0, 2],
-                self.params["red_h"],
-                self.params["yellow_h"],
-            )
-        score = max(
-            self._orientation_score(image, box_uv, state, orientation, roll, centre, lens)
-            for orientation in self.orientations
+    def _states(
+        self, image: np.ndarray, boxes: list, colour: str, roll: float, centre: tuple[float, float]
+    ) -> tuple[list[str], np.ndarray | None]:
+        """Each contour's state: the pass's colour, or for yellowRed the red/yellow split on the
+        lens patches (4.1), which are returned too (sampled at template size)."""
+        if colour != "yellowred":
+            return [colour] * len(boxes), None
+        size = (self.params["template_size"],) * 2
+        matrices = warp_matrices(np.array(boxes), roll, centre, size)
+        lenses = np.stack([warp_patch(image, m, size) for m in matrices])
+        states = red_or_yellow_states(
+            lenses,
+            self.ranges[1, 0, 1],
+            self.ranges[1, 0, 2],
+            self.params["red_h"],
+            self.params["yellow_h"],
         )
-        return score, state
+        return states, lenses
 
-    def _orientation_score(
+    def _scores(
         self,
         image: np.ndarray,
-        box_uv,
-        state: str,
+        boxes: list,
+        states: list[str],
+        lenses: np.ndarray | None,
+        roll: float,
+        centre: tuple[float, float],
+        threshold: float | None,
+    ) -> list[float | None]:
+        """Each contour's NCC with its state's template, the best over the allowed
+        orientations (3.5); None for those a ``threshold`` rules out.
+
+        The score is OpenCV's NCC (:func:`ncc`). With a ``threshold``, a contour whose NCC,
+        computed in float64 for all patches at once (:func:`ncc_batch`), is below it by more
+        than :data:`NCC_MARGIN` in every orientation cannot pass it and is not scored by OpenCV
+        (the two computations differ by rounding only, far below the margin; nearly flat patches,
+        :data:`FLAT_ENERGY`, are always scored by OpenCV); the others get OpenCV's value, so the
+        candidates kept are those of the per-contour computation.
+        """
+        patches = {
+            o: self._patches(image, boxes, states, lenses, o, roll, centre)
+            for o in self.orientations
+        }
+        maybe = np.ones(len(boxes), bool)
+        if threshold is not None:
+            maybe[:] = False
+            for orientation, stack in patches.items():
+                for state in set(states):
+                    rows = np.array([s == state for s in states])
+                    template = self.templates[state, orientation]
+                    approx = ncc_batch(stack[rows], template, FLAT_ENERGY)
+                    maybe[rows] |= ~(approx <= threshold - NCC_MARGIN)
+        return [
+            max(ncc(patches[o][i], self.templates[states[i], o]) for o in self.orientations)
+            if maybe[i]
+            else None
+            for i in range(len(boxes))
+        ]
+
+    def _patches(
+        self,
+        image: np.ndarray,
+        boxes: list,
+        states: list[str],
+        lenses: np.ndarray | None,
         orientation: str,
         roll: float,
         centre: tuple[float, float],
-        lens: np.ndarray | None = None,
-    ) -> float:
-        """NCC of the patch a lens of ``state`` implies in a head of ``orientation``.
+    ) -> np.ndarray:
+        """The patches a lens of each state implies in a head of ``orientation``, stacked.
 
-        ``lens`` is the lens MBR already sampled at template size, if any; when the patch is
+        ``lenses`` are the lens MBRs already sampled at template size, if any; where a patch is
         that very rectangle at that size (the bare-lens layout), it is reused, not sampled again.
         """
-        box = patch_box(box_uv, state, orientation, self.layout)
         size = patch_size(orientation, self.layout)
-        if lens is not None and box == tuple(box_uv) and size == lens.shape[1::-1]:
-            patch = lens
-        else:
-            patch = extract_patch(image, box, roll, centre, size)
-        return ncc(patch, self.templates[state, orientation])
+        wanted = [patch_box(b, state, orientation, self.layout) for b, state in zip(boxes, states)]
+        reuse = lenses is not None and size == lenses.shape[2:0:-1]
+        todo = [i for i, box in enumerate(wanted) if not (reuse and box == boxes[i])]
+        out = np.empty((len(boxes), size[1], size[0], 3), np.uint8)
+        if lenses is not None and reuse:
+            out[:] = lenses
+        matrices = warp_matrices(np.array([wanted[i] for i in todo]), roll, centre, size)
+        for i, matrix in zip(todo, matrices):
+            out[i] = warp_patch(image, matrix, size)
+        return out
 
     def fit(self, samples: Iterable[Sample], *, detector: Detector | None = None) -> Model:
         """Derive range bounds (Figure 16) and T (5.2) from annotated samples."""

@@ -194,6 +194,50 @@ def load_templates(folder: str | None, layout: Layout) -> dict[tuple[str, str], 
     return out
 
 
+def warp_matrices(
+    boxes_uv: np.ndarray,
+    roll: float,
+    centre: tuple[float, float],
+    size: tuple[int, int],
+) -> np.ndarray:
+    """The affine maps ``(N, 2, 3)`` from the pixels of a ``size`` (w, h) patch to the image
+    pixels of each levelled rectangle ``(u0, v0, u1, v1)`` of ``boxes_uv`` (N, 4).
+
+    Patch pixel ``(j, i)``'s centre goes to the levelled ``(u0 + (j + 1/2) su, v0 + (i + 1/2)
+    sv)``, rotated by the roll about ``centre``. Without roll the rotation is the identity and
+    the maps are written out for all boxes at once, with the same numbers as the product of the
+    two matrices that a rolled box gets.
+    """
+    width, height = size
+    boxes = np.asarray(boxes_uv, dtype=np.float64).reshape(-1, 4)
+    su, sv = (boxes[:, 2] - boxes[:, 0]) / width, (boxes[:, 3] - boxes[:, 1]) / height
+    out = np.zeros((len(boxes), 2, 3))
+    if roll == 0:
+        out[:, 0, 0], out[:, 1, 1] = su, sv
+        out[:, 0, 2] = boxes[:, 0] + su / 2 + centre[0]
+        out[:, 1, 2] = boxes[:, 1] + sv / 2 + centre[1]
+        return out
+    c, s = np.cos(roll), np.sin(roll)
+    to_xy = np.array([[c, s], [-s, c]])
+    for k, (u0, v0) in enumerate(boxes[:, :2]):
+        to_uv = np.array([[su[k], 0.0, u0 + su[k] / 2], [0.0, sv[k], v0 + sv[k] / 2]])
+        out[k, :, :2] = to_xy @ to_uv[:, :2]
+        out[k, :, 2] = to_xy @ to_uv[:, 2] + centre
+    return out
+
+
+def warp_patch(image: np.ndarray, matrix: np.ndarray, size: tuple[int, int]) -> np.ndarray:
+    """The patch of ``size`` (w, h) that the map ``matrix`` of :func:`warp_matrices` samples
+    (bilinear, border replicated)."""
+    return cv2.warpAffine(
+        image,
+        matrix,
+        size,
+        flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
+        borderMode=cv2.BORDER_REPLICATE,
+    )
+
+
 def extract_patch(
     image: np.ndarray,
     box_uv: tuple[float, float, float, float],
@@ -207,21 +251,8 @@ def extract_patch(
     :func:`tl_geometry.level_coordinates`; the patch is rotated on the fly, as the paper does, by
     one affine warp from patch pixels to image pixels (bilinear, border replicated).
     """
-    width, height = (size, size) if isinstance(size, int | float) else size
-    u0, v0, u1, v1 = box_uv
-    su, sv = (u1 - u0) / width, (v1 - v0) / height
-    c, s = np.cos(roll), np.sin(roll)
-    # patch pixel (j, i) centre -> levelled (u, v) -> image (x, y)
-    to_uv = np.array([[su, 0.0, u0 + su / 2], [0.0, sv, v0 + sv / 2]])
-    to_xy = np.array([[c, s], [-s, c]])
-    matrix = np.hstack([to_xy @ to_uv[:, :2], (to_xy @ to_uv[:, 2] + centre)[:, None]])
-    return cv2.warpAffine(
-        image,
-        matrix,
-        (width, height),
-        flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
-        borderMode=cv2.BORDER_REPLICATE,
-    )
+    shape = (int(size), int(size)) if isinstance(size, int | np.integer) else (size[0], size[1])
+    return warp_patch(image, warp_matrices(np.array([box_uv]), roll, centre, shape)[0], shape)
 
 
 def ncc(patch: np.ndarray, template: np.ndarray) -> float:
@@ -234,3 +265,28 @@ def ncc(patch: np.ndarray, template: np.ndarray) -> float:
         raise ValueError(f"patch {patch.shape} and template {template.shape} differ in shape")
     score = float(cv2.matchTemplate(patch, template, cv2.TM_CCOEFF_NORMED)[0, 0])
     return score if np.isfinite(score) else 0.0
+
+
+def ncc_batch(patches: np.ndarray, template: np.ndarray, floor: float = 0.0) -> np.ndarray:
+    """:func:`ncc` of each patch of a stack ``(N, h, w, 3)`` with one template, in float64.
+
+    The same formula (per-channel means removed, products summed over channels, over the root
+    of the product of the sums of squares), from per-channel sums of the 8-bit values, which
+    float64 holds exactly: it agrees with OpenCV's value up to float rounding, except on
+    (nearly) flat patches, where rounding decides OpenCV's value: NaN for a patch whose sum of
+    squared deviations is at most ``floor``.
+    """
+    count, channels = len(patches), patches.shape[-1]
+    pixels = patches[0].size // channels if count else 1
+    x = patches.reshape(count, -1).astype(np.float64)
+    t = template.reshape(-1).astype(np.float64)
+    channel_of = np.tile(np.eye(channels), (pixels, 1))  # sums per channel as a product
+    sums = x @ channel_of
+    t_sums = t @ channel_of
+    numerator = x @ t - sums @ t_sums / pixels
+    energy = np.einsum("nk,nk->n", x, x) - (sums * sums).sum(axis=1) / pixels
+    t_energy = float(t @ t - t_sums @ t_sums / pixels)
+    out = np.full(count, np.nan)
+    usable = (energy > floor) & (energy > 0) & (t_energy > 0)
+    np.divide(numerator, np.sqrt(np.maximum(energy, 0) * t_energy), out=out, where=usable)
+    return out
