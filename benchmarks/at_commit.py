@@ -1,7 +1,8 @@
 """Earlier commits for A/B timings in the same run: one module file as it was (``git show``;
 its own imports resolve against the current tree, so this is for files whose imports did not
 change in between), or a whole tree installed in its own virtual environment, for timing whole
-commands (:func:`python_at`)."""
+commands (:func:`python_at`); :func:`plugin_at` builds a plugin class of such a module with
+its default parameters."""
 
 from __future__ import annotations
 
@@ -34,6 +35,21 @@ def module_at(commit: str, path: str) -> ModuleType:
     sys.modules[name] = module
     spec.loader.exec_module(module)
     return module
+
+
+def plugin_at(cls: type, **params: object) -> object:
+    """An instance of ``cls``, a plugin class loaded from an earlier commit, with its default
+    parameters updated by ``params``.
+
+    Before the plugin API named the parameter schema ``PARAMS``, a plugin class declared it as
+    ``params``; the current base class validates against ``PARAMS``, so an older class's
+    schema is given that name first.
+    """
+    own = vars(cls)
+    if "PARAMS" not in own and isinstance(own.get("params"), tuple):
+        cls.PARAMS = own["params"]  # type: ignore[attr-defined]
+    schema = cls.PARAMS  # type: ignore[attr-defined]
+    return cls(**{**{p.name: p.default for p in schema}, **params})
 
 
 def python_at(commit: str) -> Path:

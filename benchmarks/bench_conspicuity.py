@@ -35,6 +35,7 @@ from tsrkit_plugins.detectors.localization import localize  # noqa: E402
 
 REPO = harness.REPO
 sys.path.insert(0, str(REPO / "tests"))
+from at_commit import plugin_at  # noqa: E402
 from conspicuity_filter2d import conspicuity_filter2d  # noqa: E402
 from oracles.conspicuity_oracle import conspicuity_reference  # noqa: E402
 
@@ -90,8 +91,7 @@ def baseline_module(commit):
 
 def baseline_detector(module):
     """The baseline module's detector with its default parameters."""
-    cls = module.Conspicuity
-    return cls(**{p.name: p.default for p in cls.PARAMS})
+    return plugin_at(module.Conspicuity)
 
 
 def same_output(old, new, detect_old, detect_new, images):

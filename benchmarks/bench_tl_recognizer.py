@@ -38,7 +38,7 @@ from tsrkit.geometry import iou_matrix  # noqa: E402
 from tsrkit.types import Annotation, Dataset, Frame, Sample  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from at_commit import module_at  # noqa: E402
+from at_commit import module_at, plugin_at  # noqa: E402
 from tl_recognizer_straightforward import tl_recognizer_straightforward  # noqa: E402
 
 WIDTH, HEIGHT = 1413, 1884
@@ -85,7 +85,7 @@ def baseline_detector(commit: str, params: dict):
     """TL-recognizer as of ``commit`` (its ``tl_recognizer.py``), with ``params`` over the
     defaults."""
     cls = module_at(commit, "plugins/detectors/tl_recognizer/tl_recognizer.py").TlRecognizer
-    return cls(**{**{p.name: p.default for p in cls.PARAMS}, **params})
+    return plugin_at(cls, **params)
 
 
 def reference_comparison(

@@ -61,6 +61,14 @@ def load(name: str, path: Path) -> ModuleType:
     return module
 
 
+def first_file(root: Path, *paths: str) -> Path:
+    """The first of ``paths`` under ``root`` that exists (a module that moved between commits)."""
+    for path in paths:
+        if (root / path).is_file():
+            return root / path
+    raise SystemExit(f"none of {', '.join(paths)} under {root}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--base", type=Path, required=True, help="root of the other checkout")
@@ -76,7 +84,7 @@ def main() -> None:
     versions = {
         "base": (
             load("base_verifier_features", plugins / "verifiers" / "features.py"),
-            load("base_forest", plugins / "verifiers" / "forest.py"),
+            load("base_forest", first_file(plugins, "shared/forest.py", "verifiers/forest.py")),
             load("base_lamp_features", plugins / "classifiers" / "lamp_state" / "features.py"),
         ),
         "this tree": (verifier_now, forest_now, lamp_now),
