@@ -60,6 +60,17 @@ class UntrainedDetector(Detector):
         raise TsrkitError("untrained needs a model: pass --param model=M")
 
 
+class FrameCrasher(Detector):
+    name = "frame-crasher"
+    summary = "finds nothing; raises on the video frame with the given index"
+    PARAMS = (Param("crash_at", "int", 0, min=0, help="index of the frame that raises"),)
+
+    def detect(self, frame):
+        if frame.index == self.params["crash_at"]:
+            raise RuntimeError("deliberate crash")
+        return []
+
+
 @hookimpl
 def register_detectors(register):
     register(OracleDetector)

@@ -8,6 +8,7 @@ A :class:`FrameRecord` holds one frame's size, compute time, lighting and its de
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -24,6 +25,51 @@ BOX_CHOICES = ("lens", "housing")
 
 def _rounded(values) -> Box:
     x0, y0, x1, y1 = (round(float(v), DECIMALS) for v in values)
+    return x0, y0, x1, y1
+
+
+def _typed(value: Any, kind: type, name: str, optional: bool = False) -> Any:
+    """``value`` read from JSON when it is a ``kind`` (never a bool) or, when ``optional``,
+    None.
+
+    Raises
+    ------
+    TypeError
+        Anything else: a record read from JSON is refused whole, not half used.
+
+    >>> _typed(3, int, "frame")
+    3
+    >>> _typed("3", int, "frame")
+    Traceback (most recent call last):
+    TypeError: 'frame' must be int, not str
+    """
+    if (value is None and optional) or (isinstance(value, kind) and not isinstance(value, bool)):
+        return value
+    raise TypeError(f"{name!r} must be {kind.__name__}, not {type(value).__name__}")
+
+
+def _number(value: Any, name: str, null: float | None = math.nan) -> Any:
+    """A number read from JSON; null reads as ``null``: NaN by default, since
+    :func:`tsrkit.atomic.json_line` writes a non-finite number as null.
+
+    >>> _number(2, "x"), _number(None, "x")
+    (2, nan)
+    >>> _number(True, "x")
+    Traceback (most recent call last):
+    TypeError: 'x' must be a number, not bool
+    """
+    if value is None:
+        return null
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        return value
+    raise TypeError(f"{name!r} must be a number, not {type(value).__name__}")
+
+
+def _box(value: Any, name: str) -> Box:
+    """Four numbers read from JSON as a box (see :func:`_number`)."""
+    if not isinstance(value, list) or len(value) != 4:
+        raise TypeError(f"{name!r} must be a list of 4 numbers")
+    x0, y0, x1, y1 = (_number(v, name) for v in value)
     return x0, y0, x1, y1
 
 
@@ -97,21 +143,28 @@ class DetectionRecord:
 
     @classmethod
     def from_json(cls, data: Mapping[str, Any]) -> DetectionRecord:
-        """Read :meth:`to_json`'s form back (older records without ``lens_bbox`` too)."""
-        bbox = tuple(data["bbox"])
+        """Read :meth:`to_json`'s form back (older records without ``lens_bbox`` too).
+
+        Raises
+        ------
+        KeyError, TypeError
+            A required field is missing or a field has the wrong type.
+        """
+        bbox = _box(data["bbox"], "bbox")
+        scores = _typed(data.get("state_scores", {}), dict, "state_scores")
         return cls(
-            data["x"],
-            data["y"],
-            data["radius"],
+            _number(data["x"], "x"),
+            _number(data["y"], "y"),
+            _number(data["radius"], "radius"),
             bbox,
-            tuple(data.get("lens_bbox", bbox)),
-            data["score"],
-            data.get("state", "unknown"),
-            dict(data.get("state_scores", {})),
-            data.get("origin", "detected"),
-            data.get("housing_score"),
-            data.get("track_id"),
-            data.get("distance_m"),
+            _box(data["lens_bbox"], "lens_bbox") if "lens_bbox" in data else bbox,
+            _number(data["score"], "score"),
+            _typed(data.get("state", "unknown"), str, "state"),
+            {_typed(k, str, "state"): _number(v, k) for k, v in scores.items()},
+            _typed(data.get("origin", "detected"), str, "origin"),
+            _number(data.get("housing_score"), "housing_score", None),
+            _typed(data.get("track_id"), int, "track_id", optional=True),
+            _number(data.get("distance_m"), "distance_m", None),
         )
 
 
@@ -169,16 +222,27 @@ class FrameRecord:
 
     @classmethod
     def from_json(cls, data: Mapping[str, Any]) -> FrameRecord:
-        """Read :meth:`to_json`'s form back."""
+        """Read :meth:`to_json`'s form back.
+
+        Raises
+        ------
+        KeyError, TypeError
+            A required field is missing or a field has the wrong type (a hand-edited or
+            damaged file): the record is refused whole.
+        """
+        source = _typed(data["source"], str, "source")
+        frame = _typed(data.get("frame", 0), int, "frame")
         if "skipped" in data:
-            return cls(data["source"], data.get("frame", 0), skipped=data["skipped"])
+            return cls(source, frame, skipped=_typed(data["skipped"], str, "skipped"))
         return cls(
-            data["source"],
-            data.get("frame", 0),
-            data["width"],
-            data["height"],
-            data["ms"],
-            data.get("lighting"),
-            tuple(DetectionRecord.from_json(d) for d in data["detections"]),
-            notes=tuple(str(n) for n in data.get("notes", ())),
+            source,
+            frame,
+            _typed(data["width"], int, "width"),
+            _typed(data["height"], int, "height"),
+            _number(data["ms"], "ms"),
+            _typed(data.get("lighting"), str, "lighting", optional=True),
+            tuple(
+                DetectionRecord.from_json(d) for d in _typed(data["detections"], list, "detections")
+            ),
+            notes=tuple(str(n) for n in _typed(data.get("notes", []), list, "notes")),
         )

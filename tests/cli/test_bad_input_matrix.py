@@ -1004,6 +1004,14 @@ RUNS: list[Row] = [
     ("bench-workers-zero", bench("-w", "0"), 2, "0 is not in the range x>=1"),
     ("detect-every-zero", detect("--every", "0"), 2, "0 is not in the range x>=1"),
     (
+        "detect-key-every-zero",
+        detect("--key-every", "0"),
+        2,
+        "'--key-every': 0 is not in the range",
+    ),
+    ("detect-agree-zero", detect("--agree", "0"), 2, "'--agree': 0 is not in the range x>=1"),
+    ("detect-agree-word", detect("--agree", "two"), 2, "'two' is not a valid integer"),
+    (
         "convert-unknown-to",
         lambda tmp: [
             "datasets",

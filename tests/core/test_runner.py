@@ -139,6 +139,35 @@ def test_an_unreadable_cache_entry_is_computed_again(tmp_path):
     assert json.loads(entries[0].read_text())["frame"] in range(3)
 
 
+@pytest.mark.parametrize(
+    "damage",
+    [
+        lambda entry: entry.write_bytes(b""),  # a crash right after the file was made
+        lambda entry: entry.write_bytes(b"\0" * 64),  # a crash before unsynced data reached disk
+        lambda entry: entry.write_text(entry.read_text().replace('"width": 40', '"width": "40"')),
+        lambda entry: entry.write_text(entry.read_text().replace('"x": 13.0', '"x": true', 1)),
+        lambda entry: entry.write_text(
+            entry.read_text().replace('"detections": [', '"detections": [7, ')
+        ),
+    ],
+    ids=["empty", "zeros", "text width", "bool x", "number as detection"],
+)
+def test_a_damaged_cache_entry_is_refused_whole_and_computed_again(tmp_path, damage):
+    """Entries are written without fsync, so a crash can leave one empty or zero-filled; a
+    hand edit can leave valid JSON of the wrong types. Either is computed again and rewritten,
+    never handed to the metrics."""
+    data = hand_dataset(2)
+    first = benchmark(data, make(OracleDetector), cache_dir=tmp_path)
+    damaged = sorted(tmp_path.glob("*/*.json"))[0]
+    before = json.loads(damaged.read_text())
+    damage(damaged)
+    again = benchmark(data, make(OracleDetector), cache_dir=tmp_path)
+    assert again["timing"]["frames_computed"] == 1 and again["timing"]["frames_cached"] == 1
+    assert without_timing(again) == without_timing(first)
+    rewritten = json.loads(damaged.read_text())
+    assert {**rewritten, "ms": 0} == {**before, "ms": 0}
+
+
 def test_compare_writes_side_by_side_report_and_paired_test(tmp_path):
     result = compare(
         hand_dataset(12), [make(OracleDetector), make(ShiftedDetector)], out=tmp_path, cache=False

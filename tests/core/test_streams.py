@@ -5,6 +5,7 @@ import json
 import cv2
 import numpy as np
 import pytest
+from benchmark_fakes import FrameCrasher, UntrainedDetector, make
 
 import tsrkit
 from tsrkit.errors import TsrkitError
@@ -82,6 +83,19 @@ def test_a_follower_gives_the_same_records_whatever_the_workers(video):
     serial = records(run_pipeline(follower, [video]))
     assert records(run_pipeline(follower, [video], workers=2)) == serial
     assert len(serial) == 150
+
+
+def test_in_a_worker_a_crashing_plugin_costs_its_frame_and_a_setup_error_ends_the_run(video):
+    """Frame 70 lies in the second chunk, processed by a worker: it is skipped in place, as
+    when run here; a setup problem raised in a worker (no model) reaches the caller."""
+    crashing = Pipeline(make(FrameCrasher, crash_at=70))
+    serial = records(run_pipeline(crashing, [video]))
+    assert records(run_pipeline(crashing, [video], workers=2)) == serial
+    assert [i for i, r in enumerate(serial) if r[0] == "skipped"] == [70]
+    assert serial[70][1].endswith("drive.mp4#70")
+    assert "plugin error: RuntimeError: deliberate crash" in serial[70][2]
+    with pytest.raises(TsrkitError, match="needs a model"):
+        list(run_pipeline(Pipeline(make(UntrainedDetector)), [video], workers=2))
 
 
 def test_a_tracker_needs_one_worker(video):

@@ -144,13 +144,17 @@ def main() -> None:
     A benchmark imports about 2,300 modules (NumPy, SciPy, scikit-learn, matplotlib, numba, the
     plugins); the teardown frees them one by one, about a second of CPU after the command's work
     is done (``benchmarks/bench_run_tail.py``). Exit handlers still run and the standard streams
-    are flushed before :func:`os._exit`; files are written and closed inside the command.
+    are flushed before :func:`os._exit`; files are written and closed inside the command. Under
+    a profiler or tracer (``python -m cProfile``, coverage), which write their results after
+    the program returns, the process ends the usual way.
     """
     try:
         cli.main(prog_name="tsrkit")
         status = 0
     except SystemExit as exc:
         status = exit_status(exc.code)
+    if sys.getprofile() is not None or sys.gettrace() is not None:
+        raise SystemExit(status)
     atexit._run_exitfuncs()
     for stream in (sys.stdout, sys.stderr):
         with contextlib.suppress(Exception):  # a closed pipe has nothing left to flush
