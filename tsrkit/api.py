@@ -23,7 +23,8 @@ The names, by what they are for:
 - geometry: :data:`Box`, :func:`box_centre`, :func:`circle_box`, :func:`clip_box`,
   :func:`iou_matrix`, :func:`xywh_to_xyxy`, :func:`xyxy_to_xywh`;
 - files and errors: :func:`atomic_open`, :func:`write_json`, :func:`json_line`,
-  :func:`read_text`, :func:`read_yaml`, :func:`read_image`, :func:`image_size`,
+  :func:`read_text`, :func:`read_json`, :func:`read_yaml`, :func:`read_image`,
+  :func:`image_size`,
   :data:`IMAGE_EXTENSIONS`, :class:`TsrkitError`, :class:`DatasetError`,
   :class:`ImageReadError`;
 - models: :class:`Model`, :class:`ModelError`, :func:`load_model`, :func:`save_model`;

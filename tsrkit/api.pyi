@@ -16,6 +16,7 @@ from tsrkit.datasets import (
 )
 from tsrkit.datasets.errors import (
     DatasetError as DatasetError,
+    read_json as read_json,
     read_text as read_text,
     read_yaml as read_yaml,
 )

@@ -10,7 +10,9 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
-__all__ = ["atomic_open", "finite", "json_line", "write_json"]
+from tsrkit.outputs import refuse_input, refuse_special
+
+__all__ = ["atomic_open", "finite", "json_line", "json_text", "write_json"]
 
 
 @contextlib.contextmanager
@@ -19,12 +21,16 @@ def atomic_open(
 ):
     """Open a temporary file next to ``path``; on success it replaces ``path`` atomically.
 
-    On an exception the temporary file is removed and ``path`` is left as it was. ``sync``
-    forces the bytes to disk before the rename (``fsync``), so that a crash of the machine
-    cannot leave an empty file under the new name; a cache entry, which is recomputed when it
-    cannot be read, skips that wait.
+    On an exception the temporary file is removed and ``path`` is left as it was. A ``path``
+    that names one of the run's inputs (:func:`tsrkit.outputs.reading`) is refused before
+    anything is written, and so is a device node (:func:`tsrkit.outputs.refuse_special`).
+    ``sync`` forces the bytes to disk before the rename (``fsync``), so that a crash of the
+    machine cannot leave an empty file under the new name; a cache entry, which is recomputed
+    when it cannot be read, skips that wait.
     """
     path = Path(path)
+    refuse_input(path)
+    refuse_special(path, follow=False)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
@@ -66,13 +72,24 @@ def finite(data: Any) -> Any:
     return data
 
 
+def json_text(data: Any, indent: int | None = None, default: Any = None) -> str:
+    """``data`` as JSON text with every non-finite number written as null (:func:`finite`):
+    what tsrkit writes is JSON that any strict reader accepts (no ``NaN`` / ``Infinity``).
+
+    Examples
+    --------
+    >>> json_text({"p": float("nan"), "m": float("-inf"), "n": 1.5})
+    '{"p": null, "m": null, "n": 1.5}'
+    """
+    return json.dumps(finite(data), indent=indent, default=default, allow_nan=False)
+
+
 def json_line(data: Any) -> str:
     """One JSON Lines record (no newline), with non-finite numbers as null."""
-    return json.dumps(finite(data), allow_nan=False)
+    return json_text(data)
 
 
-def write_json(path: str | os.PathLike, data: Any) -> None:
-    """Write ``data`` as indented JSON, atomically."""
+def write_json(path: str | os.PathLike, data: Any, indent: int | None = 2) -> None:
+    """Write ``data`` as indented JSON, atomically, with non-finite numbers as null."""
     with atomic_open(path) as fh:
-        json.dump(data, fh, indent=2, sort_keys=False)
-        fh.write("\n")
+        fh.write(json_text(data, indent) + "\n")

@@ -16,6 +16,8 @@ import contextlib
 import functools
 import json
 import os
+import shutil
+import tempfile
 import time
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
@@ -28,11 +30,12 @@ from tsrkit.eval.guard import Failure, GuardedMetrics
 from tsrkit.eval.runfacts import run_facts
 from tsrkit.eval.settings import EvalSettings, not_exhaustive_note, resolve_box
 from tsrkit.outlock import locked
+from tsrkit.outputs import refuse_input
 from tsrkit.plugin import Classifier, Detector, ReportWriter, Verifier
 from tsrkit.records import FrameRecord
 from tsrkit.registry import get_registry
 from tsrkit.report import REPORT_KEYS, ProgressBar, RunResult, build_report, ordered
-from tsrkit.runfolder import write_run
+from tsrkit.runfolder import remove_stale_files, write_run
 from tsrkit.types import Dataset
 
 __all__ = [
@@ -113,12 +116,27 @@ def evaluate(
     metrics = metrics_for(settings)
     kept: list[FrameRecord] = []
     skipped: list[dict[str, str]] = []
+    resized: list[str] = []
     start = time.perf_counter()
     for record in records:
         if record.skipped is not None:
             skipped.append({"source": record.source, "reason": record.skipped})
             continue
-        metrics.update(dataset.samples[record.index], record)
+        sample = dataset.samples[record.index]
+        if (
+            sample.width
+            and sample.height
+            and (sample.width, sample.height)
+            != (
+                record.width,
+                record.height,
+            )
+        ):
+            resized.append(
+                f"{Path(sample.source).name} declares {sample.width}x{sample.height}, "
+                f"the file is {record.width}x{record.height}"
+            )
+        metrics.update(sample, record)
         kept.append(record)
     wall = time.perf_counter() - start
     sections, results, written = metrics.compute(REPORT_KEYS)
@@ -134,6 +152,11 @@ def evaluate(
     notes = [] if settings.exhaustive else [not_exhaustive_note(dataset.name)]
     counted = sections.get("frame_notes", {}).get("counts", {})
     notes += [f"{n} of {len(kept)} frames: {text}" for text, n in counted.items()]
+    if resized:
+        notes.append(
+            f"{len(resized)} of {len(kept)} frames: the annotation file declares another size "
+            f"than the image's (first: {resized[0]}); their boxes are evaluated as given"
+        )
 
     def report(files: Sequence[str], failures: Sequence[Failure]) -> dict[str, Any]:
         return build_report(
@@ -157,7 +180,31 @@ def evaluate(
         return run
     folder = Path(out)
     folder.mkdir(parents=True, exist_ok=True)
-    return write_run(run, writers_for(writers), folder, report)
+    with staged(folder) as staging:
+        run = write_run(run, writers_for(writers), staging, report)
+        remove_stale_files(folder, {*run.report.get("files", []), *run.report.get("plots", [])})
+    return run
+
+
+@contextlib.contextmanager
+def staged(folder: Path):
+    """A hidden folder inside ``folder`` for the writers; when they are done, each file it
+    holds replaces its namesake in ``folder`` (renames, no copies). When the run stops midway
+    (an error, Ctrl-C), the staged files are removed and ``folder`` keeps the previous run
+    whole: old and new files are never mixed. A file that would replace one of the run's
+    inputs (:func:`tsrkit.outputs.reading`) refuses the whole move."""
+    staging = Path(tempfile.mkdtemp(prefix=".writing-", dir=folder))
+    try:
+        yield staging
+        moves = [(p, folder / p.relative_to(staging)) for p in sorted(staging.rglob("*"))]
+        moves = [(source, target) for source, target in moves if source.is_file()]
+        for _, target in moves:
+            refuse_input(target, "a report file")  # before anything is replaced
+        for source, target in moves:
+            target.parent.mkdir(parents=True, exist_ok=True)
+            os.replace(source, target)
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
 
 
 def run_benchmark(

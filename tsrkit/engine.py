@@ -13,16 +13,19 @@ import inspect
 import json
 import multiprocessing
 import os
+import re
 import time
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, TypeVar
 
-from tsrkit.atomic import atomic_open
+from tsrkit.atomic import atomic_open, json_line
 from tsrkit.errors import TsrkitError
+from tsrkit.files import InputFileError, read_json
 from tsrkit.images import ImageReadError
 from tsrkit.lighting import light_condition
 from tsrkit.pipeline import FrameResult, Pipeline
@@ -30,6 +33,7 @@ from tsrkit.plugin import Classifier, Detector, Plugin, Verifier
 from tsrkit.records import FrameRecord
 from tsrkit.registry import PluginNotFound, get_registry
 from tsrkit.types import Candidate, Frame, Sample
+from tsrkit.workers import check_workers, end_with_run, pool_broke
 
 __all__ = [
     "ENGINES",
@@ -122,18 +126,23 @@ def process_sample(index: int, sample: Sample, job: Job) -> FrameRecord:
     record = compute_record(index, sample, job)
     if path is not None and record.skipped is None:
         with atomic_open(path, sync=False) as fh:
-            json.dump(record.to_json(), fh)
+            fh.write(json_line(record.to_json()))
     return record
 
 
+#: The largest cache entry read, in bytes (a frame's record is a few kilobytes).
+MAX_CACHE_ENTRY = 64 * 2**20
+
+
 def read_cached(path: Path) -> FrameRecord | None:
-    """The record cached at ``path``, or None when there is none or it cannot be read (cut
-    short by a crash, edited by hand...): the frame is then computed again and the entry
-    rewritten."""
+    """The record cached at ``path``, or None when there is none or it cannot be used (not a
+    regular file, too large, cut short by a crash, edited by hand, not a record): the frame is
+    then computed again and the entry rewritten, so a damaged cache costs time, never the run."""
+    if not path.is_file():
+        return None
     try:
-        with open(path, encoding="utf-8") as fh:
-            return FrameRecord.from_json(json.load(fh))
-    except (OSError, ValueError, KeyError, TypeError, AttributeError, RecursionError):
+        return FrameRecord.from_json(read_json(path, MAX_CACHE_ENTRY))
+    except (InputFileError, OSError, KeyError, TypeError, ValueError, AttributeError, IndexError):
         return None
 
 
@@ -180,10 +189,11 @@ def classify_annotations(classifier: Classifier, frame: Frame, sample: Sample) -
 _WORKER_JOB: Job | None = None
 
 
-def _init_worker(job: Job) -> None:
+def _init_worker(job: Job, run: int) -> None:
     global _WORKER_JOB
     _WORKER_JOB = job
     single_thread()
+    end_with_run(run)
 
 
 def single_thread() -> None:
@@ -242,22 +252,31 @@ def run_records(
     """Frame records in dataset order, computed in this process, a process pool or on Dask."""
     if engine not in ENGINES:
         raise BenchmarkError(f"unknown engine '{engine}' (choose {' or '.join(ENGINES)})")
-    if workers < 1:
-        raise BenchmarkError(f"workers must be at least 1; got {workers}")
+    check_workers(workers)
     if engine == "dask":
         yield from _run_dask(samples, job, workers, scheduler)
     elif workers == 1:
         yield from (process_sample(i, s, job) for i, s in enumerate(samples))
     else:
         with ProcessPoolExecutor(
-            workers, mp_context=pool_context(), initializer=_init_worker, initargs=(job,)
+            workers,
+            mp_context=pool_context(),
+            initializer=_init_worker,
+            initargs=(job, os.getpid()),
         ) as pool:
-            yield from ordered(
-                lambda i, s: pool.submit(_run_in_worker, i, s),
-                lambda f: f.result(),
-                samples,
-                4 * workers,
-            )
+            try:
+                yield from ordered(
+                    lambda i, s: pool.submit(_run_in_worker, i, s),
+                    lambda f: f.result(),
+                    samples,
+                    4 * workers,
+                )
+            except BrokenProcessPool as exc:
+                raise pool_broke(exc) from None
+
+
+#: A Dask scheduler address: ``protocol://...`` or ``host:port``.
+SCHEDULER_ADDRESS = re.compile(r"[a-z]+://\S+|(\[[0-9a-fA-F:]+\]|[^\s:/\[\]]+):\d{1,5}")
 
 
 def _run_dask(
@@ -270,9 +289,14 @@ def _run_dask(
         cluster = LocalCluster(n_workers=workers, threads_per_worker=1, dashboard_address=None)
         scheduler = cluster
     address = getattr(scheduler, "scheduler_address", scheduler)
+    if isinstance(address, str) and not SCHEDULER_ADDRESS.fullmatch(address):
+        raise BenchmarkError(
+            f"--scheduler {address!r}: expected HOST:PORT or PROTOCOL://HOST:PORT "
+            "(e.g. tcp://10.0.0.5:8786)"
+        )
     try:
         client = Client(address, timeout="20s", set_as_default=False)
-    except OSError as exc:
+    except (OSError, ValueError) as exc:
         raise BenchmarkError(f"cannot reach Dask scheduler {address}: {exc}") from None
     try:
         shared = client.scatter(job, broadcast=True)

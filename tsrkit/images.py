@@ -14,8 +14,9 @@ import numpy as np
 from PIL import Image
 
 from tsrkit.errors import TsrkitError
+from tsrkit.files import InputFileError, file_size
 
-__all__ = ["MAX_PIXELS", "ImageReadError", "max_pixels", "read_image", "to_bgr8"]
+__all__ = ["MAX_PIXELS", "ImageReadError", "max_file_bytes", "max_pixels", "read_image", "to_bgr8"]
 
 #: Default largest image (decoded pixels) read; ``TSRKIT_MAX_PIXELS`` overrides it.
 MAX_PIXELS = 100_000_000
@@ -40,15 +41,18 @@ def read_image(path: str | os.PathLike) -> np.ndarray:
     Raises
     ------
     ImageReadError
-        With the reason: missing, empty, truncated, larger than :func:`max_pixels` (read from
-        the header before decoding, so a decompression bomb allocates nothing), or not
-        decodable.
+        With the reason: missing, not a regular file (a FIFO or device would block or never
+        end), a file larger than :func:`max_file_bytes` (checked before reading), empty,
+        truncated, larger than :func:`max_pixels` (read from the header before decoding, so a
+        decompression bomb allocates nothing), or not decodable.
     """
     path = Path(path)
     try:
+        file_size(path, max_file_bytes())
+    except InputFileError as exc:
+        raise ImageReadError(f"{path}: {exc.problem}") from None
+    try:
         data = np.fromfile(path, dtype=np.uint8)
-    except FileNotFoundError:
-        raise ImageReadError(f"{path}: no such file") from None
     except OSError as exc:
         raise ImageReadError(f"{path}: cannot read ({exc.strerror or exc})") from None
     if data.size == 0:
@@ -93,22 +97,80 @@ def to_bgr8(image: np.ndarray) -> np.ndarray:
 
 
 def _truncation(data: np.ndarray) -> str | None:
-    """Detect the truncated JPEG and PNG files that decoders would silently half-decode."""
+    """Detect the truncated JPEG and PNG files that decoders would silently half-decode.
+
+    The file's own structure is followed (PNG chunks to ``IEND``; JPEG segments to the first
+    scan, then the end-of-image marker), so bytes after the end marker, which phones append
+    (maker notes, depth maps, a second picture), are accepted, and the end marker of an
+    embedded thumbnail does not hide a cut-off main image.
+    """
     head = data[:8].tobytes()
-    tail = data[-4096:].tobytes()
-    if head.startswith(b"\xff\xd8") and b"\xff\xd9" not in tail:
-        return "truncated JPEG (no end-of-image marker)"
-    if head.startswith(b"\x89PNG") and b"IEND" not in tail:
-        return "truncated PNG (no IEND chunk)"
+    if head.startswith(b"\x89PNG\r\n\x1a\n"):
+        return None if _png_ends(data) else "truncated PNG (no IEND chunk)"
+    if head.startswith(b"\xff\xd8"):
+        return None if _jpeg_ends(data) else "truncated JPEG (no end-of-image marker)"
     return None
 
 
+def _png_ends(data: np.ndarray) -> bool:
+    """Whether the PNG's chunk chain reaches ``IEND`` inside ``data``."""
+    at = 8
+    while at + 8 <= data.size:
+        if data[at + 4 : at + 8].tobytes() == b"IEND":
+            return True
+        at += 12 + int.from_bytes(data[at : at + 4].tobytes(), "big")
+    return False
+
+
+def _jpeg_ends(data: np.ndarray) -> bool:
+    """Whether a JPEG's marker segments lead to a scan that an end-of-image marker closes.
+
+    Segments before the first scan (SOS) carry their length and are skipped whole, so an EXIF
+    thumbnail's own end marker is not taken for the image's; inside entropy-coded data every
+    0xFF byte is stuffed or a marker, so the first FF D9 after the scan header ends the image.
+    """
+    at = 2
+    while at + 4 <= data.size:
+        if data[at] != 0xFF:
+            return False
+        marker = int(data[at + 1])
+        if marker == 0xFF:  # a fill byte before a marker
+            at += 1
+        elif marker == 0xD9:
+            return True
+        elif 0xD0 <= marker <= 0xD7 or marker == 0x01:  # markers without a length
+            at += 2
+        elif marker == 0xDA:
+            return data[at + 2 :].tobytes().find(b"\xff\xd9") >= 0
+        else:
+            at += 2 + (int(data[at + 2]) << 8 | int(data[at + 3]))
+    return False
+
+
 def max_pixels() -> int:
-    """The largest image read, in pixels: ``TSRKIT_MAX_PIXELS`` or :data:`MAX_PIXELS`."""
-    try:
-        return int(os.environ.get("TSRKIT_MAX_PIXELS", MAX_PIXELS))
-    except ValueError:
+    """The largest image read, in pixels: ``TSRKIT_MAX_PIXELS`` or :data:`MAX_PIXELS`.
+
+    Raises
+    ------
+    TsrkitError
+        When ``TSRKIT_MAX_PIXELS`` is set to something other than a positive integer.
+    """
+    given = os.environ.get("TSRKIT_MAX_PIXELS")
+    if given is None:
         return MAX_PIXELS
+    try:
+        value = int(given)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise TsrkitError(f"TSRKIT_MAX_PIXELS must be a positive integer; got {given!r}")
+    return value
+
+
+def max_file_bytes() -> int:
+    """The largest image file read, in bytes: an uncompressed image of :func:`max_pixels`
+    pixels at 16 bits and four channels, plus 64 MiB of metadata."""
+    return 8 * max_pixels() + 64 * 2**20
 
 
 def _too_large(path: Path) -> str | None:

@@ -14,13 +14,17 @@ from pathlib import Path
 
 import cv2
 
+from tsrkit.errors import TsrkitError
+from tsrkit.files import not_regular
 from tsrkit.images import ImageReadError, read_image, to_bgr8
+from tsrkit.outputs import is_output
 from tsrkit.types import Frame, Skipped
 
 __all__ = [
     "IMAGE_EXTENSIONS",
     "VIDEO_EXTENSIONS",
     "Work",
+    "check_range",
     "expand_paths",
     "iter_frames",
     "iter_video",
@@ -67,19 +71,49 @@ VIDEO_EXTENSIONS = {
 
 
 def expand_paths(paths: Iterable[str | os.PathLike]) -> Iterator[Path | Skipped]:
-    """Files named directly, and every non-hidden file below each folder, sorted."""
+    """Files named directly, and every non-hidden file below each folder, sorted.
+
+    What is not a regular file (a FIFO, device or socket, which would block or never end) is
+    skipped with its reason; the run's own outputs (:func:`tsrkit.outputs.writing`) are left
+    out, so an output written inside an input folder is not read back as an input.
+    """
     for given in paths:
         path = Path(given)
         if path.is_dir():
             for root, dirs, files in os.walk(path):
-                dirs[:] = sorted(d for d in dirs if not d.startswith("."))
+                dirs[:] = sorted(
+                    d for d in dirs if not d.startswith(".") and not is_output(Path(root) / d)
+                )
                 for name in sorted(files):
-                    if not name.startswith("."):
-                        yield Path(root) / name
-        elif path.exists():
-            yield path
+                    if not name.startswith(".") and not is_output(Path(root) / name):
+                        yield _regular(Path(root) / name)
+        elif path.exists() or path.is_symlink():
+            yield _regular(path)
         else:
             yield Skipped(str(path), "no such file or folder")
+
+
+def _regular(path: Path) -> Path | Skipped:
+    problem = not_regular(path)
+    return path if problem is None else Skipped(str(path), problem)
+
+
+def check_range(every: int, start: int, end: int | None) -> None:
+    """Refuse a video frame selection that keeps nothing or is not one.
+
+    Raises
+    ------
+    TsrkitError
+        Naming the options, e.g. ``--end 1 is before --start 3``.
+    """
+    if every < 1:
+        raise TsrkitError(f"--every {every}: must be at least 1")
+    if start < 0:
+        raise TsrkitError(f"--start {start}: must be at least 0")
+    if end is not None and end < start:
+        raise TsrkitError(f"--end {end} is before --start {start}")
+    if end is not None and end == start:
+        raise TsrkitError(f"--start {start} --end {end} is an empty range of frames")
 
 
 @dataclass(frozen=True)
@@ -102,8 +136,7 @@ def plan_work(
     """The units of work of ``paths``: one per image, one per video or, with ``chunk``, one per
     ``chunk`` kept frames of a video whose container declares its frame count (so that workers
     each decode their own part); unusable paths as :class:`Skipped`."""
-    if every < 1 or start < 0 or (end is not None and end < start):
-        raise ValueError("need every >= 1, start >= 0 and end >= start")
+    check_range(every, start, end)
     for item in expand_paths(paths):
         if isinstance(item, Skipped):
             yield item
@@ -183,7 +216,11 @@ def iter_video(
                         image=to_bgr8(image), source=str(path), index=index, timestamp=stamp
                     )
             index += 1
-        if decoded == 0 and index <= start:
+        if decoded == 0 and 0 < index <= start:
+            yield Skipped(
+                str(path), f"--start {start} is past the end: the video has {index} frames"
+            )
+        elif decoded == 0 and index <= start:
             yield Skipped(str(path), "no frames decoded (empty or unreadable video)")
     finally:
         capture.release()

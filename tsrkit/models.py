@@ -22,6 +22,7 @@ import numpy as np
 
 from tsrkit.atomic import atomic_open, write_json
 from tsrkit.errors import TsrkitError
+from tsrkit.files import InputFileError, file_size, not_regular, read_text
 from tsrkit.params import Part
 
 __all__ = ["FORMAT_VERSION", "Model", "ModelError", "load_model", "model_paths", "save_model"]
@@ -108,6 +109,10 @@ def save_model(
     return npz_path
 
 
+#: The largest model file read, in bytes.
+MAX_MODEL_BYTES = 4 * 2**30
+
+
 def load_model(path: str | os.PathLike, plugin: str) -> Model:
     """Read a model saved by :func:`save_model` and check it belongs to ``plugin``.
 
@@ -119,11 +124,20 @@ def load_model(path: str | os.PathLike, plugin: str) -> Model:
     """
     npz_path, json_path = model_paths(path)
     for p in (npz_path, json_path):
-        if not p.is_file():
+        problem = not_regular(p)
+        if problem == "no such file":
             raise ModelError(f"model {p}: no such file (a model is a .npz with a .json beside it)")
+        if problem:
+            raise ModelError(f"model {p}: {problem}")
     try:
-        meta = json.loads(json_path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        file_size(npz_path, MAX_MODEL_BYTES)
+    except InputFileError as exc:
+        raise ModelError(f"model {exc}") from None
+    try:
+        meta = json.loads(read_text(json_path, MAX_MODEL_BYTES))
+    except InputFileError as exc:
+        raise ModelError(f"model {json_path}: unreadable metadata ({exc.problem})") from None
+    except (json.JSONDecodeError, RecursionError) as exc:
         raise ModelError(f"model {json_path}: unreadable metadata ({exc})") from None
     if (
         not isinstance(meta, dict)

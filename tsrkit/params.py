@@ -7,15 +7,15 @@ A plugin lists :class:`Param` objects; values arrive as Python objects (API, YAM
 
 from __future__ import annotations
 
+import difflib
 import math
 import os
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-import yaml
-
 from tsrkit.errors import TsrkitError
+from tsrkit.files import InputFileError, not_regular, read_yaml
 
 if TYPE_CHECKING:
     from tsrkit.plugin import Plugin
@@ -55,6 +55,9 @@ PLUGIN_TYPES = {
     "verifier": "verifier",
     "classifier": "classifier",
 }
+
+#: The most integers an ``ints`` range such as ``1..10`` may expand to.
+MAX_RANGE = 10_000
 
 _TRUE = {"1", "true", "yes", "on"}
 _FALSE = {"0", "false", "no", "off"}
@@ -254,12 +257,18 @@ def _convert(kind: str, value: Any) -> Any:
     if kind in ("str", "path"):
         if not isinstance(value, str):
             raise ValueError("not a string")
+        if kind == "path" and os.path.exists(value) and not os.path.isdir(value):
+            problem = not_regular(value)
+            if problem:  # a FIFO or device would block whatever reads it
+                raise ValueError(problem)
         return value
     element = "int" if kind == "ints" else "float"
     if isinstance(value, str):
         text = value.strip().strip("()[]")
         if kind == "ints" and ".." in text:
             lo, hi = (int(part) for part in text.split(".."))
+            if hi - lo >= MAX_RANGE:
+                raise ValueError(f"a range of {hi - lo + 1} integers; at most {MAX_RANGE}")
             return tuple(range(lo, hi + 1))
         value = [part for part in text.replace(" ", ",").split(",") if part]
     if not isinstance(value, Sequence):
@@ -308,12 +317,20 @@ def parse_assignments(items: Iterable[str]) -> dict[str, str]:
     return out
 
 
+#: The keys of a run configuration, and the largest one read (bytes).
+CONFIG_KEYS = ("detector", "verifier", "classifier", "tracker", "description")
+MAX_CONFIG_BYTES = 2**20
+
+
 def load_config(path: str | os.PathLike) -> dict[str, Any]:
     """Read a YAML run configuration: a file, or the name of a shipped preset
     (:mod:`tsrkit.presets`).
 
-    The file is a mapping whose optional keys ``detector``, ``classifier`` and ``tracker`` are
-    each either a plugin name or ``{"name": ..., "params": {...}}``; other keys are kept.
+    The file is a mapping whose optional keys ``detector``, ``verifier``, ``classifier`` and
+    ``tracker`` are each either a plugin name or ``{"name": ..., "params": {...}}``, and
+    ``description`` a line of text; any other key is refused with the closest known one. The
+    file is read as :func:`tsrkit.files.read_yaml` reads (a regular file of at most
+    :data:`MAX_CONFIG_BYTES`, bounded nesting and aliases, no repeated key).
 
     Raises
     ------
@@ -324,22 +341,22 @@ def load_config(path: str | os.PathLike) -> dict[str, Any]:
 
     path = resolve_config(path)
     try:
-        with open(path, encoding="utf-8") as fh:
-            data = yaml.safe_load(fh) or {}
-    except OSError as exc:
-        raise ParamError(f"config {path}: cannot read ({exc.strerror or exc})") from None
-    except UnicodeDecodeError as exc:
-        raise ParamError(f"config {path}: not valid UTF-8 (byte offset {exc.start})") from None
-    except yaml.YAMLError as exc:
-        raise ParamError(f"config {path}: not valid YAML ({' '.join(str(exc).split())})") from None
+        data = read_yaml(path, MAX_CONFIG_BYTES)
+    except InputFileError as exc:
+        raise ParamError(f"config {exc}") from None
+    data = {} if data is None else data
     if not isinstance(data, dict):
         raise ParamError(f"config {path}: expected a mapping at the top level")
     _string_keys(data, f"config {path}")
+    _known_keys(data, CONFIG_KEYS, f"config {path}")
     for kind in ("detector", "verifier", "classifier", "tracker"):
         entry = data.get(kind)
         if isinstance(entry, str):
             data[kind] = {"name": entry, "params": {}}
         elif entry is not None:
+            if isinstance(entry, dict):
+                _string_keys(entry, f"config {path}: '{kind}'")
+                _known_keys(entry, ("name", "params"), f"config {path}: '{kind}'")
             if not isinstance(entry, dict) or not isinstance(entry.get("name"), str):
                 raise ParamError(f"config {path}: '{kind}' must be a name or have a 'name' key")
             params = entry.get("params") or {}
@@ -348,6 +365,24 @@ def load_config(path: str | os.PathLike) -> dict[str, Any]:
             _string_keys(params, f"config {path}: '{kind}.params'")
             data[kind] = {"name": entry["name"], "params": params}
     return data
+
+
+def _known_keys(mapping: Mapping[str, Any], known: Sequence[str], owner: str) -> None:
+    """Refuse a key that is not one of ``known``, suggesting the closest (a misspelt key would
+    otherwise be ignored without a word).
+
+    Examples
+    --------
+    >>> _known_keys({"clasifier": "ab-hist"}, CONFIG_KEYS, "run.yaml")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    tsrkit.params.ParamError: run.yaml: unknown key 'clasifier'; did you mean 'classifier'? ...
+    """
+    for key in mapping:
+        if key not in known:
+            close = difflib.get_close_matches(key, known, n=1)
+            hint = f"; did you mean '{close[0]}'?" if close else ""
+            raise ParamError(f"{owner}: unknown key '{key}'{hint} (known: {', '.join(known)})")
 
 
 def _string_keys(mapping: Mapping[Any, Any], owner: str) -> None:

@@ -77,17 +77,19 @@ REPORT_KEYS = frozenset(
 
 
 class ProgressBar:
-    """A rich progress bar with frames/s on stderr; does nothing when disabled."""
+    """A rich progress bar with frames/s on stderr; does nothing when disabled or when stderr
+    is not a terminal (a redirected log gets no bar lines)."""
 
     def __init__(self, total: int, enabled: bool, label: str = "benchmark"):
+        console = Console(stderr=True)
         self.progress = Progress(
             TextColumn(f"[bold]{label}"),
             BarColumn(),
             MofNCompleteColumn(),
             TextColumn("{task.fields[rate]} frames/s"),
             TimeRemainingColumn(),
-            console=Console(stderr=True),
-            disable=not enabled,
+            console=console,
+            disable=not (enabled and console.is_terminal),
             transient=False,
         )
         self.task = self.progress.add_task("frames", total=total, rate="-")

@@ -11,12 +11,14 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import os
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 from tsrkit.errors import TsrkitError
 from tsrkit.eval.guard import Failure
+from tsrkit.files import loads_json, read_text
 from tsrkit.plugin import ReportWriter
 from tsrkit.records import FrameRecord
 from tsrkit.report import RunResult, run_results
@@ -26,6 +28,7 @@ __all__ = [
     "ReportBuilder",
     "load_run",
     "read_comparison",
+    "read_object",
     "read_records",
     "read_report",
     "remove_stale_files",
@@ -113,7 +116,8 @@ def _write_all(run: RunResult, writers: Sequence[ReportWriter], folder: Path) ->
 def load_run(folder: Path) -> RunResult:
     """The :class:`RunResult` of a benchmark folder, from its ``report.json`` and
     ``detections.jsonl``, with the dataset opened again as the run opened it (by registry name
-    or path, format and image folder, and split).
+    or path, format and image folder, and split); or of a ``tsrkit track VIDEO`` folder
+    (:func:`tsrkit.spatiotemporal.results.load_track_run`).
 
     A dataset that cannot be opened again (moved, or several concatenated) leaves the run
     without ground truth: its results and tables are complete, the frames' overlays are not.
@@ -124,7 +128,13 @@ def load_run(folder: Path) -> RunResult:
         Not a run folder, or a ``report.json`` / ``detections.jsonl`` that is not what a run
         writes (naming the file, the line and the problem).
     """
-    report = read_report(folder / "report.json")
+    report = read_object(folder / "report.json")
+    from tsrkit.spatiotemporal.results import is_track_report, load_track_run
+
+    if is_track_report(report):
+        return load_track_run(folder, report)
+    if not isinstance(report.get("dataset"), dict):
+        raise TsrkitError(f"{folder / 'report.json'}: not a tsrkit report (no 'dataset' entry)")
     records = read_records(folder / "detections.jsonl")
     try:
         results = run_results(report)
@@ -151,22 +161,39 @@ def read_report(path: Path) -> dict[str, Any]:
     Raises
     ------
     TsrkitError
-        Missing, empty, not JSON, or not a JSON object.
+        Missing, empty, not JSON, or not a JSON object with the run's ``dataset``.
     """
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise TsrkitError(f"{path.parent}: not a run folder ({path.name} missing)") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise TsrkitError(f"{path}: cannot be read ({exc})") from None
+    data = read_object(path)
+    if "dataset" not in data:
+        raise TsrkitError(f"{path}: not a tsrkit report (no 'dataset' entry)")
+    return data
+
+
+def read_object(path: Path) -> dict[str, Any]:
+    """The JSON object of a run folder's ``report.json`` or ``compare.json``.
+
+    Raises
+    ------
+    TsrkitError
+        Missing (the folder is then not a run folder), empty, not JSON, or not an object.
+    """
+    if not path.exists() and (path.parent / "traversals.jsonl").is_file():
+        raise TsrkitError(
+            f"{path.parent}: a track run without a video (traversals.jsonl only) has no "
+            "report to write again; tsrkit report reads the folders of benchmark, compare "
+            "and track VIDEO --out"
+        )
+    if not os.path.lexists(path):
+        raise TsrkitError(
+            f"{path.parent}: not a run folder ({path.name} missing; tsrkit report reads the "
+            "folders of benchmark, compare and track VIDEO --out)"
+        )
+    text = read_text(path)  # a special, unreadable or huge file: one line naming it
     if not text.strip():
         raise TsrkitError(f"{path}: empty file (the run did not finish writing it)")
-    try:
-        data = json.loads(text)
-    except ValueError as exc:
-        raise TsrkitError(f"{path}: not valid JSON ({exc})") from None
-    if not isinstance(data, dict) or "dataset" not in data:
-        raise TsrkitError(f"{path}: not a tsrkit report (no 'dataset' entry)")
+    data = loads_json(text, path)
+    if not isinstance(data, dict):
+        raise TsrkitError(f"{path}: not a tsrkit report (not a JSON object)")
     return data
 
 
@@ -196,18 +223,15 @@ def read_records(path: Path) -> list[FrameRecord]:
     TsrkitError
         Missing file, or a line that is not a record (naming the line).
     """
-    try:
-        lines = path.read_text(encoding="utf-8").splitlines()
-    except FileNotFoundError:
-        raise TsrkitError(f"{path.parent}: not a run folder ({path.name} missing)") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise TsrkitError(f"{path}: cannot be read ({exc})") from None
+    if not os.path.lexists(path):
+        raise TsrkitError(f"{path.parent}: not a run folder ({path.name} missing)")
+    lines = read_text(path).splitlines()
     records = []
     for number, line in enumerate(lines, 1):
         if not line.strip():
             continue
         try:
-            data = json.loads(line)
+            data = loads_json(line, f"{path}: line {number}")
             records.append(FrameRecord.from_json(data))
         except (ValueError, KeyError, TypeError, AttributeError) as exc:
             problem = f"missing {exc}" if isinstance(exc, KeyError) else str(exc)

@@ -60,6 +60,7 @@ def build(
     params: Params = (),
     config: Config = None,
     classifier_alone: bool = False,
+    with_tracker: bool = True,
 ) -> Selection:
     """Instantiate the chosen plugins with validated, routed parameters.
 
@@ -75,8 +76,13 @@ def build(
     classifier_alone : bool
         When a classifier and no detector is named, run the classifier alone (on ground-truth
         boxes) instead of adding the default detector.
+    with_tracker : bool
+        False for a run that evaluates frames independently: a config naming a tracker is then
+        refused rather than ignored.
     """
     settings = _config(config)
+    if not with_tracker:
+        no_tracker(settings)
     chosen = {}
     for kind, given in zip(STAGES, (detector, verifier, classifier, tracker)):
         name = given or (settings.get(kind) or {}).get("name")
@@ -113,6 +119,7 @@ def build_compare(
     compared); ``params`` override them.
     """
     settings = _config(config)
+    no_tracker(settings)
     verifier = verifier or (settings.get("verifier") or {}).get("name")
     classifier = classifier or (settings.get("classifier") or {}).get("name")
     assignments: dict[str, Any] = {}
@@ -170,6 +177,17 @@ def build_compare(
         )
         for i, d in enumerate(detectors)
     ]
+
+
+def no_tracker(settings: Mapping[str, Any]) -> None:
+    """Refuse a run configuration that names a tracker where frames are evaluated one by one
+    (``benchmark``, ``compare``): it would be ignored without a word."""
+    entry = settings.get("tracker")
+    if entry:
+        raise ParamError(
+            f"the config names tracker '{entry['name']}', but this verb evaluates frames one by "
+            "one and runs no tracker (use it with detect or track)"
+        )
 
 
 def route_params(

@@ -13,6 +13,7 @@ from __future__ import annotations
 import os
 from collections.abc import Iterable, Iterator
 from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 
 from tsrkit.engine import ordered, pool_context, single_thread
 from tsrkit.errors import TsrkitError
@@ -20,6 +21,7 @@ from tsrkit.follow import Follower
 from tsrkit.inputs import Work, iter_frames, plan_work, read_work
 from tsrkit.pipeline import FrameResult, Pipeline
 from tsrkit.types import Frame, Skipped
+from tsrkit.workers import check_workers, end_with_run, pool_broke
 
 __all__ = ["CHUNK_FRAMES", "Runner", "chunk_frames", "process_frame", "run_pipeline"]
 
@@ -69,8 +71,7 @@ def run_pipeline(
         with one runs here only. A follower's chunks are a multiple of its key-frame interval,
         so that its records do not depend on ``workers``.
     """
-    if workers < 1:
-        raise TsrkitError(f"workers must be at least 1; got {workers}")
+    check_workers(workers)
     if workers == 1:
         for item in iter_frames(paths, every, start, end):
             yield (
@@ -81,16 +82,24 @@ def run_pipeline(
         raise TsrkitError("a tracker follows a video frame by frame: run it with one worker")
     units = plan_work(paths, every, start, end, chunk=chunk_frames(pipeline))
     with ProcessPoolExecutor(
-        workers, mp_context=pool_context(), initializer=_init_worker, initargs=(pipeline, every)
+        workers,
+        mp_context=pool_context(),
+        initializer=_init_worker,
+        initargs=(pipeline, every, os.getpid()),
     ) as pool:
-        for results in ordered(
-            lambda _, unit: unit if isinstance(unit, Skipped) else pool.submit(_process_work, unit),
-            lambda done: [done] if isinstance(done, Skipped) else done.result(),
-            units,
-            4 * workers,
-        ):
-            for result in results:
-                yield result, None
+        try:
+            for results in ordered(
+                lambda _, unit: (
+                    unit if isinstance(unit, Skipped) else pool.submit(_process_work, unit)
+                ),
+                lambda done: [done] if isinstance(done, Skipped) else done.result(),
+                units,
+                4 * workers,
+            ):
+                for result in results:
+                    yield result, None
+        except BrokenProcessPool as exc:
+            raise pool_broke(exc) from None
 
 
 def chunk_frames(pipeline: Runner) -> int:
@@ -110,10 +119,11 @@ def chunk_frames(pipeline: Runner) -> int:
 _WORKER: tuple[Runner, int] | None = None
 
 
-def _init_worker(pipeline: Runner, every: int) -> None:
+def _init_worker(pipeline: Runner, every: int, run: int) -> None:
     global _WORKER
     _WORKER = (pipeline, every)
     single_thread()
+    end_with_run(run)
 
 
 def _process_work(unit: Work) -> list[FrameResult | Skipped]:

@@ -9,7 +9,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from tsrkit.api import STATES, Annotation, Dataset, DatasetError, read_text, to_state
+from tsrkit.api import STATES, Annotation, Dataset, DatasetError, read_json, to_state
 
 
 def resolve_image(base: Path, name: str, images: Path | None = None) -> str:
@@ -95,17 +95,6 @@ def explicit_state(record: Mapping[str, Any], path: Path, where: str) -> str | N
     if state is not None and state not in STATES:
         raise DatasetError(path, f"state {state!r} is not one of {', '.join(STATES)}", where)
     return state
-
-
-def read_json(path: Path) -> Any:
-    """Parse a JSON file; a DatasetError names the line and column of a syntax error."""
-    text = read_text(path)
-    try:
-        return json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise DatasetError(
-            path, f"not valid JSON ({exc.msg})", f"line {exc.lineno} column {exc.colno}"
-        ) from None
 
 
 def field(record: Any, key: str, kind: type | tuple[type, ...], path: Path, where: str) -> Any:

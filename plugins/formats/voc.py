@@ -78,6 +78,9 @@ class Voc(DatasetFormat):
         files = _xml_files(path)
         if not files:
             raise DatasetError(path, "no .xml annotation files found")
+        for file in files:
+            if not file.is_file():  # a FIFO or device would block the XML parser
+                raise DatasetError(file, "not a regular file")
         root = path if path.is_dir() else path.parent
         splits = _splits(root)
         samples = tuple(_sample(f, images, splits.get(f.stem)) for f in files)

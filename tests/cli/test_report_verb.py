@@ -49,7 +49,10 @@ def test_a_run_of_a_dataset_given_by_path_is_rendered_again_with_its_frames(path
     ("damage", "message"),
     [
         (lambda d: (d / "report.json").write_text(""), "report.json: empty file"),
-        (lambda d: (d / "report.json").write_text("{oops"), "report.json: not valid JSON"),
+        (
+            lambda d: (d / "report.json").write_text("{oops"),
+            "report.json: line 1 column 2: not valid JSON",
+        ),
         (lambda d: (d / "report.json").write_text("[1, 2]"), "report.json: not a tsrkit report"),
         (
             lambda d: (d / "detections.jsonl").write_text('{"source": "a.png"}\n{oops\n'),

@@ -197,3 +197,42 @@ def test_a_report_written_before_results_rendered_themselves_still_renders():
     titles = [t.title for r in run_results(stored) for t in r.tables()]
     assert "Overlap matching (Lee 2017, 3.6.2)" in titles
     assert "States of matched detections: confusion" in titles
+
+
+class NotFinite(Metric):
+    """A third-party metric whose figures are not finite (a ratio of zero frames, a bound)."""
+
+    name = "not-finite"
+
+    def reset(self, settings):
+        self.frames = 0
+
+    def update(self, sample, record):
+        self.frames += 1
+
+    def compute(self):
+        return {"odd": {"ratio": float("nan"), "bound": float("inf"), "frames": self.frames}}
+
+
+class NotFinitePlugin:
+    @hookimpl
+    def register_metrics(register):
+        register(NotFinite)
+
+
+def test_non_finite_metric_values_are_written_as_null(registry, tmp_path):
+    registry.add(NotFinitePlugin, "not-finite")
+    args = ["benchmark", "--dataset", "sample", "-d", "gray-tophat", "-w", "1", "-q"]
+    result = CliRunner().invoke(cli, [*args, "--no-cache", "-o", str(tmp_path)])
+    assert result.exit_code == 0, result.output
+
+    def refuse(token):
+        raise AssertionError(f"{token} written into JSON")
+
+    report = json.loads((tmp_path / "report.json").read_text(), parse_constant=refuse)
+    lines = (tmp_path / "detections.jsonl").read_text().splitlines()
+    assert report["odd"] == {"ratio": None, "bound": None, "frames": len(lines)}
+    for line in lines:
+        json.loads(line, parse_constant=refuse)
+    again = CliRunner().invoke(cli, ["report", str(tmp_path), "--writer", "markdown"])
+    assert again.exit_code == 0, again.output

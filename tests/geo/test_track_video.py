@@ -100,3 +100,73 @@ def test_malformed_inputs_give_one_clear_error(tmp_path, break_it, message):
     result = CliRunner().invoke(cli, args)
     assert result.exit_code == 2
     assert message in result.output and "Traceback" not in result.output
+
+
+def strict_json(text: str):
+    """Parse ``text`` as JSON, refusing the ``NaN`` / ``Infinity`` tokens Python accepts."""
+
+    def refuse(token):
+        raise AssertionError(f"{token} is not JSON")
+
+    return json.loads(text, parse_constant=refuse)
+
+
+def test_a_damaged_cache_entry_is_computed_again(drive, tmp_path):
+    out = tmp_path / "run"
+    args = track_args(drive, out)
+    assert CliRunner().invoke(cli, args).exit_code == 0
+    first = json.loads((out / "report.json").read_text())
+    entries = sorted((out / "cache").rglob("*.json"))
+    assert entries
+    for entry, damage in zip(entries, ["{oops", "[]", '{"tracks": 3}', ""], strict=False):
+        entry.write_text(damage)
+    again = CliRunner().invoke(cli, args)
+    assert again.exit_code == 0, again.output
+    assert "Traceback" not in again.output
+    report = json.loads((out / "report.json").read_text())
+    assert report["timing"]["cached_traversals"] == 0
+    assert report["traversals"] == first["traversals"]
+    # Every JSON file of the run folder, the rewritten cache included, is strict JSON.
+    for path in [*out.rglob("*.json"), *out.rglob("*.jsonl")]:
+        for line in [path.read_text()] if path.suffix == ".json" else path.read_text().split("\n"):
+            if line.strip():
+                strict_json(line)
+
+
+@pytest.mark.parametrize("option", ["--upstream", "--downstream", "--vicinity", "--slack"])
+@pytest.mark.parametrize("value", ["inf", "-inf", "nan"])
+def test_non_finite_distances_are_refused(drive, tmp_path, option, value):
+    out = tmp_path / "run"
+    result = CliRunner().invoke(cli, [*track_args(drive, out), option, value])
+    assert result.exit_code == 2
+    errors = [line for line in result.output.splitlines() if line.startswith("Error:")]
+    assert len(errors) == 1 and option in errors[0] and value in errors[0]
+    assert "Traceback" not in result.output and not out.exists()
+
+
+def test_report_writes_a_track_run_again(drive, tmp_path):
+    out = tmp_path / "run"
+    assert CliRunner().invoke(cli, track_args(drive, out)).exit_code == 0
+    page = (out / "report.html").read_text()
+    (out / "report.html").unlink()
+    (out / "summary.md").unlink()
+    result = CliRunner().invoke(
+        cli, ["report", str(out), "--writer", "html", "--writer", "markdown"]
+    )
+    assert result.exit_code == 0, result.output
+    assert (out / "report.html").read_text() == page
+    assert "| 0 | 0 | through |" in (out / "summary.md").read_text()
+    (out / "traversals.jsonl").write_text('{"traversal": 0}\n')
+    broken = CliRunner().invoke(cli, ["report", str(out)])
+    assert broken.exit_code == 2
+    assert "traversals.jsonl: line 1: not a traversal record (missing intersection" in (
+        broken.output
+    )
+
+
+def test_report_says_what_a_track_run_without_video_lacks(drive, tmp_path):
+    args = ["track", "--gps", str(drive / "gps.csv"), "--map", str(drive / "map.osm")]
+    assert CliRunner().invoke(cli, [*args, "--out", str(tmp_path)]).exit_code == 0
+    result = CliRunner().invoke(cli, ["report", str(tmp_path)])
+    assert result.exit_code == 2 and "Traceback" not in result.output
+    assert "a track run without a video (traversals.jsonl only)" in result.output

@@ -16,6 +16,7 @@ from tsrkit.cli.common import FiniteFloatRange, plugin_options
 from tsrkit.cli.completion import dataset_names, plugin_list, plugin_names, preset_or_file
 from tsrkit.cli.errors import UserError
 from tsrkit.eval.settings import BOX_OPTIONS
+from tsrkit.outputs import dataset_inputs, reading
 from tsrkit.report import print_table
 from tsrkit.selection import build, build_compare
 
@@ -134,7 +135,8 @@ def run_options(func):
 
 
 def load_dataset(ref: str, format_name: str | None, images: str | None, split: str | None):
-    """Open the dataset and keep one split if asked."""
+    """Open the dataset and keep one split if asked; a dataset without a sample ends the run
+    with exit status 1 (nothing found, as for ``detect``)."""
     from tsrkit.datasets import open_dataset
 
     dataset = open_dataset(ref, format=format_name, images=images)
@@ -142,7 +144,16 @@ def load_dataset(ref: str, format_name: str | None, images: str | None, split: s
         dataset = dataset.split(split)
         if not len(dataset):
             raise UserError(f"dataset '{ref}' has no samples in split '{split}'")
+    if not len(dataset):
+        click.echo(f"error: dataset '{ref}' has no samples", err=True)
+        raise SystemExit(1)
     return dataset
+
+
+def check_engine(engine: str, scheduler: str | None) -> None:
+    """Refuse ``--scheduler`` without ``--engine dask`` (it would be ignored)."""
+    if scheduler is not None and engine != "dask":
+        raise UserError(f"--scheduler {scheduler} needs --engine dask")
 
 
 def _run_kwargs(
@@ -219,20 +230,41 @@ def benchmark_command(
     """
     from tsrkit.benchmarking import benchmark
 
+    check_engine(engine, scheduler)
     start_pool_early(workers, engine)
-    chosen = build(detector, verifier, classifier, None, params, config, classifier_alone=True)
-    dataset = load_dataset(dataset_ref, format_name, images, split)
-    report = benchmark(
-        dataset,
-        chosen.detector,
-        chosen.classifier,
-        out=out,
-        verifier=chosen.verifier,
-        **_run_kwargs(
-            workers, engine, scheduler, no_cache, iou_threshold, quiet, eval_box, writers, no_plots
-        ),
+    chosen = build(
+        detector,
+        verifier,
+        classifier,
+        None,
+        params,
+        config,
+        classifier_alone=True,
+        with_tracker=False,
     )
+    dataset = load_dataset(dataset_ref, format_name, images, split)
+    with reading(dataset_inputs([dataset_ref], dataset)):
+        report = benchmark(
+            dataset,
+            chosen.detector,
+            chosen.classifier,
+            out=out,
+            verifier=chosen.verifier,
+            **_run_kwargs(
+                workers,
+                engine,
+                scheduler,
+                no_cache,
+                iou_threshold,
+                quiet,
+                eval_box,
+                writers,
+                no_plots,
+            ),
+        )
     print_table([report])
+    for note in report.get("notes", []):
+        click.echo(f"note: {note}", err=True)
     click.echo(f"report: {os.path.join(out, 'report.json')}", err=True)
     if report["frames"] == 0 and report["skipped"]:
         click.echo(f"error: all {len(report['skipped'])} inputs were skipped", err=True)
@@ -329,6 +361,7 @@ def compare_command(
       tsrkit compare --config recommended --without-verifier --html -o out/verifier
       tsrkit compare -p conspicuity.weights=1,1,2 -p gray-tophat.h_peak=0.8
     """
+    check_engine(engine, scheduler)
     start_pool_early(workers, engine)
     run_compare(
         dataset_ref,
@@ -370,20 +403,25 @@ def run_compare(
     from tsrkit.comparison import compare
 
     names = [n.strip() for n in detector_names.split(",") if n.strip()]
+    if not names:
+        raise UserError(
+            f"--detectors {detector_names!r} names no detector (e.g. lab-frst,conspicuity)"
+        )
     runs = build_compare(names, classifier, verifier, params, config)
     if without_verifier and runs[0].verifier is None:
         raise click.UsageError("--without-verifier needs a verifier (--verifier or --config)")
     dataset = load_dataset(dataset_ref, format_name, images, split)
     detectors = [run.detector for run in runs if run.detector is not None]
-    comparison = compare(
-        dataset,
-        detectors,
-        runs[0].classifier,
-        out=out,
-        verifier=runs[0].verifier,
-        without_verifier=without_verifier,
-        **options,
-    )
+    with reading(dataset_inputs([dataset_ref], dataset)):
+        comparison = compare(
+            dataset,
+            detectors,
+            runs[0].classifier,
+            out=out,
+            verifier=runs[0].verifier,
+            without_verifier=without_verifier,
+            **options,
+        )
     print_table(comparison["reports"])
     for test in comparison["paired_tests"] + comparison.get("verifier_tests", []):
         click.echo(

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 from collections import Counter
 from contextlib import nullcontext
 from pathlib import Path
@@ -11,7 +10,9 @@ import click
 from rich.console import Console
 from rich.table import Table
 
+from tsrkit.atomic import json_text
 from tsrkit.cli.completion import dataset_names, plugin_names
+from tsrkit.cli.drive import drive_command
 from tsrkit.cli.synth import synth_command
 from tsrkit.datasets import (
     DatasetError,
@@ -23,6 +24,8 @@ from tsrkit.datasets import (
 )
 from tsrkit.datasets.registry import GENERATED_SAMPLE
 from tsrkit.errors import TsrkitError
+from tsrkit.outlock import locked_file
+from tsrkit.outputs import dataset_inputs, reading, refuse_input, refuse_special
 from tsrkit.types import Dataset
 
 __all__ = [
@@ -45,6 +48,7 @@ def datasets_group() -> None:
       tsrkit datasets info roboflow_traffic_light_kr
       tsrkit datasets convert roboflow_traffic_light_kr --to yolo --out kr-yolo/
       tsrkit datasets synth --out synth/ --frames 100
+      tsrkit datasets drive --out city/          # video, GPS log and map for tsrkit track
     """
 
 
@@ -62,7 +66,7 @@ def list_command(as_json: bool) -> None:
     for entry in load_registry().values():
         rows.append({**entry.to_info(), "present": _present(entry)})
     if as_json:
-        click.echo(json.dumps(rows, indent=2))
+        click.echo(json_text(rows, indent=2))
         return
     table = Table(title=f"tsrkit datasets ({registry_path()})")
     for column in ("name", "format", "task", "box", "licence", "present"):
@@ -106,7 +110,7 @@ def info_command(name: str, as_json: bool) -> None:
         "labels": dict(labels.most_common()),
     }
     if as_json:
-        click.echo(json.dumps(facts, indent=2, default=str))
+        click.echo(json_text(facts, indent=2, default=str))
         return
     table = Table(title=f"dataset {dataset.name}", show_header=False)
     for key, value in facts.items():
@@ -196,7 +200,10 @@ def convert_command(
     console = Console(stderr=True, soft_wrap=True)
     with console.status(f"converting {src} to {to_format}...") if not quiet else nullcontext():
         dataset = open_dataset(src, format=src_format, images=images)
-        write_dataset(dataset, to_format, out)
+        refuse_special(out, "--out")
+        with reading(dataset_inputs([src], dataset)), locked_file(out):
+            refuse_input(out, "--out")
+            write_dataset(dataset, to_format, out)
         changes = state_changes(dataset, open_dataset(out, format=to_format))
     boxes = sum(len(s.annotations) for s in dataset)
     click.echo(f"wrote {len(dataset)} images, {boxes} boxes as {to_format} to {out}")
@@ -238,3 +245,4 @@ def _present(entry) -> str:
 
 
 datasets_group.add_command(synth_command)
+datasets_group.add_command(drive_command)

@@ -21,10 +21,14 @@ from tsrkit.cli.errors import UserError
 from tsrkit.draw import draw_detections
 from tsrkit.errors import TsrkitError
 from tsrkit.follow import Follower
+from tsrkit.inputs import IMAGE_EXTENSIONS, VIDEO_EXTENSIONS, check_range
+from tsrkit.outlock import locked_file
+from tsrkit.outputs import reading, refuse_input, refuse_special, writing
 from tsrkit.report import ProgressBar
 from tsrkit.selection import build
 from tsrkit.streams import Runner, run_pipeline
 from tsrkit.types import Frame, Skipped
+from tsrkit.workers import check_workers
 
 __all__ = ["default_inputs", "detect_command", "flushed_output", "run_detect"]
 
@@ -101,6 +105,17 @@ def _write_overlay(folder: Path, frame: Frame, number: int, detections) -> None:
     if ok:
         with atomic_open(folder / f"{name}.png", "wb") as fh:
             fh.write(encoded.tobytes())
+
+
+def printable(text: str) -> str:
+    """``text`` with control characters escaped, so that a skipped file's line stays one line.
+
+    Examples
+    --------
+    >>> printable("a\\nb.png")
+    'a\\\\nb.png'
+    """
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
 
 
 def default_inputs() -> list[str]:
@@ -192,17 +207,30 @@ def detect_command(
       tsrkit detect frames/ -d conspicuity -p weights=1,1,2 -w 2 -o d.jsonl
       tsrkit detect drive.mp4 --config recommended --agree 3 -w 2 -o drive.jsonl
     """
-    pipeline = build(detector, verifier, classifier, tracker, params, config).pipeline()
+    if any(not str(p) for p in paths):
+        raise UserError("an empty path was given (quote a real file or folder)")
+    check_range(every, start, end)
+    check_workers(workers)
+    inputs = list(paths) or default_inputs()
+    draw_dir = Path(draw) if draw else None
+    with reading(inputs):
+        for given, option in ((out, "--out"), (draw_dir, "--draw")):
+            if given is not None:
+                refuse_input(given, option)
+                refuse_special(given, option)
+        if out is not None and out.suffix.lower() in IMAGE_EXTENSIONS | VIDEO_EXTENSIONS:
+            raise UserError(f"--out {out} names an image or video; detect writes JSON Lines")
+        pipeline = build(detector, verifier, classifier, tracker, params, config).pipeline()
     if key_every > 1 and pipeline.tracker is not None:
         raise UserError("--key-every and --tracker both carry lights between frames: choose one")
     runner = Follower(pipeline, key_every) if key_every > 1 else pipeline
-    inputs = list(paths) or default_inputs()
-    draw_dir = Path(draw) if draw else None
     if draw_dir is not None:
         draw_dir.mkdir(parents=True, exist_ok=True)
     sink = flushed_output(out) if out else nullcontext(sys.stdout)
     progress = not quiet and Console(stderr=True).is_terminal  # no bar in redirected logs
-    with sink as stream:
+    partial = out.with_name(out.name + ".partial") if out else None
+    lock = locked_file(out) if out else nullcontext()
+    with lock, writing([out, partial, draw_dir]), sink as stream:
         frames, found, skipped = run_detect(
             runner, inputs, stream, draw_dir, every, start, end, workers, progress, agree
         )
@@ -212,7 +240,7 @@ def detect_command(
         f"[bold]{len(skipped)}[/bold] skipped" + (f" -> {out}" if out else "")
     )
     for item in skipped:
-        console.print(f"  skipped {item.source}: {item.reason}", markup=False)
+        console.print(f"  skipped {printable(item.source)}: {item.reason}", markup=False)
     if frames == 0 and skipped:
         console.print(f"error: all {len(skipped)} inputs were skipped", markup=False)
         raise SystemExit(1)

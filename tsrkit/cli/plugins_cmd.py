@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
-import json
-
 import click
 from rich.console import Console
 from rich.table import Table
 
 import tsrkit
+from tsrkit.atomic import json_text
 from tsrkit.registry import KINDS
 
 __all__ = ["plugins_command"]
@@ -32,7 +31,7 @@ def plugins_command(as_json: bool, kind: str | None) -> None:
     """
     found = tsrkit.plugins(kind)
     if as_json:
-        click.echo(json.dumps(found, indent=2))
+        click.echo(json_text(found, indent=2))
         return
     table = Table(title="tsrkit plugins")
     for column in ("name", "kind", "package", "version", "summary"):

@@ -8,6 +8,7 @@ from pathlib import Path
 import click
 
 from tsrkit.cli.completion import plugin_names
+from tsrkit.cli.errors import UserError
 
 __all__ = ["report_command"]
 
@@ -24,13 +25,14 @@ __all__ = ["report_command"]
     help="Report writer to run (repeatable).",
 )
 def report_command(run_dir, writers) -> None:
-    """Write RUN_DIR/report.html (a benchmark folder) or RUN_DIR/compare.html (a compare
-    folder) from the files the run left, without recomputing.
+    """Write RUN_DIR/report.html (a benchmark or `track VIDEO --out` folder) or
+    RUN_DIR/compare.html (a compare folder) from the files the run left, without recomputing.
 
     \b
     Examples:
       tsrkit report tsrkit-out/conspicuity     # one benchmark run: report.html
       tsrkit report tsrkit-out                 # a compare folder: compare.html
+      tsrkit report runs/drive                 # a track run: report.html
       tsrkit report runs/kr --writer markdown --writer html
     """
     from tsrkit.eval.guard import Failure
@@ -48,6 +50,11 @@ def report_command(run_dir, writers) -> None:
                 written += writer.write_comparison(folder)
             except Exception as exc:
                 failures.append(Failure.of(f"writer '{writer.name}'", exc))
+        if not written and not failures:
+            names = ", ".join(w.name for w in chosen)
+            raise UserError(
+                f"{folder}: a compare folder; {names} write nothing for one (html does)"
+            )
     else:
         run = load_run(folder)
         for writer in chosen:

@@ -9,6 +9,8 @@ import click
 from rich.console import Console
 
 from tsrkit.errors import TsrkitError
+from tsrkit.outlock import locked_file
+from tsrkit.outputs import refuse_special
 from tsrkit.synth import LIGHTINGS, generate
 
 __all__ = ["synth_command"]
@@ -22,7 +24,11 @@ __all__ = ["synth_command"]
     help="Output folder (images/, annotations.json, coco.json).",
 )
 @click.option(
-    "--frames", default=48, show_default=True, type=click.IntRange(min=1), help="Number of frames."
+    "--frames",
+    default=48,
+    show_default=True,
+    type=click.IntRange(1, 1_000_000),
+    help="Number of frames.",
 )
 @click.option("--seed", default=0, show_default=True, type=int, help="Scene seed.")
 @click.option("--width", default=480, show_default=True, type=click.IntRange(64, 8192))
@@ -66,8 +72,14 @@ def synth_command(
     conditions = tuple(c.strip() for c in lighting.split(",") if c.strip())
     from tsrkit.report import ProgressBar
 
+    if video is not None:
+        refuse_special(video, "--video")
+
     try:
-        with ProgressBar(frames, not quiet and Console(stderr=True).is_terminal, "synth") as bar:
+        with (
+            locked_file(out),
+            ProgressBar(frames, not quiet and Console(stderr=True).is_terminal, "synth") as bar,
+        ):
             dataset = generate(
                 out, frames, seed, width, height, overwrite=overwrite, lighting=conditions,
                 on_frame=bar.advance,

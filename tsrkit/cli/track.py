@@ -12,8 +12,13 @@ import click
 from rich.console import Console
 from rich.table import Table
 
-from tsrkit.atomic import atomic_open
-from tsrkit.cli.common import plugin_options
+from tsrkit.atomic import atomic_open, json_line
+from tsrkit.cli.common import FiniteFloatRange, plugin_options
+from tsrkit.cli.errors import UserError
+from tsrkit.files import not_regular
+from tsrkit.geo.gps import EARLIEST, LATEST
+from tsrkit.outlock import locked
+from tsrkit.outputs import reading, refuse_input
 
 __all__ = ["track_command"]
 
@@ -27,20 +32,26 @@ def _start_time(text: str | None) -> float | None:
     if text is None:
         return None
     try:
-        return float(text)
+        seconds = float(text)
     except ValueError:
-        pass
-    try:
-        stamp = datetime.fromisoformat(text.replace("Z", "+00:00"))
-    except ValueError:
-        raise click.BadParameter(f"'{text}' is neither epoch seconds nor ISO 8601") from None
-    return (stamp if stamp.tzinfo else stamp.replace(tzinfo=UTC)).timestamp()
+        try:
+            stamp = datetime.fromisoformat(text.replace("Z", "+00:00"))
+        except ValueError:
+            raise click.BadParameter(
+                f"'{text}' is neither epoch seconds nor ISO 8601", param_hint="--start-utc"
+            ) from None
+        seconds = (stamp if stamp.tzinfo else stamp.replace(tzinfo=UTC)).timestamp()
+    if not EARLIEST <= seconds <= LATEST:  # NaN fails too
+        raise click.BadParameter(
+            f"'{text}' is not a time in the years 1970-9999", param_hint="--start-utc"
+        )
+    return seconds
 
 
 def _write_jsonl(path: Path, records) -> None:
     with atomic_open(path) as fh:
         for record in records:
-            fh.write(json.dumps(record) + "\n")
+            fh.write(json_line(record) + "\n")
 
 
 @click.command("track")
@@ -61,7 +72,7 @@ def _write_jsonl(path: Path, records) -> None:
 )
 @click.option(
     "--vicinity",
-    type=click.FloatRange(min=1.0, max=1000.0),
+    type=FiniteFloatRange(min=1.0, max=1000.0),
     default=30.0,
     show_default=True,
     help="Distance (m) within which a fix is near an intersection (Zheng's Figure 3-13: 50).",
@@ -75,14 +86,14 @@ def _write_jsonl(path: Path, records) -> None:
 )
 @click.option(
     "--upstream",
-    type=click.FloatRange(min=0.0),
+    type=FiniteFloatRange(min=0.0, max=1000.0),
     default=10.0,
     show_default=True,
     help="Short range: trajectory metres before the anchor frame (3.4.4).",
 )
 @click.option(
     "--downstream",
-    type=click.FloatRange(min=0.0),
+    type=FiniteFloatRange(min=0.0, max=1000.0),
     default=5.0,
     show_default=True,
     help="Short range: trajectory metres after the anchor frame (3.4.4).",
@@ -96,14 +107,14 @@ def _write_jsonl(path: Path, records) -> None:
 )
 @click.option(
     "--roi-top",
-    type=click.FloatRange(min=0.05, max=1.0),
+    type=FiniteFloatRange(min=0.05, max=1.0),
     default=0.6,
     show_default=True,
     help="Share of the frame's height searched by whole-frame detection (Zheng 5.4: 0.6).",
 )
 @click.option(
     "--slack",
-    type=click.FloatRange(min=0.0, max=3.0),
+    type=FiniteFloatRange(min=0.0, max=3.0),
     default=0.0,
     show_default=True,
     help="Tolerance (radii) across a head's axis for colour changes in Eq. 3.37 (paper: 0).",
@@ -164,10 +175,23 @@ def track_command(
     """
     from tsrkit.geo import read_signals, read_track, traversals
 
-    if video is None and (truth or detector or verifier or classifier or tracker or params):
-        raise click.UsageError("--truth and plugin options need a VIDEO")
+    if video is None:
+        given = video_options_given(click.get_current_context())
+        if given:
+            raise click.UsageError(
+                f"{', '.join(given)}: need a VIDEO (without one, track lists the traversals)"
+            )
+    with reading([video, gps, osm, truth]):
+        if out is not None:
+            refuse_input(out, "--out")
+    for given in (video, truth):
+        problem = not_regular(given) if given is not None else None
+        if problem:
+            raise UserError(f"{given}: {problem}")
     track = read_track(gps)
     signals = read_signals(osm)
+    if len(track) < 2:  # one fix has no direction: no movement through an intersection
+        raise UserError(f"{gps}: one GPS fix only; a track needs at least two GPS fixes")
     console = Console()
     if video is not None:
         from tsrkit.spatiotemporal.run import TrackSettings
@@ -186,6 +210,7 @@ def track_command(
             console,
         )
         return
+    no_signals(signals, osm)
     found = traversals(track, signals, vicinity)
     table = Table(
         title=f"{len(found)} traversals of {len(signals)} intersections ({len(track)} fixes)"
@@ -206,8 +231,8 @@ def track_command(
         console.print(f"GPS gap: {_utc(start)} - {_utc(end)[11:]} (not bridged)", markup=False)
     if out:
         path = Path(out) / "traversals.jsonl"
-        path.parent.mkdir(parents=True, exist_ok=True)
-        _write_jsonl(path, (t.to_json(signals) for t in found))
+        with locked(out):
+            _write_jsonl(path, (t.to_json(signals) for t in found))
         console.print(f"-> {path}")
 
 
@@ -218,7 +243,6 @@ def _track_video(
     import contextlib
     import time
 
-    from tsrkit.outlock import locked
     from tsrkit.report import ProgressBar, versions
     from tsrkit.selection import build
     from tsrkit.spatiotemporal.evaluate import evaluate_traversal, read_truth, temporal_section
@@ -229,7 +253,13 @@ def _track_video(
     selection = build(*plugins)
     truth_frames = read_truth(truth) if truth else None
     fps, count = video_facts(video)
+    no_signals(signals, signals.source)
     start = float(track.time[0]) if start_utc is None else start_utc
+    if start > track.time[-1] or start + count / max(fps, 1e-9) < track.time[0]:
+        raise UserError(
+            f"--start-utc {_utc(start)}: the video's {count} frames lie outside the GPS log "
+            f"({_utc(float(track.time[0]))} - {_utc(float(track.time[-1]))[11:]})"
+        )
     found = frame_traversals(
         track,
         signals,
@@ -267,6 +297,7 @@ def _track_video(
                 "map": signals.source,
                 "frames": count,
                 "fps": fps,
+                "start_utc": start,
                 "clip_frames": total,
                 "traversals": len(records),
                 **json.loads(identity(selection, settings)),
@@ -288,6 +319,42 @@ def _track_video(
             console.print(f"note: {note}", markup=False)
         shown = ", ".join(["traversals.jsonl", *written["files"]])
         console.print(f"-> {out}: {shown}, plots/", markup=False)
+
+
+#: The options that act on the video's frames only.
+VIDEO_ONLY = (
+    "detector",
+    "verifier",
+    "classifier",
+    "tracker",
+    "params",
+    "config",
+    "start_utc",
+    "upstream",
+    "downstream",
+    "top",
+    "roi_top",
+    "slack",
+    "flow_margin",
+    "truth",
+)
+
+
+def video_options_given(ctx: click.Context) -> list[str]:
+    """The video-only options the command line (or the environment) set, by their long name:
+    without a VIDEO they would be ignored without a word."""
+    flags = {p.name: p.opts[-1] for p in ctx.command.params}
+    return [
+        flags[name]
+        for name in VIDEO_ONLY
+        if ctx.get_parameter_source(name) not in (None, click.core.ParameterSource.DEFAULT)
+    ]
+
+
+def no_signals(signals, osm) -> None:
+    """Refuse a map without a signalised intersection: every run on it finds nothing."""
+    if not len(signals):
+        raise UserError(f"{osm}: no traffic signal (highway=traffic_signals node) in the map")
 
 
 def _print_traversals(console, records, evaluations, frames, clip_frames, elapsed) -> None:

@@ -9,6 +9,9 @@ from rich.console import Console
 
 from tsrkit.cli.completion import dataset_names, plugin_names, trainable_names
 from tsrkit.errors import TsrkitError
+from tsrkit.models import model_paths
+from tsrkit.outlock import locked_file
+from tsrkit.outputs import dataset_inputs, reading, refuse_input, refuse_special
 from tsrkit.params import parse_assignments
 from tsrkit.registry import get_registry
 from tsrkit.training import train
@@ -91,12 +94,21 @@ def train_command(
         raise click.UsageError("detector.KEY=VALUE parameters need --detector")
     det = get_registry().create("detector", detector, detector_params) if detector else None
     dataset = open_datasets(dataset_refs, split, format=format_name, images=images)
+    if not len(dataset):
+        click.echo(f"error: {', '.join(dataset_refs)}: no samples to train on", err=True)
+        raise SystemExit(1)
     status = Console(stderr=True).status(
         f"training {plugin} on {len(dataset)} samples of {dataset.name}...", spinner="dots"
     )
+    model = model_paths(out)
+    for path in model:
+        refuse_special(path, "--out")
     try:
-        with status if not quiet else nullcontext():
-            path = train(plugin, dataset, out, own, det)
+        with reading(dataset_inputs(dataset_refs, dataset)), locked_file(model[0]):
+            for path in model:
+                refuse_input(path, "--out")
+            with status if not quiet else nullcontext():
+                path = train(plugin, dataset, out, own, det)
     except TsrkitError:
         raise
     except ValueError as exc:  # the data cannot train this plugin (a class without samples...)

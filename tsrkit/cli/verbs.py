@@ -55,8 +55,9 @@ VERBS = {
     "report": Verb(
         "tsrkit.cli.report",
         "report_command",
-        "Write RUN_DIR/report.html (a benchmark folder) or RUN_DIR/compare.html (a compare "
-        "folder) from the files the run left, without recomputing.",
+        "Write RUN_DIR/report.html (a benchmark or `track VIDEO --out` folder) or "
+        "RUN_DIR/compare.html (a compare folder) from the files the run left, without "
+        "recomputing.",
     ),
     "track": Verb(
         "tsrkit.cli.track",

@@ -9,11 +9,10 @@ import os
 from pathlib import Path
 from typing import Any
 
-import yaml
-
 from tsrkit.errors import TsrkitError
+from tsrkit.files import InputFileError, loads_json, loads_yaml, read_bytes
 
-__all__ = ["DatasetError", "read_text", "read_yaml"]
+__all__ = ["DatasetError", "read_json", "read_text", "read_yaml"]
 
 
 class DatasetError(TsrkitError):
@@ -47,8 +46,9 @@ def read_text(path: str | os.PathLike, missing: str = "file not found") -> str:
     Raises
     ------
     DatasetError
-        ``missing`` when the file does not exist, the reason when it cannot be read, and
-        "not valid UTF-8" with the line and the offending byte when it does not decode.
+        ``missing`` when the file does not exist, the reason when it cannot be read (not a
+        regular file, larger than :data:`tsrkit.files.MAX_TEXT_BYTES`...), and "not valid
+        UTF-8" with the line and the offending byte when it does not decode.
 
     Examples
     --------
@@ -62,11 +62,11 @@ def read_text(path: str | os.PathLike, missing: str = "file not found") -> str:
     """
     path = Path(path)
     try:
-        data = path.read_bytes()
-    except FileNotFoundError:
-        raise DatasetError(path, missing) from None
-    except OSError as exc:
-        raise DatasetError(path, f"cannot read ({exc.strerror or exc})") from None
+        data = read_bytes(path)
+    except InputFileError as exc:
+        raise DatasetError(
+            path, missing if exc.problem == "no such file" else exc.problem
+        ) from None
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:
@@ -76,7 +76,8 @@ def read_text(path: str | os.PathLike, missing: str = "file not found") -> str:
 
 
 def read_yaml(path: str | os.PathLike, missing: str = "file not found") -> Any:
-    """Parse a YAML file with the C loader when available.
+    """Parse a YAML file (:func:`tsrkit.files.loads_yaml`: the C loader when available, bounded
+    nesting and aliases, no repeated key).
 
     Raises
     ------
@@ -84,15 +85,22 @@ def read_yaml(path: str | os.PathLike, missing: str = "file not found") -> Any:
         ``missing`` when the file does not exist; "not valid UTF-8" or "not valid YAML" with
         the line otherwise.
     """
-    path = Path(path)
-    text = read_text(path, missing)
     try:
-        return yaml.load(text, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        reason = " ".join(str(getattr(exc, "problem", None) or exc).split())  # one line
-        raise DatasetError(
-            path,
-            f"not valid YAML ({reason})",
-            f"line {mark.line + 1}" if mark else "",
-        ) from None
+        return loads_yaml(read_text(path, missing), path)
+    except InputFileError as exc:
+        raise DatasetError(path, exc.problem) from None
+
+
+def read_json(path: str | os.PathLike, missing: str = "file not found") -> Any:
+    """Parse a JSON file (:func:`tsrkit.files.loads_json`: nesting bounded).
+
+    Raises
+    ------
+    DatasetError
+        ``missing`` when the file does not exist; "not valid UTF-8" or "not valid JSON" with
+        the line and column otherwise, or "nested deeper than ...".
+    """
+    try:
+        return loads_json(read_text(path, missing), path)
+    except InputFileError as exc:
+        raise DatasetError(path, exc.problem) from None

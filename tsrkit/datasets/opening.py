@@ -16,6 +16,7 @@ from tsrkit.datasets.errors import DatasetError
 from tsrkit.datasets.registry import DatasetEntry, load_registry
 from tsrkit.datasets.states import check_mapping, to_state
 from tsrkit.errors import TsrkitError
+from tsrkit.files import not_regular
 from tsrkit.registry import get_registry
 from tsrkit.types import Annotation, Dataset
 
@@ -90,7 +91,8 @@ def read_dataset(path: Path, format: str, images: Path | None = None) -> Dataset
     DatasetError
         A malformed file: the reader's own error, or one made here of what a reader let
         through (invalid UTF-8, values of the wrong type, a box that is not finite or has no
-        area), naming the file and the problem.
+        area, or lies wholly outside the image size its sample declares), naming the file and
+        the problem.
     """
     reader = get_registry().create("format", format)
     try:
@@ -108,6 +110,12 @@ def read_dataset(path: Path, format: str, images: Path | None = None) -> Dataset
                 raise DatasetError(
                     path, f"box {tuple(ann.bbox)} is not finite or has no area", where
                 )
+            w, h = sample.width, sample.height
+            if w and h and (x0 >= w or y0 >= h or x1 <= 0 or y1 <= 0):
+                where = f"{Path(sample.source).name}, box {k}"
+                raise DatasetError(
+                    path, f"box {tuple(ann.bbox)} lies outside the {w}x{h} image", where
+                )
     return dataset
 
 
@@ -119,6 +127,9 @@ def detect_format(path: Path) -> str:
     TsrkitError
         When none or several match, naming them and asking for ``--format``.
     """
+    problem = None if Path(path).is_dir() else not_regular(path)
+    if problem:
+        raise DatasetError(path, problem)
     matched = [
         info.name
         for info in get_registry().plugins("format")

@@ -6,6 +6,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+from tsrkit import files
 from tsrkit.errors import TsrkitError
 
 __all__ = ["GeoError", "read_text"]
@@ -33,10 +34,18 @@ class GeoError(TsrkitError):
 
 
 def read_text(path: Path) -> str:
-    """The UTF-8 text of ``path`` (a byte order mark dropped), or a :class:`GeoError`."""
+    """The UTF-8 text of ``path`` (a byte order mark dropped), or a :class:`GeoError`: missing,
+    not a regular file, larger than :data:`tsrkit.files.MAX_TEXT_BYTES`, not UTF-8."""
     try:
-        return path.read_text(encoding="utf-8-sig")
-    except FileNotFoundError:
-        raise GeoError(path, "no such file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise GeoError(path, f"cannot read as UTF-8 text ({exc})") from None
+        return files.read_text(path)
+    except files.InputFileError as exc:
+        raise GeoError(path, exc.problem) from None
+
+
+def check_file(path: Path) -> None:
+    """Raise a :class:`GeoError` unless ``path`` is a regular file of at most
+    :data:`tsrkit.files.MAX_TEXT_BYTES` (a FIFO or device would block the reader)."""
+    try:
+        files.file_size(path, files.MAX_TEXT_BYTES)
+    except files.InputFileError as exc:
+        raise GeoError(path, exc.problem) from None

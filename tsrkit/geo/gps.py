@@ -70,6 +70,9 @@ def _csv_time(text: str) -> float:
 
 Rows = list[tuple[int | str, float, float, float]]
 
+#: UTC seconds of the first and last instant a GPS time may name (1970-01-01, 9999-12-31).
+EARLIEST, LATEST = 0.0, 253402300799.0
+
 #: Log formats by file extension; other extensions are told apart by their first character.
 _BY_SUFFIX = {".csv": "csv", ".gpx": "gpx", ".nmea": "nmea", ".nma": "nmea", ".nme": "nmea"}
 
@@ -167,8 +170,8 @@ def read_track(path: str | os.PathLike) -> Track:
     ------
     GeoError
         Naming the file and line (GPX: track point): missing file, invalid text, wrong column
-        count or tags, a value that is not a number, NaN, a latitude or longitude out of range,
-        times not increasing, or no fix at all.
+        count or tags, a value that is not a number, NaN, a time outside the years 1970-9999,
+        a latitude or longitude out of range, times not increasing, or no fix at all.
     """
     path = Path(path)
     rows, _ = _rows(path)
@@ -178,6 +181,8 @@ def read_track(path: str | os.PathLike) -> Track:
     for number, t, la, lo in rows:
         if not all(math.isfinite(v) for v in (t, la, lo)):
             raise GeoError(path, "time, latitude or longitude is not finite", number)
+        if not EARLIEST <= t <= LATEST:
+            raise GeoError(path, f"time {t:g} s is outside the years 1970-9999", number)
         if not -90 <= la <= 90 or not -180 <= lo <= 180:
             raise GeoError(path, f"latitude {la} / longitude {lo} out of range", number)
         if t <= previous:

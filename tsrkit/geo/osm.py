@@ -21,7 +21,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
-from tsrkit.geo.errors import GeoError, read_text
+from tsrkit.geo.errors import GeoError, check_file, read_text
 from tsrkit.geo.geojson import geojson_nodes
 from tsrkit.geo.osm_pbf import SIGNAL_TAGS, pbf_nodes
 from tsrkit.geo.projection import LocalProjection
@@ -123,6 +123,8 @@ def read_signals(path: str | os.PathLike, merge_m: float = MERGE_M) -> Signals:
         node (feature) with bad coordinates.
     """
     path = Path(path)
+    if path.exists():  # a missing file is each reader's own message
+        check_file(path)
     nodes = _nodes(path)
     signals = [n for n in nodes if n[3].get("highway") == "traffic_signals"]
     crossings = [n for n in nodes if n[3].get("highway") != "traffic_signals"]

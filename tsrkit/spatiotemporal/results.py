@@ -14,6 +14,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from tsrkit.errors import TsrkitError
 from tsrkit.eval.guard import Failure
 from tsrkit.eval.results import Figure, MetricResult, Plot, Table, fmt
 from tsrkit.eval.runfacts import STAGES, description_tables
@@ -24,9 +25,15 @@ __all__ = [
     "ACCURACY_NOTE",
     "TrackFacts",
     "TraversalsResult",
+    "is_track_report",
+    "load_track_run",
+    "read_traversals",
     "summary_rows",
     "write_track_run",
 ]
+
+#: What a record of ``traversals.jsonl`` holds (its number and the fields the reports read).
+TRAVERSAL_FIELDS = ("traversal", "intersection", "movement", "anchor_frame", "short_range")
 
 #: What the accuracy column of the traversal table holds.
 ACCURACY_NOTE = (
@@ -198,3 +205,81 @@ def write_track_run(
         return with_outputs(report, files, failures=failures)
 
     return write_run(run, writers_for(None), out, build)
+
+
+def is_track_report(report: Mapping[str, Any]) -> bool:
+    """Whether ``report`` (a ``report.json``) is a ``tsrkit track VIDEO`` run's."""
+    return "dataset" not in report and all(k in report for k in ("video", "gps", "map"))
+
+
+def read_traversals(path: Path) -> list[dict[str, Any]]:
+    """The records of a track run's ``traversals.jsonl``.
+
+    Raises
+    ------
+    TsrkitError
+        Missing file, or a line that is not a traversal record (naming the line).
+    """
+    from tsrkit.files import loads_json, read_text
+
+    if not path.exists():
+        raise TsrkitError(f"{path.parent}: not a track run folder ({path.name} missing)")
+    lines = read_text(path).splitlines()  # InputFileError: one line naming the file
+    records = []
+    for number, line in enumerate(lines, 1):
+        if not line.strip():
+            continue
+        record = loads_json(line, f"{path}: line {number}")
+        missing = [k for k in TRAVERSAL_FIELDS if not isinstance(record, dict) or k not in record]
+        tracks = record.get("tracks") if isinstance(record, dict) else None
+        if missing or not isinstance(tracks, list) or not all(isinstance(t, dict) for t in tracks):
+            problem = f"missing {', '.join(missing)}" if missing else "no list of tracks"
+            raise TsrkitError(f"{path}: line {number}: not a traversal record ({problem})")
+        records.append(record)
+    return records
+
+
+def load_track_run(folder: Path, report: dict[str, Any]) -> RunResult:
+    """The :class:`RunResult` of a ``tsrkit track VIDEO`` folder, from its ``report.json`` and
+    ``traversals.jsonl``, to be written again by the report writers.
+
+    The vicinity plot's profile is computed again from the GPS log and the map the report
+    names; when they cannot be read any more (moved, edited), that plot is left out and the
+    rest of the report is written.
+
+    Raises
+    ------
+    TsrkitError
+        A ``traversals.jsonl`` or ``report.json`` that is not what a track run writes.
+    """
+    records = read_traversals(folder / "traversals.jsonl")
+    try:
+        settings = report["settings"]
+        vicinity = float(settings["vicinity"])
+        fps, count = float(report["fps"]), int(report["frames"])
+    except (KeyError, TypeError, ValueError) as exc:
+        raise TsrkitError(f"{folder / 'report.json'}: not a track report ({exc!r})") from None
+    start = report.get("start_utc", records[0].get("start_utc") if records else None)
+    frames, distance = _profile(report, start, fps, count)
+    counted: dict[str, Any] = {k: report[k] for k in ("traversals", "temporal") if k in report}
+    traversals = TraversalsResult(counted, "traversals", tuple(records), frames, distance, vicinity)
+    return RunResult(dict(report), results=(TrackFacts(report, "run"), traversals))
+
+
+def _profile(
+    report: Mapping[str, Any], start: Any, fps: float, count: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """The run's vicinity profile from the GPS log and map it names; empty when they cannot be
+    read again."""
+    from tsrkit.geo import read_signals, read_track
+    from tsrkit.spatiotemporal.ranges import frame_profile
+
+    empty = (np.zeros(0, int), np.zeros(0))
+    if not isinstance(start, (int, float)):
+        return empty
+    try:
+        track = read_track(str(report["gps"]))
+        signals = read_signals(str(report["map"]))
+    except (TsrkitError, OSError, ValueError):
+        return empty
+    return frame_profile(track, signals, float(start), fps, count)

@@ -21,9 +21,10 @@ from typing import Any
 import cv2
 import numpy as np
 
-from tsrkit.atomic import atomic_open
-from tsrkit.engine import plugin_identity
+from tsrkit.atomic import write_json
+from tsrkit.engine import MAX_CACHE_ENTRY, plugin_identity
 from tsrkit.errors import TsrkitError
+from tsrkit.files import InputFileError, read_json
 from tsrkit.geo import Signals, Track
 from tsrkit.inputs import iter_video
 from tsrkit.pipeline import Pipeline
@@ -136,6 +137,36 @@ def traversal_record(
     }
 
 
+#: The fields a cached traversal record must hold to be used.
+CACHED_FIELDS = (
+    "intersection",
+    "movement",
+    "first_frame",
+    "last_frame",
+    "anchor_frame",
+    "short_range",
+    "tracks",
+)
+
+
+def read_cached(path: Path) -> dict[str, Any] | None:
+    """The traversal record cached at ``path``, or None when there is none or it cannot be
+    used (not a regular file, too large, cut short, edited by hand): the traversal is then
+    computed again and the entry rewritten."""
+    if not path.is_file():
+        return None
+    try:
+        record = read_json(path, MAX_CACHE_ENTRY)
+    except (InputFileError, OSError):
+        return None
+    if not isinstance(record, dict) or not all(k in record for k in CACHED_FIELDS):
+        return None
+    tracks, short = record["tracks"], record["short_range"]
+    if not isinstance(tracks, list) or not all(isinstance(t, dict) for t in tracks):
+        return None
+    return record if isinstance(short, list) and len(short) == 2 else None
+
+
 def track_video(
     video: str,
     track: Track,
@@ -160,15 +191,14 @@ def track_video(
         images, digest = decode_clip(video, item.first, item.last)
         key = hashlib.sha256((digest + key_base).encode()).hexdigest()
         cached = Path(cache_dir, key[:2], f"{key}.json") if cache_dir else None
-        if cached is not None and cached.is_file():
-            with open(cached, encoding="utf-8") as fh:
-                record = {**json.load(fh), "traversal": number, "cached": True}
+        record = read_cached(cached) if cached is not None else None
+        if record is not None:
+            record = {**record, "traversal": number, "cached": True}
         else:
             clip = Clip(video, images, pipeline, regional, settings.margin, settings.roi_top)
             record = traversal_record(number, item, signals, clip, settings)
             if cached is not None:
-                with atomic_open(cached) as fh:
-                    json.dump(record, fh)
+                write_json(cached, record, indent=None)
         if on_frames is not None:
             on_frames(len(images))
         yield {**record, "fps": fps, "start_utc": start}

@@ -26,7 +26,6 @@ follow the COCO convention of :mod:`tsrkit.synth.scenes` (pixel centres at ``i +
 
 from __future__ import annotations
 
-import json
 import math
 import os
 from collections.abc import Iterator
@@ -36,7 +35,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from tsrkit.atomic import atomic_open
+from tsrkit.atomic import atomic_open, json_line, write_json
 from tsrkit.geo.projection import LocalProjection
 from tsrkit.spatiotemporal.points import frame_status
 from tsrkit.synth.heads import LAMP_COLOURS, render_head
@@ -869,11 +868,10 @@ def render_drive(
                 "speed": round(float(drive.speed[k]), 3),
                 "lights": [light.to_json() for light in lights],
             }
-            truth.write(json.dumps(record) + "\n")
+            truth.write(json_line(record) + "\n")
     with atomic_open(folder / "gps.csv") as fh:
         fh.write(gps_log(drive))
     with atomic_open(folder / "map.osm") as fh:
         fh.write(osm_extract(drive))
-    with atomic_open(folder / "drive.json") as fh:
-        json.dump(summary(drive), fh, indent=1)
+    write_json(folder / "drive.json", summary(drive), indent=1)
     return folder

@@ -49,6 +49,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from tsrkit.atomic import json_text
 from tsrkit.errors import TsrkitError
 from tsrkit.types import Annotation, Dataset, Sample
 
@@ -1038,7 +1039,7 @@ def generate(
             tmp, int(frames), int(seed), int(width), int(height), opts, on_frame
         )
         write_annotations(dataset, tmp)
-        (tmp / STAMP_FILE).write_text(json.dumps(stamp, indent=2) + "\n", encoding="utf-8")
+        (tmp / STAMP_FILE).write_text(json_text(stamp, indent=2) + "\n", encoding="utf-8")
         _open_permissions(tmp)
         _publish(tmp, out, stamp, overwrite)
     except BaseException:
