@@ -34,21 +34,28 @@ harness.single_thread(opencv=False)
 import argparse  # noqa: E402
 
 import numpy as np  # noqa: E402
-from state_loso import parts, read, rule_rows, scores, wanted_boxes  # noqa: E402
+from state_loso import families, wanted_boxes  # noqa: E402
 
+from tsrkit.datasets import open_dataset  # noqa: E402
 from tsrkit.registry import get_registry  # noqa: E402
 from tsrkit.types import Dataset  # noqa: E402
 from tsrkit_plugins.classifiers.lamp_state import (  # noqa: E402
     STATES,
+    blend,
     fit_estimator,
     labelled_features,
     prefer_red,
+    red_yellow,
 )
-from tsrkit_plugins.classifiers.lamp_state.features import N_HUE, N_LENS  # noqa: E402
+from tsrkit_plugins.classifiers.lamp_state.features import (  # noqa: E402
+    N_HUE,
+    N_LENS,
+    red_amber_rows,
+)
 
 #: Column of the core's (brightest disk pixels') CIELab a; b, then the rim's a and b follow.
 LAB = 2 * N_HUE
-#: The six held-out sets: (group of ``state_loso.parts``, key).
+#: The six held-out sets: (group of :func:`parts`, key).
 SETS = (
     ("mit", "mit test"),
     ("vgis", "vgis day"),
@@ -59,6 +66,50 @@ SETS = (
 )
 #: The single-lamp states whose hue ranges are compared.
 LAMPS = ("red", "yellow", "green")
+
+
+def parts() -> dict[str, dict[str, Dataset]]:
+    """The camera families of ``state_loso.py`` this evidence was measured on (all but Japan),
+    DTLD's training part its train split only, as when it was first measured."""
+    data = families()
+    del data["japan"]
+    data["dtld"]["train"] = open_dataset("dtld_fridtjofs").split("train")
+    return data
+
+
+def bare_boxes(sample) -> list:
+    """The annotated lights of ``sample`` that lamp-state reads, as bare boxes."""
+    return wanted_boxes(sample, housed=False)[0]
+
+
+def scores(truth: np.ndarray, predicted: list[str]) -> tuple[float, float, int]:
+    """Accuracy, red recall and count over lights whose true state is in :data:`STATES`."""
+    names = [STATES[i] for i in truth]
+    right = sum(t == p for t, p in zip(names, predicted))
+    reds = [p for t, p in zip(names, predicted) if t == "red"]
+    red = sum(p == "red" for p in reds) / len(reds) if reds else float("nan")
+    return right / max(len(names), 1), red, len(names)
+
+
+def rule_rows(dataset: Dataset, features: np.ndarray) -> np.ndarray:
+    """The ``features`` of the lights of ``dataset`` (in order, no copies) as lamp-state's
+    red+amber rule reads them (:func:`red_amber_rows`: squarer boxes' two lamps too)."""
+    out, start = [], 0
+    for sample in dataset:
+        boxes = bare_boxes(sample)
+        if boxes:
+            rows = features[start : start + len(boxes)]
+            out.append(red_amber_rows(sample.load().image, boxes, rows))
+            start += len(boxes)
+    return np.concatenate(out)
+
+
+def read(probability: np.ndarray, states: list[str], rule: np.ndarray, params) -> list[str]:
+    """lamp-state's reading of its learned ``probability`` (columns ``states``), with its
+    red+amber rule (:func:`red_yellow`) on the ``rule`` rows (:func:`rule_rows`)."""
+    table = blend(probability, states, np.zeros((len(probability), len(STATES))), 0.0)
+    table = red_yellow(table, rule, params["red_yellow_ratio"])
+    return [STATES[i] for i in np.argmax(table, axis=1)]
 
 
 def hue_angles(features: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -84,7 +135,7 @@ def light_ids(dataset: Dataset, copies: int) -> tuple[np.ndarray, np.ndarray]:
     unjittered rows) and of its image."""
     lights, images, start = [], [], 0
     for image, sample in enumerate(dataset):
-        n = len(wanted_boxes(sample))
+        n = len(bare_boxes(sample))
         if n:
             lights.append(np.tile(np.arange(start, start + n), copies + 1))
             images.append(np.full(n * (copies + 1), image))

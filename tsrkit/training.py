@@ -11,13 +11,15 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+from tsrkit.datasets.concat import parse_reference
+from tsrkit.datasets.registry import load_registry
 from tsrkit.errors import TsrkitError
 from tsrkit.models import save_model
 from tsrkit.plugin import Detector, is_trainable
 from tsrkit.registry import PluginInfo, get_registry
 from tsrkit.types import Dataset
 
-__all__ = ["dataset_checksum", "train", "trainable_plugin"]
+__all__ = ["data_licences", "dataset_checksum", "train", "trainable_plugin"]
 
 
 def trainable_plugin(name: str) -> PluginInfo:
@@ -50,6 +52,20 @@ def dataset_checksum(dataset: Dataset) -> str:
     return digest.hexdigest()
 
 
+def data_licences(dataset: Dataset) -> dict[str, str]:
+    """The licence of each part of ``dataset`` (each ``NAME[:SPLIT]`` concatenated, or the
+    dataset itself): its registry entry's, else the licence the dataset carries, else ``"not
+    stated"``; written into every trained model, so that it says what data it was trained on
+    and under which terms."""
+    registry = load_registry()
+    out = {}
+    for part in dataset.info.get("parts") or [dataset.name]:
+        entry = registry.get(parse_reference(part)[0])
+        own = dataset.info.get("licence") if part == dataset.name else None
+        out[part] = entry.licence if entry is not None else str(own or "not stated")
+    return out
+
+
 def train(
     name: str,
     dataset: Dataset,
@@ -74,6 +90,7 @@ def train(
         "dataset": dataset.name,
         "samples": len(dataset),
         "checksum": dataset_checksum(dataset),
+        "licences": data_licences(dataset),
     }
     if detector is not None:
         training["detector"] = {"name": detector.name, "params": detector.params}

@@ -8,7 +8,7 @@ from oracles.lamp_state_oracle import halved
 import tsrkit
 from tsrkit.models import ModelError, load_model, save_model
 from tsrkit.types import Annotation, Candidate, Frame, Sample
-from tsrkit_plugins.classifiers.lamp_state import STATES, colour_jitter
+from tsrkit_plugins.classifiers.lamp_state import STATES, colour_jitter, labelled_features
 from tsrkit_plugins.classifiers.lamp_state.features import (
     N_FEATURES,
     N_LENS,
@@ -18,15 +18,23 @@ from tsrkit_plugins.classifiers.lamp_state.features import (
     red_amber_rows,
     two_lit,
 )
+from tsrkit_plugins.classifiers.lamp_state.views import around_lights, quarter_turn
 
 #: BGR of lit lamps as cameras record them (saturated, slightly orange red; amber; blue-green).
 COLOURS = {"red": (40, 40, 230), "yellow": (20, 170, 250), "green": (170, 230, 40)}
 SLOT = {"red": 0, "yellow": 1, "green": 2}
+#: The other order: red at the far end (a Japanese head turned so that red is on the right).
+REVERSED = {"red": 2, "yellow": 1, "green": 0}
+#: Lit centroid along the housing axis among the features, 0 top .. 1 bottom.
+POSITION = N_LENS + 6
 
 
-def head(state: str, white_core: bool = False, size: int = 20) -> tuple[np.ndarray, tuple]:
+def head(
+    state: str, white_core: bool = False, size: int = 20, slot: dict[str, int] = SLOT
+) -> tuple[np.ndarray, tuple]:
     """A road-grey image with a dark vertical 3-lamp housing whose ``state`` lamp is lit
-    (``red_yellow``: the red and the amber one); returns the image and the housing box."""
+    (``red_yellow``: the red and the amber one), each lamp at its ``slot`` (0 top, 2 bottom);
+    returns the image and the housing box."""
     image = np.full((160, 120, 3), (120, 125, 130), np.uint8)
     x0, y0 = 40, 20
     box = (x0, y0, x0 + 2 * size, y0 + 6 * size)
@@ -35,7 +43,7 @@ def head(state: str, white_core: bool = False, size: int = 20) -> tuple[np.ndarr
         centre = (x0 + size, y0 + size + 2 * size * k)
         cv2.circle(image, centre, int(0.75 * size), (45, 45, 45), -1)
     for lit in state.split("_"):
-        centre = (x0 + size, y0 + size + 2 * size * SLOT[lit])
+        centre = (x0 + size, y0 + size + 2 * size * slot[lit])
         cv2.circle(image, centre, int(0.75 * size), COLOURS[lit], -1)
         if white_core:
             cv2.circle(image, centre, int(0.5 * size), (250, 250, 250), -1)
@@ -66,6 +74,75 @@ def test_features_see_the_lit_position_and_the_rim():
     assert b[N_LENS + 9 : N_LENS + 12].tolist() == [0.0, 0.0, 1.0]
     lens_box = [Candidate.from_circle(60, 40, 10, 1.0)]
     assert lamp_features(top, lens_box)[0][N_LENS + 8] == 0.0
+
+
+def mirrored(image: np.ndarray, box: tuple) -> tuple[np.ndarray, tuple]:
+    """``image`` mirrored left to right, and ``box`` with it."""
+    width = image.shape[1]
+    return np.ascontiguousarray(image[:, ::-1]), (width - box[2], box[1], width - box[0], box[3])
+
+
+@pytest.mark.parametrize("white_core", [False, True])
+@pytest.mark.parametrize("state", ["red", "yellow", "green", "red_yellow"])
+@pytest.mark.parametrize("order", [SLOT, REVERSED], ids=["red left", "red right"])
+def test_a_mirrored_horizontal_head_is_read_as_its_colour_places_it(state, white_core, order):
+    """A horizontal head with red on the left (Europe, the US) or on the right (Japan) and its
+    mirror image: the features are the same up to the rendering's one-pixel asymmetry (the
+    redder end is put on top either way), the lit lamp sits where its colour puts it (red on
+    top, green at the bottom, whichever end it was lit at), and the shipped model reads the
+    lit state in both: a mirrored head never swaps red and green."""
+    image, box = head(state, white_core, slot=order)
+    image, (box,) = quarter_turn(image, [box], clockwise=False)  # top lamp to the left
+    assert box[2] - box[0] > box[3] - box[1]
+    views = [(image, box), mirrored(image, box)]
+    rows = np.stack([lamp_features(i, [Candidate.from_box(b, 1.0)])[0] for i, b in views])
+    assert np.abs(rows[0] - rows[1]).max() < 0.02
+    if state in ("red", "red_yellow"):
+        assert rows[:, POSITION].max() < 0.4  # red, or red and amber: the upper part
+    elif state == "green":
+        assert rows[:, POSITION].min() > 0.7
+    classifier = tsrkit.classifier("lamp-state")
+    for i, b in views:
+        found = classifier.classify(Frame(i, "horizontal"), [Candidate.from_box(b, 1.0)])
+        assert found[0].state == state
+
+
+def test_training_views_keep_the_features_and_turn_heads_either_way():
+    """The part of a frame the training views are made of gives the same features as the whole
+    frame, and a quarter turn either way makes a vertical head horizontal with its lamp order
+    reversed between the two turns (red on the left, then on the right)."""
+    image, box = head("red")
+    wide = np.concatenate([image, np.full_like(image, 90)], axis=1)
+    part, (moved,) = around_lights(wide, [box])
+    assert part.shape[1] < wide.shape[1]
+    whole = lamp_features(wide, [Candidate.from_box(box, 1.0)])
+    assert np.array_equal(lamp_features(part, [Candidate.from_box(moved, 1.0)]), whole)
+    reds = []
+    for clockwise in (False, True):
+        turned, (at,) = quarter_turn(image, [box], clockwise)
+        assert at[2] - at[0] == box[3] - box[1] and at[3] - at[1] == box[2] - box[0]
+        x0, y0, x1, y1 = (int(v) for v in at)
+        red = turned[y0:y1, x0:x1, 2].astype(int) - turned[y0:y1, x0:x1, 1]
+        reds.append(np.argmax(red.mean(axis=0)) / (x1 - x0))
+    assert reds[0] < 0.3 < 0.7 < reds[1]  # anticlockwise: red left; clockwise: red right
+
+
+def test_training_turns_only_frames_without_horizontal_heads(tmp_path):
+    """With every jittered view turned (``turned`` 1), a vertical head's views differ from
+    those without turns in their housing features, and a frame holding a horizontal head is
+    never turned (its views equal those of no turns)."""
+    vertical, box = head("green")
+    lying, (flat,) = quarter_turn(vertical, [box], clockwise=True)
+    data = []
+    for name, image, at in (("v", vertical, box), ("h", lying, flat)):
+        path = tmp_path / f"{name}.png"
+        cv2.imwrite(str(path), image)
+        data.append([Sample(str(path), (Annotation(at, "green"),))])
+    for sample, changed in zip(data, (True, False)):
+        plain, _ = labelled_features(sample, copies=2, seed=4, turned=0.0)
+        turned, _ = labelled_features(sample, copies=2, seed=4, turned=1.0)
+        assert np.array_equal(plain[0], turned[0])  # the light itself is never turned
+        assert (not np.array_equal(plain[1:], turned[1:])) is changed
 
 
 @pytest.mark.parametrize("white_core", [False, True])

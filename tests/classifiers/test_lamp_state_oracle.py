@@ -17,7 +17,7 @@ import tsrkit
 from tsrkit.models import Model, ModelError, save_model
 from tsrkit.registry import get_registry
 from tsrkit.types import Candidate, Frame
-from tsrkit_plugins.classifiers.lamp_state.features import housing_of, lamp_features
+from tsrkit_plugins.classifiers.lamp_state.features import VERSION, housing_of, lamp_features
 from tsrkit_plugins.shared.forest import Forest
 from tsrkit_plugins.shared.persistence import estimator_arrays
 
@@ -55,10 +55,15 @@ def frames(shared_datasets):
             Candidate.from_circle(x, y, r, 1.0)
             for x, y, r in rng.uniform((-10, -10, 0.6), (w + 10, h + 10, 20), (20, 3))
         ]
-        # boxes without a fitted housing, read as housings (tall and wide), their lit lens found
+        # boxes without a fitted housing, read as housings (tall and wide), their lit lens found,
+        # and annotated boxes given as their own housings (the lit lens found in them too)
         read_as_housings = [Candidate.from_box(c.housing, 1.0) for c in housed(rng, w, h, 10)]
+        own = [dataclasses.replace(c, housing=c.bbox) for c in read_as_housings[:5] + boxes]
         out.append(
-            (frame, boxes + stage.verify(frame, lenses) + housed(rng, w, h) + read_as_housings)
+            (
+                frame,
+                boxes + stage.verify(frame, lenses) + housed(rng, w, h) + read_as_housings + own,
+            )
         )
     return out
 
@@ -82,8 +87,8 @@ def test_features_equal_the_oracle(real):
         expected = oracle.lamp_features(frame.image, candidates)
         assert np.array_equal(lamp_features(frame.image, candidates), expected)
         assert np.array_equal(lamp_features(frame.image, candidates[3:4]), expected[3:4])
-        # fitted horizontal housings alone (none resampled) and boxes read as housings alone
-        for kind in (fitted_wide, unfitted):
+        # fitted horizontal housings alone, boxes read as housings alone, own housings alone
+        for kind in (fitted_wide, unfitted, own_housing):
             some = [c for c in candidates if kind(c)]
             assert some
             expected = oracle.lamp_features(frame.image, some)
@@ -97,6 +102,10 @@ def fitted_wide(candidate):
 
 def unfitted(candidate):
     return candidate.housing is None and housing_of(candidate) is not None
+
+
+def own_housing(candidate):
+    return candidate.housing == candidate.bbox
 
 
 @pytest.mark.parametrize("params", PARAMS, ids=str)
@@ -145,7 +154,7 @@ def test_a_model_of_another_feature_count_is_one_clear_error(tmp_path):
     x = rng.normal(size=(60, 12))  # the trees would read past each row of the 43 features
     with threadpool_limits(1):
         estimator = HistGradientBoostingClassifier(max_iter=3).fit(x, np.arange(60) % 3)
-    info = {"layout": 3, "states": ["red", "yellow", "green"]}
+    info = {"layout": VERSION, "states": ["red", "yellow", "green"]}
     path = tmp_path / "short"
     model = Model(arrays=estimator_arrays(estimator), info=info)
     save_model(path, model, plugin="lamp-state", plugin_version="0", params={}, training={})

@@ -9,6 +9,7 @@ from click.testing import CliRunner
 
 from tsrkit.cli.main import cli
 from tsrkit.datasets import concat_datasets, open_datasets, parse_reference
+from tsrkit.datasets.registry import load_registry
 from tsrkit.errors import TsrkitError
 from tsrkit.types import Annotation, Dataset, Sample
 
@@ -75,3 +76,9 @@ def test_train_reads_repeated_datasets(tmp_path):
     training = json.loads((tmp_path / "ab.json").read_text())["training"]
     assert training["dataset"] == "udacity_mit_tl_crops:test+udacity_mit_tl_crops:train"
     assert training["samples"] == 297 + 1187
+    licence = load_registry()["udacity_mit_tl_crops"].licence
+    assert "CC BY-SA 4.0" in licence
+    assert training["licences"] == {
+        "udacity_mit_tl_crops:test": licence,
+        "udacity_mit_tl_crops:train": licence,
+    }

@@ -6,7 +6,9 @@ classifier must match exactly. The feature functions the speed-up left alone are
 Housings are resampled as lamp-state defines it since long housings are halved (outputs
 changed by design): a side at least ``HALVE_FROM`` times its output length is first halved
 (:func:`halved`: an odd last pixel dropped, pairs averaged), then the whole crop resampled by
-OpenCV's area rule."""
+OpenCV's area rule. Since layout 4 every housing is read, a horizontal one turned end over end
+where its bottom end is redder, and the red+amber reading looks for two lamps in the profile
+(:func:`_two_lit`, one profile and one pair of lamps at a time)."""
 
 from __future__ import annotations
 
@@ -121,14 +123,52 @@ def _slots(profile):
     return np.stack([profile[:, c - half : c + half + 1].mean(axis=1) for c in centres], axis=1)
 
 
+def _lamp_peaks(p, prominence=0.15):
+    """The lamps of one profile, one by one: interior local maxima standing out by
+    ``prominence`` of the range within a sixth of the length on both sides, the first of any
+    within two bins."""
+    along = len(p)
+    reach = along // 6
+    span = max(p.max() - p.min(), 1e-3)
+    peaks, seen = [], []
+    for i in range(1, along - 1):
+        if p[i] < p[max(0, i - 2) : i + 3].max():
+            continue
+        before, after = p[max(0, i - reach) : i], p[i + 1 : i + 1 + reach]
+        if before.min() > p[i] - prominence * span or after.min() > p[i] - prominence * span:
+            continue
+        if not (seen and i - seen[-1] <= 2):
+            peaks.append(i)
+        seen.append(i)
+    return peaks
+
+
 def _two_lit(profile, redness, dip=0.7):
-    top, middle, bottom = _slots(profile).T
-    lower = np.minimum(top, middle)
-    along = profile.shape[1]
-    gap = profile[:, along // 6 : along // 2 + 1].min(axis=1)
-    both = (lower - bottom) / np.maximum(np.maximum(top, middle) - bottom, 1e-3)
-    two = (gap < bottom + dip * (lower - bottom)) & (_slots(redness)[:, 0] > 0)
-    return np.where(two, both, 0.0)
+    n, along = profile.shape
+    half = along // 12
+    out = np.zeros(n)
+    for k in range(n):
+        p, r = profile[k], redness[k]
+        edged = np.pad(p, 1, mode="edge")
+        peaks = _lamp_peaks(p)
+        for x, a in enumerate(peaks):
+            for b in peaks[x + 1 :]:
+                d = b - a
+                if not (along // 6 <= d <= along // 2) or b + d > along + 1:
+                    continue
+                third = min(b + d, along - 1)
+                dark = edged[third : third + 3].mean()
+                lower, higher = min(p[a], p[b]), max(p[a], p[b])
+                red_a = r[max(0, a - half) : a + half + 1].max()
+                red_b = r[max(0, b - half) : b + half + 1].max()
+                if (
+                    lower > dark
+                    and p[a : b + 1].min() < dark + dip * (lower - dark)
+                    and red_a > 0
+                    and red_a >= red_b
+                ):
+                    out[k] = max(out[k], (lower - dark) / max(higher - dark, 1e-3))
+    return out
 
 
 def _housing_features(upright, hsv, vertical):
@@ -166,6 +206,18 @@ def _upright_housings(image, boxes):
     return out, vertical
 
 
+def _turned_by_colour(upright, vertical):
+    """Each horizontal patch end over end when its bottom end slot is redder than its top."""
+    out = upright.copy()
+    bgr = band(upright.astype(np.float32) / 255)
+    redness = (bgr[..., 2] - bgr[..., 1]).mean(axis=2)
+    ends = _slots(redness)
+    for i in range(len(upright)):
+        if not vertical[i] and ends[i, 2] > ends[i, 0]:
+            out[i] = upright[i, ::-1]
+    return out
+
+
 def lamp_features(image, candidates):
     """The (N, N_FEATURES) features of ``candidates``, computed the old way."""
     rows = np.zeros((len(candidates), N_FEATURES), np.float32)
@@ -175,12 +227,13 @@ def lamp_features(image, candidates):
     if boxed:
         boxes = np.array([housings[i] for i in boxed], np.float64)
         upright, vertical = _upright_housings(image, boxes)
-        hsv = _convert(upright, cv2.COLOR_BGR2HSV)
-        rows[boxed, N_LENS:] = _housing_features(upright, hsv, vertical) * vertical[:, None]
-        found = lit_lenses(boxes, vertical, hsv)
+        found = lit_lenses(boxes, vertical, _convert(upright, cv2.COLOR_BGR2HSV))
         for k, i in enumerate(boxed):
-            if candidates[i].housing is None:
+            if candidates[i].housing in (None, candidates[i].bbox):
                 lenses[i] = found[k]
+        upright = _turned_by_colour(upright, vertical)
+        hsv = _convert(upright, cv2.COLOR_BGR2HSV)
+        rows[boxed, N_LENS:] = _housing_features(upright, hsv, vertical)
     if lenses:
         rows[:, :N_LENS] = _lens_features(image, lenses)
     return np.nan_to_num(rows)

@@ -59,6 +59,7 @@ from tsrkit_plugins.classifiers.lamp_state.features import (
     lamp_features,
     red_amber_rows,
 )
+from tsrkit_plugins.classifiers.lamp_state.views import around_lights, quarter_turn
 from tsrkit_plugins.shared.forest import Forest
 from tsrkit_plugins.shared.persistence import estimator_arrays, load_estimator
 
@@ -87,20 +88,29 @@ def colour_jitter(image: np.ndarray, rng: np.random.Generator) -> np.ndarray:
 
 
 def labelled_features(
-    samples: Iterable[Sample], copies: int = 0, seed: int = 0
+    samples: Iterable[Sample], copies: int = 0, seed: int = 0, turned: float = 0.0
 ) -> tuple[np.ndarray, np.ndarray]:
     """Features and state indices of every annotation in :data:`STATES`, plus ``copies``
-    colour-jittered views of each (:func:`colour_jitter`, seeded: deterministic)."""
+    colour-jittered views of each (:func:`colour_jitter`); of a frame none of whose lights is
+    wider than tall, each jittered view is also turned a quarter (either way, :mod:`.views`)
+    with probability ``turned``. Seeded: deterministic. The views are made of the part of the
+    frame the features read (:func:`~.views.around_lights`), with the same values."""
     rng = np.random.default_rng(seed)
+    turns = np.random.default_rng([seed, 1])
     rows, labels = [], []
     for sample in samples:
         wanted = [a for a in sample.annotations if a.state in STATES]
         if not wanted:
             continue
-        image = sample.load().image
-        boxes = [Candidate.from_box(a.bbox, 1.0) for a in wanted]
+        image, boxes = around_lights(sample.load().image, [a.bbox for a in wanted])
+        upright = all(y1 - y0 >= x1 - x0 for x0, y0, x1, y1 in boxes)
         for view in range(copies + 1):
-            rows.append(lamp_features(colour_jitter(image, rng) if view else image, boxes))
+            seen, at = image, boxes
+            if view:
+                seen = colour_jitter(image, rng)
+                if upright and turns.random() < turned:
+                    seen, at = quarter_turn(seen, boxes, bool(turns.random() < 0.5))
+            rows.append(lamp_features(seen, [Candidate.from_box(b, 1.0) for b in at]))
             labels += [STATES.index(a.state) for a in wanted]
     if not rows:
         return np.zeros((0, N_FEATURES), np.float32), np.zeros(0, np.int64)
@@ -220,6 +230,15 @@ class LampState(Classifier):
             max=20,
             help="training: colour-jittered views added per light (camera white balance and "
             "response), for states that carry over to unseen cameras",
+        ),
+        Param(
+            "turned",
+            "float",
+            0.5,
+            min=0.0,
+            max=1.0,
+            help="training: share of the jittered views of frames without horizontal heads "
+            "turned a quarter (either way), so that horizontal heads are learned",
         ),
         Param("seed", "int", 0, min=0, help="training: seed of the jitter and the trees"),
         Param(
@@ -383,7 +402,9 @@ class LampState(Classifier):
         TsrkitError
             Fewer than two states among the annotations.
         """
-        features, labels = labelled_features(samples, self.params["copies"], self.params["seed"])
+        features, labels = labelled_features(
+            samples, self.params["copies"], self.params["seed"], self.params["turned"]
+        )
         present = sorted(set(labels.tolist()))
         if len(present) < 2:
             raise TsrkitError(

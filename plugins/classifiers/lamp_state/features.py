@@ -33,6 +33,7 @@ from collections.abc import Sequence
 
 import cv2
 import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
 
 from tsrkit.api import Candidate
 
@@ -49,7 +50,7 @@ ELONGATION = 1.5
 #: averaged over pixel pairs.
 HALVE_FROM = 2
 #: Feature layout version: a model trained on another layout is refused.
-VERSION = 3
+VERSION = 4
 
 
 def _lens_masks() -> tuple[np.ndarray, np.ndarray]:
@@ -279,22 +280,72 @@ def scaled(values: np.ndarray) -> np.ndarray:
     return (values - low) / np.maximum(values.max(axis=1, keepdims=True) - low, 1e-3)
 
 
-def two_lit(profile: np.ndarray, redness: np.ndarray, dip: float = 0.7) -> np.ndarray:
-    """How far the top and middle slots of an (N, along) brightness profile are both lit above
-    the bottom one, as a share of the brightest slot's height above it: 1 when both are as
-    bright as the brightest, 0 (or below) when either is as dark as the bottom. Red+amber
-    lights both (DTLD's ``red_yellow``), and its top lamp is red: where the (N, along)
-    ``redness`` (red minus green) at the top slot is not above 0 (a grey backplate or an unlit
-    lens above an amber lamp), the result is 0. Two lamps have dark housing between them:
-    where the profile between the two slot centres stays above ``dip`` of the way from the
-    bottom to the dimmer of the two, one lamp's glare lights both slots and the result is 0."""
-    top, middle, bottom = slots(profile).T
-    lower = np.minimum(top, middle)
+def lamp_peaks(profile: np.ndarray, prominence: float = 0.15) -> np.ndarray:
+    """Where an (N, along) brightness profile has a lamp: the (N, along) mask of its interior
+    local maxima (the highest within 2 bins either side) that stand out on both sides, within a
+    sixth of the length, by ``prominence`` of the profile's range; of maxima 1 or 2 bins apart
+    (a flat top) only the first. A bright box end (a backplate, sky) is not a lamp: it has no
+    fall on its outer side."""
     along = profile.shape[1]
-    gap = profile[:, along // 6 : along // 2 + 1].min(axis=1)
-    both = (lower - bottom) / np.maximum(np.maximum(top, middle) - bottom, 1e-3)
-    two = (gap < bottom + dip * (lower - bottom)) & (slots(redness)[:, 0] > 0)
-    return np.where(two, both, 0.0)
+    reach = along // 6
+    drop = prominence * np.maximum(np.ptp(profile, axis=1, keepdims=True), 1e-3)
+    edged = np.pad(profile, ((0, 0), (2, 2)), constant_values=-np.inf)
+    local = profile >= sliding_window_view(edged, 5, axis=1).max(axis=2)
+    windows = sliding_window_view(
+        np.pad(profile, ((0, 0), (reach, reach)), constant_values=np.inf), reach, axis=1
+    )
+    before = windows[:, :along].min(axis=2)  # profile[i - reach : i]
+    after = windows[:, reach + 1 : reach + 1 + along].min(axis=2)  # profile[i + 1 : i + 1 + reach]
+    peak = local & (before <= profile - drop) & (after <= profile - drop)
+    peak[:, [0, along - 1]] = False
+    first = peak.copy()
+    peak[:, 1:] &= ~first[:, :-1]
+    peak[:, 2:] &= ~first[:, :-2]
+    return peak
+
+
+def two_lit(profile: np.ndarray, redness: np.ndarray, dip: float = 0.7) -> np.ndarray:
+    """How far two adjacent lamps of an upright housing are both lit, red above amber
+    (red+amber, DTLD's ``red_yellow``): over every pair of lamps (:func:`lamp_peaks`) of the
+    (N, along) brightness ``profile`` one lamp pitch ``d`` apart (a sixth to a half of the
+    length) whose next slot below (``d`` further, at most a bin past the end) is dark, the
+    dimmer lamp's height above that dark slot as a share of the brighter one's: 1 when both
+    are as bright, 0 when no pair qualifies. A pair qualifies when the profile between the two
+    dips below ``dip`` of the way from the dark slot to the dimmer lamp (two lamps, not one
+    lamp's glare) and the upper lamp is red (``redness``, red minus green, at its reddest within
+    a twelfth of the length either side, the lamp's rim where its core is white, above 0: a
+    grey backplate or an unlit lens above an amber lamp is not) and at least as red as the
+    lower one. Read on lamps found in the profile, not at fixed slots, it holds where the box
+    holds a backplate above and below the head, whose bright ends shift the lamps off the
+    thirds of the box and outshine them (``benchmarks/RESULTS.state.md``)."""
+    n, along = profile.shape
+    peak = lamp_peaks(profile)
+    around = sliding_window_view(np.pad(profile, ((0, 0), (1, 1)), mode="edge"), 3, axis=1)
+    level = around.mean(axis=2)
+    half = along // 12
+    red = sliding_window_view(
+        np.pad(redness, ((0, 0), (half, half)), mode="edge"), 2 * half + 1, axis=1
+    )
+    red = red.max(axis=2)
+    best = np.zeros(n)
+    for d in range(along // 6, along // 2 + 1):
+        upper = np.arange(0, min(along - d, along + 2 - 2 * d))
+        lower = upper + d
+        dark = level[:, np.minimum(lower + d, along - 1)]
+        dim = np.minimum(profile[:, upper], profile[:, lower])
+        bright = np.maximum(profile[:, upper], profile[:, lower])
+        gap = sliding_window_view(profile, d + 1, axis=1).min(axis=2)[:, upper]
+        pair = (
+            peak[:, upper]
+            & peak[:, lower]
+            & (dim > dark)
+            & (gap < dark + dip * (dim - dark))
+            & (red[:, upper] > 0)
+            & (red[:, upper] >= red[:, lower])
+        )
+        share = np.where(pair, (dim - dark) / np.maximum(bright - dark, 1e-3), 0.0)
+        best = np.maximum(best, share.max(axis=1, initial=0.0))
+    return best
 
 
 def band_profiles(
@@ -333,6 +384,34 @@ def housing_features(upright: np.ndarray, hsv: np.ndarray, vertical: np.ndarray)
     )
 
 
+def turned_by_colour(upright: np.ndarray, hsv: np.ndarray, vertical: np.ndarray) -> None:
+    """Turn the horizontal heads among upright housing patches (BGR ``upright`` and its
+    ``hsv``, in place) end over end where their bottom end slot is redder (red minus green,
+    :func:`band_profiles`, :func:`slots`) than their top one, so that the redder end is on top,
+    where a vertical head has its red lamp.
+
+    A horizontal head's order differs by country (red on the left in Europe and the US, on the
+    right in Japan), so its position is read only as its colour places it: a lit red or orange
+    lamp at either end goes on top, a lit green or blue-green lamp (redness below the unlit
+    end's) at the bottom, an amber lamp stays in the middle. A head and its mirror image give
+    the same patch (the rule reads both ends alike), so a mirrored head reads the same state;
+    a lamp without colour (a white core on a white housing) is placed by chance, and the model,
+    trained on vertical heads turned a quarter either way, learns how far that placing holds."""
+    wide = np.flatnonzero(~vertical)
+    if len(wide):
+        ends = slots(band_profiles(upright[wide], hsv[wide])[3])
+        turn = wide[ends[:, 2] > ends[:, 0]]
+        upright[turn] = upright[turn, ::-1]
+        hsv[turn] = hsv[turn, ::-1]
+
+
+def finds_lens(candidate: Candidate) -> bool:
+    """Whether lamp-state finds the lit lens in the candidate's housing (:func:`lit_lenses`):
+    a box read as a housing (no fitted housing), or a candidate whose housing is its own box (an
+    annotated housing box given as the housing); a fitted housing's candidate is its lens."""
+    return candidate.housing is None or candidate.housing == candidate.bbox
+
+
 def lamp_features(image: np.ndarray, candidates: Sequence[Candidate]) -> np.ndarray:
     """The (N, :data:`N_FEATURES`) float32 features of ``candidates`` in ``image``."""
     rows = np.zeros((len(candidates), N_FEATURES), np.float32)
@@ -342,24 +421,15 @@ def lamp_features(image: np.ndarray, candidates: Sequence[Candidate]) -> np.ndar
     if boxed:
         boxes = np.array([housings[i] for i in boxed], np.float64)
         vertical = (boxes[:, 3] - boxes[:, 1]) >= (boxes[:, 2] - boxes[:, 0])
-        fitted = np.array([candidates[i].housing is not None for i in boxed])
-        # a horizontal head's order differs by country (red on the left in Europe and the US,
-        # on the right in Japan and in cinTA's Indonesian heads): its position is not read (its
-        # features stay 0), only its lit lens, found in it when the box is read as a housing (a
-        # fitted housing's candidate is its lens): a fitted horizontal housing is not resampled
-        read = np.flatnonzero(vertical | ~fitted)
-        if len(read):
-            upright = upright_housings(image, boxes[read], vertical[read])
-            hsv = convert(upright, cv2.COLOR_BGR2HSV)
-            tall = vertical[read]
-            if tall.any():
-                at = [boxed[k] for k in read[tall]]
-                rows[at, N_LENS:] = housing_features(upright[tall], hsv[tall], tall[tall])
-            unfitted = ~fitted[read]
-            if unfitted.any():
-                found = lit_lenses(boxes[read[unfitted]], tall[unfitted], hsv[unfitted])
-                for k, lens in zip(read[unfitted].tolist(), found):
-                    lenses[boxed[k]] = lens
+        upright = upright_housings(image, boxes, vertical)
+        hsv = convert(upright, cv2.COLOR_BGR2HSV)
+        finding = np.array([finds_lens(candidates[i]) for i in boxed])
+        if finding.any():  # in the patches as resampled, before any turn
+            found = lit_lenses(boxes[finding], vertical[finding], hsv[finding])
+            for k, lens in zip(np.flatnonzero(finding).tolist(), found):
+                lenses[boxed[k]] = lens
+        turned_by_colour(upright, hsv, vertical)
+        rows[boxed, N_LENS:] = housing_features(upright, hsv, vertical)
     if lenses:
         rows[:, :N_LENS] = lens_features(image, lenses)
     return np.nan_to_num(rows)
