@@ -1,8 +1,9 @@
 """State metrics: confusion, per-class figures, Mascetti's R-Y errors, Zheng's discrimination."""
 
+import numpy as np
 import pytest
 
-from tsrkit.eval.state import discriminative_ratio, state_metrics
+from tsrkit.eval.state import confusion, discriminative_ratio, label_order, per_class, state_metrics
 
 
 def test_confusion_accuracy_and_red_yellow_errors():
@@ -56,3 +57,26 @@ def test_misclassification_rate_per_ratio_bin():
     assert bins[0.9] == (1, 0.0)
     assert sum(p for p, _ in bins.values()) == 3
     assert m["discriminative_ratio"]["mean"] == pytest.approx((0.95 + 0.1 + 0.05) / 3)
+
+
+def test_confusion_and_per_class_agree_with_sklearn():
+    from sklearn.metrics import confusion_matrix, precision_recall_fscore_support
+
+    rng = np.random.default_rng(5)
+    states = ["red", "yellow", "green", "off"]
+    truth = list(rng.choice(states, 300, p=[0.5, 0.1, 0.4, 0.0]))
+    predicted = list(rng.choice(states, 300))
+    labels = label_order(set(truth) | set(predicted))
+    assert confusion(truth, predicted, labels).tolist() == (
+        confusion_matrix(truth, predicted, labels=labels).tolist()
+    )
+    precision, recall, _, support = precision_recall_fscore_support(
+        truth, predicted, labels=labels, zero_division=np.nan
+    )
+    ours = per_class(truth, predicted, labels)
+    for label, p, r, n in zip(labels, precision, recall, support):
+        if label in ours:
+            assert ours[label]["support"] == n
+            assert ours[label]["precision"] == pytest.approx(p)
+            assert ours[label]["recall"] == (None if np.isnan(r) else pytest.approx(r))
+    assert ours["off"]["recall"] is None  # predicted, never true

@@ -28,6 +28,7 @@ __all__ = [
     "RATIO_EDGES",
     "StateMetric",
     "StateResult",
+    "confusion",
     "discriminative_ratio",
     "draw_confusion",
     "label_order",
@@ -72,14 +73,8 @@ def state_metrics(
     """
     if len(truth) != len(predicted):
         raise ValueError(f"{len(truth)} true states but {len(predicted)} predictions")
-    from sklearn.metrics import confusion_matrix  # on first use: sklearn is slow to import
-
     labels = label_order(set(truth) | set(predicted))
-    matrix = (
-        confusion_matrix(truth, predicted, labels=labels)
-        if len(truth)
-        else np.zeros((len(labels), len(labels)), dtype=int)
-    )
+    matrix = confusion(truth, predicted, labels)
     return {
         "pairs": len(truth),
         "accuracy": float(np.trace(matrix) / matrix.sum()) if matrix.sum() else None,
@@ -106,7 +101,7 @@ def label_order(seen: set[str]) -> list[str]:
 def per_class(
     truth: Sequence[str], predicted: Sequence[str], labels: Sequence[str]
 ) -> dict[str, dict]:
-    """Precision, recall and support of every state that occurs (``sklearn.metrics``).
+    """Precision, recall and support of every state that occurs (None where undefined).
 
     Examples
     --------
@@ -116,11 +111,11 @@ def per_class(
     """
     if not len(truth):
         return {}
-    from sklearn.metrics import precision_recall_fscore_support
-
-    precision, recall, _, support = precision_recall_fscore_support(
-        truth, predicted, labels=list(labels), zero_division=np.nan
-    )
+    matrix = confusion(truth, predicted, labels)
+    support = matrix.sum(axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        precision = np.diag(matrix) / matrix.sum(axis=0)
+        recall = np.diag(matrix) / support
     predicted_counts = Counter(predicted)
     return {
         label: {
@@ -131,6 +126,24 @@ def per_class(
         for label, p, r, n in zip(labels, precision, recall, support)
         if n or predicted_counts[label]
     }
+
+
+def confusion(truth: Sequence[str], predicted: Sequence[str], labels: Sequence[str]) -> np.ndarray:
+    """The confusion matrix: row = true label, column = predicted, in ``labels``' order (pairs
+    with a label outside ``labels`` are not counted), as ``sklearn.metrics.confusion_matrix``
+    without its import time.
+
+    Examples
+    --------
+    >>> confusion(["red", "red", "green"], ["red", "green", "green"], ["red", "green"]).tolist()
+    [[1, 1], [0, 1]]
+    """
+    index = {label: i for i, label in enumerate(labels)}
+    matrix = np.zeros((len(labels), len(labels)), dtype=int)
+    for true, guess in zip(truth, predicted):
+        if true in index and guess in index:
+            matrix[index[true], index[guess]] += 1
+    return matrix
 
 
 def red_yellow_errors(matrix: np.ndarray, labels: Sequence[str]) -> dict[str, int]:
