@@ -25,27 +25,22 @@ parameters, and merges their candidates:
 Members are written ``NAME [KEY=VALUE ...]; NAME ...``, e.g.
 ``lab-frst top=15; conspicuity n_top=15``; values are checked by each member's own schema.
 
-**Default members** (:data:`DEFAULT_MEMBERS`, the recommended preset's): lab-frst binarises
-each symmetry map at ``fraction`` of its maximum (Zheng 5.2.2: 0.5), so on a frame whose
-strongest dark spot is a blue sign or a patch of sky (a + b far below zero) the green lamps fall
-under the cut (a KR frame with two lit teal lamps on a dark head got 2 lab-frst candidates,
-neither on them). At ``fraction=0.1`` the union's candidate recall on the test splits rises KR
-0.82 -> 0.88, cinTA 0.95 -> 0.95, DTLD 0.71 -> 0.91 (lights of radius 3-4 px 0.43 -> 0.86),
-synthetic 0.82 -> 0.95, at no cost in time (about 35 instead of 20 candidates per frame;
-``benchmarks/candidate_recall.py --extra``, ``RESULTS.verifier.md``).
-
-**Members in the band above the horizon.** A member with ``scale_top=0.6`` searches the upper
-60 % of the rows only: a traffic light stands above the camera, so from a dash-cam it is seen
-above the horizon, near the middle row. Members at one band and scale run on one frame made for
-them, and every member reads the colour conversions of the one frame (:attr:`Frame.views`).
-The members ``lab-blob top=30 levels=2 scale_top=0.6; lab-frst top=15 fraction=0.1
-radii=1,2,3,4,5,6 scale=0.5 scale_top=0.6; adaboost-hsv max_boxes=10 scale=0.5`` (lab-blob for
-lenses of radius 1-4 px at full resolution in the band, lab-frst for radii 2-12 px on the
-half-size band, adaboost-hsv for large lamps anywhere at half size) find more lights than the
-default on every set, the smallest too, at a fraction of its time; what the band costs in
-recall against the whole frame, per member and set, and the times:
-``benchmarks/RESULTS.verifier.md``, ``benchmarks/RESULTS.detector_speed.md``. They are not the
-default while the shipped verifier model is trained on the default members' candidates.
+**Default members** (:data:`DEFAULT_MEMBERS`, the recommended preset's), **in the band above
+the horizon.** A member with ``scale_top=0.6`` searches the upper 60 % of the rows only: a
+traffic light stands above the camera, so from a dash-cam it is seen above the horizon, near the
+middle row. Members at one band and scale run on one frame made for them, and every member
+reads the colour conversions of the one frame (:attr:`Frame.views`). The defaults are lab-blob
+for lenses of radius 1-4 px at full resolution in the band, lab-frst (``fraction=0.1``: the
+symmetry map binarised at a tenth of its maximum, not Zheng 5.2.2's half, so that green lamps
+stay when a blue sign or sky is the frame's strongest spot) for radii 2-12 px on the half-size
+band, and adaboost-hsv for large lamps anywhere at half size. Against the earlier members
+(lab-frst ``top=15 fraction=0.1``, conspicuity ``n_top=15``, adaboost-hsv ``max_boxes=10``,
+tl-recognizer on the whole frame) they find more lights on every set and size (candidate recall
+DTLD 0.92 -> 0.96, iwai_japan_tl 0.85 -> 0.88, lenses of radius <= 3 px DTLD 0.76 -> 0.84) at
+about 75 instead of 35 candidates per frame and a ninth of the time; the band costs 2 of 658
+iwai_japan_tl lights and 2 of 131 cinTA test lights against the whole frame
+(``benchmarks/RESULTS.verifier.md``, ``benchmarks/RESULTS.detector_speed.md``). A camera that
+looks up at lights (not from a car) should set ``scale_top=1`` or other members.
 
 **Upscaled members** (multi-resolution, after Mascetti et al. 2016, 4.2, who run extraction
 and pruning on a resized frame; here the frame is enlarged so that 2-3 px lenses reach the
@@ -77,7 +72,9 @@ from tsrkit.api import (
 )
 
 DEFAULT_MEMBERS = (
-    "lab-frst top=15 fraction=0.1; conspicuity n_top=15; adaboost-hsv max_boxes=10; tl-recognizer"
+    "lab-blob top=30 levels=2 scale_top=0.6; "
+    "lab-frst top=15 fraction=0.1 radii=1,2,3,4,5,6 scale=0.5 scale_top=0.6; "
+    "adaboost-hsv max_boxes=10 scale=0.5"
 )
 
 #: The union's own keys in a member's assignments (not passed to the member).
