@@ -12,7 +12,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-__all__ = ["ALPHA", "bootstrap_interval", "format_p", "paired_test"]
+__all__ = ["ALPHA", "bootstrap_interval", "format_p", "paired_test", "quantile7"]
 
 ALPHA = 0.05
 
@@ -32,16 +32,36 @@ def bootstrap_interval(
         return None
     if np.all(data == data[0]):
         return [float(data[0])] * 2
-    rng = np.random.default_rng(seed)
+    # SciPy's stats.bootstrap(method="percentile", random_state=seed), resample for resample
+    # (its legacy RandomState stream), without the second of importing scipy.stats
+    rng = np.random.RandomState(seed)
     batch = max(1, 4_000_000 // data.size)  # bounded memory for long runs
     means = np.concatenate(
         [
-            data[rng.integers(0, data.size, (min(batch, resamples - done), data.size))].mean(axis=1)
+            data[rng.randint(0, data.size, (min(batch, resamples - done), data.size))].mean(axis=-1)
             for done in range(0, resamples, batch)
         ]
     )
-    low, high = np.percentile(means, [100 * ALPHA / 2, 100 * (1 - ALPHA / 2)])
-    return [float(low), float(high)]
+    alpha = (1 - (1 - ALPHA)) / 2  # as SciPy computes it from the confidence level
+    return [quantile7(means, alpha), quantile7(means, 1 - alpha)]
+
+
+def quantile7(values: np.ndarray, p: float) -> float:
+    """The ``p`` quantile by Hyndman and Fan's (1996) definition 7, linear between order
+    statistics, in the arithmetic of ``scipy.stats.quantile`` (``np.quantile`` may differ in
+    the last digit).
+
+    Examples
+    --------
+    >>> quantile7(np.array([4.0, 1.0, 3.0, 2.0]), 0.5), quantile7(np.array([1.0, 2.0]), 0.25)
+    (2.5, 1.25)
+    """
+    ordered = np.sort(values)
+    position = p * ordered.size + (1 - p)  # 1-based
+    upper = int(position // 1)
+    g = position % 1
+    lower, upper = min(max(upper - 1, 0), ordered.size - 1), min(upper, ordered.size - 1)
+    return float((1 - g) * ordered[lower] + g * ordered[upper])
 
 
 def format_p(p_value: float | None) -> str:
