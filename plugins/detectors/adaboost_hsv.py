@@ -19,7 +19,6 @@ from typing import TYPE_CHECKING
 
 import cv2
 import numpy as np
-from scipy.special import expit
 
 from tsrkit.api import (
     STATES,
@@ -296,6 +295,8 @@ def boosted_margin(features: np.ndarray, stumps: dict[str, np.ndarray]) -> np.nd
 
 def margin_probability(margin: np.ndarray) -> np.ndarray:
     """Lee's g: ``g(f) = e^f / (e^f + e^-f)`` (= logistic(2f), Friedman et al. 2000)."""
+    from scipy.special import expit  # on first use: scipy.special costs 0.2 s to import
+
     return expit(2.0 * np.asarray(margin, np.float64))
 
 

@@ -34,6 +34,21 @@ def test_help_imports_no_verb_and_no_heavy_library():
     assert all(f"  {name}" in out for name in VERBS)
 
 
+def test_loading_every_plugin_imports_no_map_reader():
+    # sun-pca needs GPS tracks, not the OpenStreetMap reader and its SciPy graph routines
+    code = (
+        "import sys\n"
+        "from tsrkit.registry import get_registry\n"
+        "get_registry()\n"
+        "print([m for m in ('tsrkit.geo.osm', 'tsrkit.geo.vicinity', 'scipy.sparse.csgraph')"
+        " if m in sys.modules])\n"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True
+    ).stdout
+    assert out.strip().splitlines()[-1] == "[]"
+
+
 def test_each_listed_summary_is_the_verbs_own_first_sentence():
     for name, verb in VERBS.items():
         command = cli.get_command(click.Context(cli), name)

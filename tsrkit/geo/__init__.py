@@ -6,22 +6,11 @@ signalised intersections of an OpenStreetMap extract (``.osm``, ``.osm.gz``, ``.
 GeoJSON points, ``traversals`` finds the passes of the track through them with their movement;
 :mod:`tsrkit.geo.nearest` holds the basic and Zheng's extended k-d tree searches. No network is
 used: the map is a local extract (cut one with ``osmium extract``).
+
+Names are imported on first use (PEP 562, declared in ``__init__.pyi``): reading a GPS log
+does not import the map reader's SciPy graph routines.
 """
 
-from tsrkit.geo.errors import GeoError
-from tsrkit.geo.gps import Track, read_track
-from tsrkit.geo.osm import Signals, read_signals
-from tsrkit.geo.projection import LocalProjection
-from tsrkit.geo.vicinity import Traversal, movement, traversals
+from tsrkit._lazy import attach_stub
 
-__all__ = [
-    "GeoError",
-    "LocalProjection",
-    "Signals",
-    "Track",
-    "Traversal",
-    "movement",
-    "read_signals",
-    "read_track",
-    "traversals",
-]
+__getattr__, __dir__, __all__ = attach_stub(__name__, __file__)
