@@ -37,7 +37,7 @@ band, and adaboost-hsv for large lamps anywhere at half size. Against the earlie
 (lab-frst ``top=15 fraction=0.1``, conspicuity ``n_top=15``, adaboost-hsv ``max_boxes=10``,
 tl-recognizer on the whole frame) they find more lights on every set and size (candidate recall
 DTLD 0.92 -> 0.96, iwai_japan_tl 0.85 -> 0.88, lenses of radius <= 3 px DTLD 0.76 -> 0.84) at
-about 75 instead of 35 candidates per frame and a ninth of the time; the band costs 2 of 658
+about 75 instead of 35 candidates per frame and an eighth of the time; the band costs 2 of 658
 iwai_japan_tl lights and 2 of 131 cinTA test lights against the whole frame
 (``benchmarks/RESULTS.verifier.md``, ``benchmarks/RESULTS.detector_speed.md``). A camera that
 looks up at lights (not from a car) should set ``scale_top=1`` or other members.
