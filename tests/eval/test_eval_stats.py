@@ -11,6 +11,8 @@ def test_bootstrap_interval_brackets_the_mean():
     low, high = bootstrap_interval(values)
     assert low < 0.5 < high and high - low < 0.3
     assert bootstrap_interval([0.3]) is None
+    assert bootstrap_interval([0.1, float("nan"), 0.9]) is None
+    assert bootstrap_interval([1.0, float("inf")]) is None
 
 
 def test_paired_test_names_the_better_method():

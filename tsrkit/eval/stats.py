@@ -20,7 +20,8 @@ ALPHA = 0.05
 def bootstrap_interval(
     values: Sequence[float], resamples: int = 1000, seed: int = 0
 ) -> list[float] | None:
-    """95 % percentile-bootstrap interval of the mean of ``values``; None for fewer than 2.
+    """95 % percentile-bootstrap interval of the mean of ``values``; None for fewer than 2 or
+    for values that are not all finite.
 
     Examples
     --------
@@ -28,7 +29,7 @@ def bootstrap_interval(
     [1.0, 1.0]
     """
     data = np.asarray(values, dtype=float)
-    if data.size < 2:
+    if data.size < 2 or not np.isfinite(data).all():
         return None
     if np.all(data == data[0]):
         return [float(data[0])] * 2
