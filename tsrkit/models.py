@@ -2,7 +2,9 @@
 
 ``save_model`` writes ``NAME.npz`` and ``NAME.json`` atomically; the JSON records the plugin,
 its version, the parameters, the training set's checksum and a sha256 of every array, so
-``load_model`` can refuse a corrupt, truncated or mismatched file with a clear message.
+``load_model`` can refuse a corrupt, truncated or mismatched file with a clear message. A model
+may also hold whole files in a format of their own (an ONNX network: ``NAME.onnx``), written
+beside the JSON and checked by their sha256 the same way; a model of files only has no ``.npz``.
 """
 
 from __future__ import annotations
@@ -38,19 +40,21 @@ class ModelError(TsrkitError):
 class Model:
     """What a trainable plugin's ``fit`` returns and its ``model`` parameter loads.
 
-    ``arrays`` hold every learned number (numeric dtypes only); ``info`` holds small JSON facts
+    ``arrays`` hold every learned number (numeric dtypes only); ``files`` whole files by their
+    suffix (``{"onnx": b"..."}`` is written as ``NAME.onnx``); ``info`` holds small JSON facts
     (class names, explained variance, ...). ``meta`` is filled by :func:`load_model`.
     """
 
     arrays: Mapping[str, np.ndarray]
     info: Mapping[str, Any] = field(default_factory=dict)
     meta: Mapping[str, Any] = field(default_factory=dict)
+    files: Mapping[str, bytes] = field(default_factory=dict)
 
 
 def model_paths(path: str | os.PathLike) -> tuple[Path, Path]:
     """The ``.npz`` and ``.json`` paths for a model named ``path`` (with or without suffix)."""
     path = Path(path)
-    base = path.with_suffix("") if path.suffix in (".npz", ".json") else path
+    base = path.with_suffix("") if path.suffix in (".npz", ".json", ".onnx") else path
     return base.with_suffix(".npz"), base.with_suffix(".json")
 
 
@@ -78,12 +82,19 @@ def save_model(
     for name, array in model.arrays.items():
         if np.asarray(array).dtype.kind not in "biufc":
             raise ModelError(f"model array '{name}' is not numeric; cannot save without pickle")
-    buffer = io.BytesIO()
-    arrays = {k: np.asarray(v) for k, v in model.arrays.items()}
-    # numpy's stub reads **arrays as its allow_pickle keyword; the arrays are numeric (above)
-    np.savez_compressed(buffer, **arrays)  # type: ignore[arg-type]
-    with atomic_open(npz_path, "wb") as fh:
-        fh.write(buffer.getvalue())
+    for suffix in model.files:
+        if not suffix.isalnum() or suffix in ("npz", "json"):
+            raise ModelError(f"model file suffix {suffix!r}: not a plain suffix of its own")
+    if model.arrays or not model.files:
+        buffer = io.BytesIO()
+        arrays = {k: np.asarray(v) for k, v in model.arrays.items()}
+        # numpy's stub reads **arrays as its allow_pickle keyword; the arrays are numeric (above)
+        np.savez_compressed(buffer, **arrays)  # type: ignore[arg-type]
+        with atomic_open(npz_path, "wb") as fh:
+            fh.write(buffer.getvalue())
+    for suffix, data in model.files.items():
+        with atomic_open(json_path.with_suffix("." + suffix), "wb") as fh:
+            fh.write(data)
     from tsrkit import __version__
 
     write_json(
@@ -104,9 +115,13 @@ def save_model(
                 }
                 for k, v in model.arrays.items()
             },
+            "files": {
+                k: {"bytes": len(v), "sha256": hashlib.sha256(v).hexdigest()}
+                for k, v in model.files.items()
+            },
         },
     )
-    return npz_path
+    return npz_path if model.arrays or not model.files else json_path
 
 
 #: The largest model file read, in bytes.
@@ -123,16 +138,44 @@ def load_model(path: str | os.PathLike, plugin: str) -> Model:
         checksums differ from the metadata.
     """
     npz_path, json_path = model_paths(path)
-    for p in (npz_path, json_path):
-        problem = not_regular(p)
-        if problem == "no such file":
-            raise ModelError(f"model {p}: no such file (a model is a .npz with a .json beside it)")
-        if problem:
-            raise ModelError(f"model {p}: {problem}")
+    meta = _metadata(json_path, plugin)
+    arrays = _arrays(npz_path, meta["arrays"]) if meta["arrays"] or not meta["files"] else {}
+    files = {}
+    for suffix, entry in meta["files"].items():
+        where = json_path.with_suffix("." + suffix)
+        data = _read_file(where)
+        if hashlib.sha256(data).hexdigest() != entry.get("sha256"):
+            raise ModelError(f"model {where}: does not match its checksum in {json_path.name}")
+        files[suffix] = data
+    return Model(arrays=arrays, info=meta.get("info", {}), meta=meta, files=files)
+
+
+def _read_file(path: Path) -> bytes:
+    """The bytes of a model file, refused as :class:`ModelError` when missing, not a regular
+    file or larger than :data:`MAX_MODEL_BYTES`."""
+    problem = not_regular(path)
+    if problem == "no such file":
+        raise ModelError(f"model {path}: no such file (a model's files lie beside its .json)")
+    if problem:
+        raise ModelError(f"model {path}: {problem}")
     try:
-        file_size(npz_path, MAX_MODEL_BYTES)
+        file_size(path, MAX_MODEL_BYTES)
+        return path.read_bytes()
     except InputFileError as exc:
         raise ModelError(f"model {exc}") from None
+    except OSError as exc:
+        raise ModelError(f"model {path}: unreadable ({exc.strerror or exc})") from None
+
+
+def _metadata(json_path: Path, plugin: str) -> dict[str, Any]:
+    """The model's JSON metadata, checked to be tsrkit's and made for ``plugin``."""
+    problem = not_regular(json_path)
+    if problem == "no such file":
+        raise ModelError(
+            f"model {json_path}: no such file (a model is a .npz or .onnx with a .json beside it)"
+        )
+    if problem:
+        raise ModelError(f"model {json_path}: {problem}")
     try:
         meta = json.loads(read_text(json_path, MAX_MODEL_BYTES))
     except InputFileError as exc:
@@ -144,11 +187,33 @@ def load_model(path: str | os.PathLike, plugin: str) -> Model:
         or not isinstance(meta.get("plugin"), str)
         or not isinstance(meta.get("arrays"), dict)
         or not all(isinstance(entry, dict) for entry in meta["arrays"].values())
+        or not isinstance(meta.get("files", {}), dict)
+        or not all(
+            isinstance(entry, dict) and str(suffix).isalnum() and suffix not in ("npz", "json")
+            for suffix, entry in meta.get("files", {}).items()
+        )
         or not isinstance(meta.get("info", {}), dict)
     ):
         raise ModelError(f"model {json_path}: not tsrkit model metadata")
     if meta["plugin"] != plugin:
-        raise ModelError(f"model {npz_path} was trained for '{meta['plugin']}', not '{plugin}'")
+        raise ModelError(f"model {json_path} was trained for '{meta['plugin']}', not '{plugin}'")
+    meta.setdefault("files", {})
+    return meta
+
+
+def _arrays(npz_path: Path, expected: Mapping[str, Any]) -> dict[str, np.ndarray]:
+    """The arrays of the model's ``.npz``, checked against their checksums in ``expected``."""
+    problem = not_regular(npz_path)
+    if problem == "no such file":
+        raise ModelError(
+            f"model {npz_path}: no such file (a model is a .npz with a .json beside it)"
+        )
+    if problem:
+        raise ModelError(f"model {npz_path}: {problem}")
+    try:
+        file_size(npz_path, MAX_MODEL_BYTES)
+    except InputFileError as exc:
+        raise ModelError(f"model {exc}") from None
     try:
         with np.load(npz_path, allow_pickle=False) as archive:
             arrays = {name: archive[name] for name in archive.files}
@@ -167,7 +232,6 @@ def load_model(path: str | os.PathLike, plugin: str) -> Model:
         raise ModelError(
             f"model {npz_path}: corrupt archive ({type(exc).__name__}: {exc})"
         ) from None
-    expected = meta["arrays"]
     if set(arrays) != set(expected):
         raise ModelError(
             f"model {npz_path}: arrays {sorted(arrays)} do not match the "
@@ -176,7 +240,7 @@ def load_model(path: str | os.PathLike, plugin: str) -> Model:
     for name, array in arrays.items():
         if _digest(array) != expected[name].get("sha256"):
             raise ModelError(f"model {npz_path}: array '{name}' does not match its checksum")
-    return Model(arrays=arrays, info=meta.get("info", {}), meta=meta)
+    return arrays
 
 
 def _plain(value: Any) -> Any:
