@@ -69,40 +69,49 @@ def geometry(
     )
 
 
-def photometric(crop: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-    """``crop`` (uint8 BGR) as another camera's exposure, response, colour, optics and
-    coding would render it."""
-    x = crop.astype(np.float32) / 255.0
-    x = x * np.exp(rng.uniform(np.log(GAIN[0]), np.log(GAIN[1])))
-    x *= rng.uniform(*WHITE_BALANCE, 3).astype(np.float32)
-    x = np.clip(x, 0.0, 1.0) ** rng.uniform(*GAMMA)
-    grey = x.mean(axis=2, keepdims=True)
-    x = np.clip(grey + (x - grey) * rng.uniform(*SATURATION), 0.0, 1.0)
-    out = (x * 255.0).astype(np.uint8)
-    optics = rng.random()
-    if optics < 0.35:
-        out = cv2.GaussianBlur(out, (0, 0), float(rng.uniform(0.3, BLUR_SIGMA)))
-    elif optics < 0.45:  # defocus: a small disc
-        disc = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (3, 3)).astype(np.float32)
-        out = cv2.filter2D(out, -1, disc / disc.sum())
-    if rng.random() < 0.5:
-        noise = rng.normal(0.0, rng.uniform(0.0, NOISE_SIGMA), out.shape)
-        out = np.clip(out + noise, 0, 255).astype(np.uint8)
-    if rng.random() < 0.3:
-        quality = int(rng.integers(*JPEG_QUALITY))
-        ok, data = cv2.imencode(".jpg", out, [cv2.IMWRITE_JPEG_QUALITY, quality])
-        if ok:
-            out = cv2.imdecode(data, cv2.IMREAD_COLOR)
+def photometric(batch: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """A batch of crops (``(N, S, S, 3)`` uint8 BGR), each as another camera's exposure,
+    response, colour, optics and coding would render it (one draw per crop)."""
+    n = len(batch)
+    x = batch.astype(np.float32) * (1.0 / 255.0)
+    gain = np.exp(rng.uniform(np.log(GAIN[0]), np.log(GAIN[1]), (n, 1, 1, 1)))
+    x *= (gain * rng.uniform(*WHITE_BALANCE, (n, 1, 1, 3))).astype(np.float32)
+    np.clip(x, 0.0, 1.0, out=x)
+    x **= rng.uniform(*GAMMA, (n, 1, 1, 1)).astype(np.float32)
+    grey = x.mean(axis=3, keepdims=True)
+    x = grey + (x - grey) * rng.uniform(*SATURATION, (n, 1, 1, 1)).astype(np.float32)
+    noisy = rng.random(n) < 0.5
+    sigma = np.where(noisy, rng.uniform(0.0, NOISE_SIGMA, n), 0.0) / 255.0
+    x += rng.standard_normal(x.shape, dtype=np.float32) * sigma[:, None, None, None].astype(
+        np.float32
+    )
+    out = (np.clip(x, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
+    optics = rng.random(n)
+    jpeg = rng.random(n) < 0.3
+    disc = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (3, 3)).astype(np.float32)
+    for i in range(n):
+        if optics[i] < 0.35:
+            out[i] = cv2.GaussianBlur(out[i], (0, 0), float(rng.uniform(0.3, BLUR_SIGMA)))
+        elif optics[i] < 0.45:  # defocus: a small disc
+            out[i] = cv2.filter2D(out[i], -1, disc / disc.sum())
+        if jpeg[i]:
+            quality = int(rng.integers(*JPEG_QUALITY))
+            ok, data = cv2.imencode(".jpg", out[i], [cv2.IMWRITE_JPEG_QUALITY, quality])
+            if ok:
+                out[i] = cv2.imdecode(data, cv2.IMREAD_COLOR)
     return out
 
 
 def augment(
-    crop: np.ndarray, box: np.ndarray, size: int, rng: np.random.Generator, turn: float = 0.2
+    crops: np.ndarray, boxes: np.ndarray, size: int, rng: np.random.Generator, turn: float = 0.2
 ) -> tuple[np.ndarray, np.ndarray]:
-    """One augmented view of a training crop and its box (:func:`geometry`, then
-    :func:`photometric`)."""
-    out, moved = geometry(crop, box, size, rng, turn)
-    return photometric(out, rng), moved
+    """Augmented views of a batch of training crops and their boxes (:func:`geometry` per
+    crop, then :func:`photometric` on the batch)."""
+    views = np.zeros((len(crops), size, size, 3), np.uint8)
+    moved = boxes.astype(np.float32, copy=True)
+    for i in range(len(crops)):
+        views[i], moved[i] = geometry(crops[i], boxes[i], size, rng, turn)
+    return photometric(views, rng), moved
 
 
 def centre(crop: np.ndarray, size: int) -> np.ndarray:

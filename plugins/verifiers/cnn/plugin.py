@@ -157,7 +157,7 @@ class CnnVerifier(Verifier):
         Param(
             "width",
             "int",
-            16,
+            8,
             min=4,
             max=64,
             help="training: channels of the first convolution block (then x2, x4, x4)",
@@ -180,6 +180,15 @@ class CnnVerifier(Verifier):
             min=0.5,
             max=100.0,
             help="training: negatives drawn per positive, every epoch anew",
+        ),
+        Param(
+            "per_camera",
+            "int",
+            1500,
+            min=10,
+            max=10**7,
+            help="training: positives drawn per camera and epoch at most (a set with many "
+            "lights, as cinTA's near heads, does not outweigh the others)",
         ),
         Param(
             "turn",
@@ -360,6 +369,7 @@ class CnnVerifier(Verifier):
             patience=p["patience"],
             learning_rate=p["learning_rate"],
             negative_ratio=p["negative_ratio"],
+            per_camera=p["per_camera"],
             turn=p["turn"],
             seed=p["seed"],
             threads=p["threads"],

@@ -42,12 +42,13 @@ BOX_WEIGHT, STATE_WEIGHT = 2.0, 0.5
 class Settings:
     """Training settings (the plugin's parameters of the same names)."""
 
-    width: int = 16
+    width: int = 8
     epochs: int = 14
     patience: int = 4
     batch: int = 256
     learning_rate: float = 3e-3
     negative_ratio: float = 3.0
+    per_camera: int = 1500
     turn: float = 0.2
     seed: int = 0
     threads: int = 1
@@ -111,17 +112,35 @@ def network(width: int) -> Any:
     return Net()
 
 
+def _per_camera(
+    rows: np.ndarray, camera: np.ndarray, cap: int
+) -> Callable[[np.random.Generator], np.ndarray]:
+    """A draw of ``rows`` holding at most ``cap`` of each camera (a fresh subset of a larger
+    camera at every draw), so that no camera's look dominates an epoch.
+
+    Examples
+    --------
+    >>> draw = _per_camera(np.arange(5), np.array(["a", "a", "a", "b", "b"]), 2)
+    >>> sorted(draw(np.random.default_rng(0)).tolist())[-2:]
+    [3, 4]
+    >>> len(draw(np.random.default_rng(0)))
+    4
+    """
+    groups = [rows[camera[rows] == c] for c in np.unique(camera[rows])]
+
+    def draw(rng: np.random.Generator) -> np.ndarray:
+        return np.concatenate([rng.permutation(g)[:cap] for g in groups])
+
+    return draw
+
+
 def _batch(data: CropSet, rows: np.ndarray, rng: np.random.Generator | None, turn: float):
     """Network input and box targets of ``rows``: augmented views, or the plain centres
     (``rng`` None)."""
-    size = INPUT
-    images = np.zeros((len(rows), size, size, 3), np.uint8)
-    boxes = data.box[rows].copy()
-    for k, row in enumerate(rows):
-        if rng is None:
-            images[k] = centre(data.crops[row], size)
-        else:
-            images[k], boxes[k] = augment(data.crops[row], data.box[row], size, rng, turn)
+    if rng is None:
+        images = np.stack([centre(data.crops[row], INPUT) for row in rows])
+        return to_input(images), data.box[rows].copy()
+    images, boxes = augment(data.crops[rows], data.box[rows], INPUT, rng, turn)
     return to_input(images), boxes
 
 
@@ -177,7 +196,9 @@ def train(
     rng = np.random.default_rng(settings.seed)
     model = network(settings.width)
     optimiser = torch.optim.AdamW(model.parameters(), lr=settings.learning_rate, weight_decay=1e-4)
-    per_epoch = len(positives) + min(len(negatives), int(settings.negative_ratio * len(positives)))
+    draw_positives = _per_camera(positives, data.camera, settings.per_camera)
+    n_pos = len(draw_positives(rng))
+    per_epoch = n_pos + min(len(negatives), int(settings.negative_ratio * n_pos))
     steps = settings.epochs * -(-per_epoch // settings.batch)
     schedule = torch.optim.lr_scheduler.OneCycleLR(
         optimiser, settings.learning_rate, total_steps=max(steps, 1)
@@ -189,8 +210,9 @@ def train(
     best: tuple[float, int, dict[str, Any]] | None = None
     history: list[dict[str, float]] = []
     for epoch in range(settings.epochs):
-        drawn = rng.permutation(negatives)[: per_epoch - len(positives)]
-        rows = rng.permutation(np.concatenate([positives, drawn]))
+        chosen = draw_positives(rng)
+        drawn = rng.permutation(negatives)[: per_epoch - len(chosen)]
+        rows = rng.permutation(np.concatenate([chosen, drawn]))
         model.train()
         total, seen = 0.0, 0
         for k in range(0, len(rows), settings.batch):
