@@ -160,7 +160,8 @@ def decode_yolo(output: np.ndarray, conf: float, classes: int | None) -> Decoded
     """The anchors of an Ultralytics output whose best class score reaches ``conf``.
 
     ``classes`` (the number of class names, when known) tells the orientation; without it the
-    smaller of the two dimensions is taken for ``4 + nc``, as in every export (84 x 8400).
+    smaller of the two dimensions is taken for ``4 + nc``, as in every export (84 x 8400),
+    unless it is too small to be (at most 4).
 
     Raises
     ------
@@ -176,7 +177,7 @@ def decode_yolo(output: np.ndarray, conf: float, classes: int | None) -> Decoded
     >>> d.boxes.tolist(), d.scores.round(3).tolist(), d.labels.tolist()
     ([[45.0, 30.0, 55.0, 50.0]], [0.9], [1])
     """
-    if output.ndim != 3 or output.shape[0] != 1 or min(output.shape[1:]) <= 4:
+    if output.ndim != 3 or output.shape[0] != 1:
         raise ModelError(
             f"YOLO output has shape {list(output.shape)}; expected [1, 4+classes, anchors]"
         )
@@ -185,13 +186,14 @@ def decode_yolo(output: np.ndarray, conf: float, classes: int | None) -> Decoded
         transposed = cols == classes + 4
     elif rows == cols:
         raise ModelError(
-            f"YOLO output {list(output.shape)} is square: give the class names to tell "
-            "classes from anchors"
+            f"YOLO output {list(output.shape)} is square: cannot tell classes from anchors"
         )
-    else:
-        transposed = cols < rows
+    else:  # the smaller dimension, unless it is too small to hold a box and a class
+        transposed = cols < rows if min(rows, cols) > 4 else rows <= 4
     table = output[0] if transposed else output[0].T  # (anchors, 4 + nc)
     found = table.shape[1] - 4
+    if found < 1:
+        raise ModelError(f"YOLO output {list(output.shape)} has no class scores")
     if classes is not None and found != classes:
         raise ModelError(f"the model scores {found} classes but {classes} class names are given")
     labels = np.argmax(table[:, 4:], axis=1)
