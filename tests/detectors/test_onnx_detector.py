@@ -10,9 +10,10 @@ from pathlib import Path
 
 import cv2
 import numpy as np
+import onnx
 import pytest
 from click.testing import CliRunner
-from oracles.onnx_models import brightest_model, constant_model, yolo_output
+from oracles.onnx_models import brightest_model, constant_model, rtdetr_model, yolo_output
 
 import tsrkit
 from tsrkit.api import Frame, ModelError
@@ -187,6 +188,22 @@ def test_boxes_layout_by_shapes_with_a_count_and_normalised_boxes(tmp_path):
     assert [c.state for c in found] == ["yellow", "red"]
 
 
+def test_rtdetr_style_model_is_fed_its_input_size(tmp_path):
+    fractions = np.array([[[0.25, 0.5, 0.5, 0.75]]], np.float32)
+    model = rtdetr_model(
+        tmp_path / "m.onnx", fractions, np.array([[0.8]], np.float32), np.array([[2]], np.int64)
+    )
+    (found,) = detector(model, names="red,yellow,green").detect(blank(128, 64))
+    assert found.bbox == (32.0, 32.0, 64.0, 64.0) and found.state == "green"  # 16 rows above
+
+
+def test_normalised_yolo_layout_as_ultralytics_rtdetr_exports_it(tmp_path):
+    out = yolo_output([(0.5, 0.5, 0.25, 0.5, 1, 0.9)], 3, anchors=10).transpose(0, 2, 1)
+    model = constant_model(tmp_path / "m.onnx", {"output0": out}, (64, 64), {"names": RYG})
+    (found,) = detector(model, normalized=True).detect(blank(64, 64))
+    assert found.bbox == (24.0, 16.0, 40.0, 48.0) and found.state == "yellow"
+
+
 def test_non_finite_rows_are_left_out_and_noted(tmp_path):
     out = yolo_output([(100, 100, 20, 20, 0, 0.9), (200, 200, 20, 20, 1, 0.8)], 3)
     out[0, 0, 1] = np.nan
@@ -271,6 +288,14 @@ def mismatched_names(tmp: Path) -> Path:
     return model
 
 
+def unknown_second_input(tmp: Path) -> Path:
+    model = onnx.load(str(constant_model(tmp / "m.onnx", {"output0": yolo_output([], 3)})))
+    extra = onnx.helper.make_tensor_value_info("mask", onnx.TensorProto.FLOAT, [1, 64, 64])
+    model.graph.input.append(extra)
+    onnx.save(model, str(tmp / "m.onnx"))
+    return tmp / "m.onnx"
+
+
 def bad_names_file(tmp: Path) -> Path:
     model = constant_model(tmp / "m.onnx", {"output0": yolo_output([], 3)})
     (tmp / "m.json").write_text('{"classes": 3}')
@@ -284,6 +309,7 @@ def bad_names_file(tmp: Path) -> Path:
         (not_onnx, "not an ONNX model"),
         (rank3_input, r"input 'images' is tensor\(float\) \[1, 3, 64\]; expected a float image"),
         (unreadable_outputs, r"cannot read outputs out\[1, 10\] by any layout"),
+        (unknown_second_input, "inputs are images, mask; expected an image, optionally"),
         (mismatched_names, "scores 3 classes but 2 class names"),
         (bad_names_file, "no 'names' in this class-names file"),
     ],

@@ -104,3 +104,30 @@ def brightest_model(path: Path, size: tuple[int, int] = (100, 100)) -> Path:
     ]
     graph = helper.make_graph(nodes, "brightest", [_image_input(size)], outputs)
     return _save(graph, path, None)
+
+
+def rtdetr_model(path: Path, boxes: np.ndarray, scores: np.ndarray, labels: np.ndarray) -> Path:
+    """An RT-DETR style model (``lyuwenyu/RT-DETR``'s deploy export): inputs ``images`` and
+    ``orig_target_sizes`` ``[[w, h]]``, outputs ``labels``, ``boxes`` and ``scores``, the boxes
+    given as fractions (``(1, N, 4)`` ``boxes``) and scaled by the sizes fed."""
+    nodes = [
+        helper.make_node(
+            "Constant", [], [name], value=numpy_helper.from_array(np.asarray(value), name)
+        )
+        for name, value in (("labels", labels), ("fractions", boxes), ("scores", scores))
+    ]
+    nodes += [
+        helper.make_node("Cast", ["orig_target_sizes"], ["wh"], to=TensorProto.FLOAT),
+        helper.make_node("Concat", ["wh", "wh"], ["whwh"], axis=1),
+        helper.make_node("Mul", ["fractions", "whwh"], ["boxes"]),
+    ]
+    inputs = [
+        _image_input((64, 64)),
+        helper.make_tensor_value_info("orig_target_sizes", TensorProto.INT64, [1, 2]),
+    ]
+    outputs = [
+        helper.make_tensor_value_info("labels", TensorProto.INT64, list(labels.shape)),
+        helper.make_tensor_value_info("boxes", TensorProto.FLOAT, list(boxes.shape)),
+        helper.make_tensor_value_info("scores", TensorProto.FLOAT, list(scores.shape)),
+    ]
+    return _save(helper.make_graph(nodes, "rtdetr", inputs, outputs), path, None)

@@ -6,8 +6,12 @@
   those below ``conf`` and suppresses overlaps (:func:`nms`).
 - ``boxes``: post-NMS exports (torchvision detection models, RT-DETR style graphs, TensorRT's
   ``num_dets`` / ``det_boxes`` ... plugins): boxes ``[N, 4]`` or ``[1, N, 4]`` as ``x0, y0, x1,
-  y1`` (input pixels, or [0, 1] of the input with ``normalized``), scores ``[N]`` and integer
-  labels ``[N]`` (either also with a leading 1), and optionally a detection count.
+  y1`` in input pixels, scores ``[N]`` and integer labels ``[N]`` (either also with a leading
+  1), and optionally a detection count.
+
+Either layout's coordinates may be fractions of the input's size instead of pixels (the
+plugin's ``normalized``: Ultralytics' RT-DETR export is the ``yolo`` layout so, ``[1, 300,
+4 + nc]``).
 
 Rows with a value that is not finite are dropped by :func:`finite_rows`, which counts them (the
 plugin notes the count in the frame's record).
@@ -204,11 +208,8 @@ def decode_yolo(output: np.ndarray, conf: float, classes: int | None) -> Decoded
     return finite_rows(boxes, scores[keep], labels[keep])
 
 
-def decode_boxes(
-    outputs: Sequence[np.ndarray], roles: dict[str, int], scale: tuple[float, float]
-) -> Decoded:
-    """Boxes, scores and labels of a post-NMS export, boxes multiplied by ``scale``
-    (``(W, H)`` of the input for normalised coordinates, else ``(1, 1)``).
+def decode_boxes(outputs: Sequence[np.ndarray], roles: dict[str, int]) -> Decoded:
+    """Boxes, scores and labels of a post-NMS export.
 
     Raises
     ------
@@ -218,9 +219,9 @@ def decode_boxes(
     Examples
     --------
     >>> d = decode_boxes([np.array([[[0.1, 0.2, 0.3, 0.4]]]), np.array([[0.8]]),
-    ...                   np.array([[2]])], {"boxes": 0, "scores": 1, "labels": 2}, (100, 50))
-    >>> d.boxes.tolist(), d.scores.tolist(), d.labels.tolist()
-    ([[10.0, 10.0, 30.0, 20.0]], [0.8], [2])
+    ...                   np.array([[2]])], {"boxes": 0, "scores": 1, "labels": 2})
+    >>> d.boxes.round(3).tolist(), d.scores.round(3).tolist(), d.labels.tolist()
+    ([[0.1, 0.2, 0.3, 0.4]], [0.8], [2])
     """
     boxes = np.asarray(outputs[roles["boxes"]])
     if boxes.ndim == 3 and boxes.shape[0] == 1:
@@ -235,8 +236,6 @@ def decode_boxes(
     if "count" in roles:
         count = int(np.asarray(outputs[roles["count"]]).reshape(-1)[0])
         boxes, scores, labels = boxes[:count], scores[:count], labels[:count]
-    sx, sy = scale
-    boxes = boxes.astype(np.float64) * np.array([sx, sy, sx, sy])
     return finite_rows(boxes, scores, labels)
 
 

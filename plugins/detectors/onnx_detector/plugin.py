@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -78,7 +79,8 @@ class OnnxDetector(Detector):
             "normalized",
             "bool",
             False,
-            help="boxes layout: coordinates are fractions of the input's width and height",
+            help="box coordinates are fractions of the input's width and height (e.g. "
+            "Ultralytics RT-DETR exports)",
         ),
         Param(
             "tile",
@@ -156,9 +158,10 @@ class OnnxDetector(Detector):
             count = None if self._names is None else len(self._names)
             found = decode_yolo(outputs[0], self.params["conf"], count)
         else:
+            found = decode_boxes(outputs, self._roles)
+        if self.params["normalized"]:
             height, width = self._size
-            scale = (width, height) if self.params["normalized"] else (1, 1)
-            found = decode_boxes(outputs, self._roles, scale)
+            found = replace(found, boxes=found.boxes * [width, height, width, height])
         boxes = placed.to_image(found.boxes) + np.tile(origin, 2)
         return Decoded(boxes, found.scores, found.labels, found.dropped)
 

@@ -16,8 +16,10 @@ import numpy as np
 from tsrkit.api import ModelError
 from tsrkit_plugins.detectors.onnx_detector.layouts import OutputInfo
 
-#: ONNX Runtime's element types and the NumPy dtypes fed to them.
+#: ONNX Runtime's element types and the NumPy dtypes fed to them: the image's, and a size
+#: input's (RT-DETR's ``orig_target_sizes``).
 INPUT_DTYPES = {"tensor(float)": np.float32, "tensor(float16)": np.float16}
+SIZE_DTYPES = {"tensor(int64)": np.int64, "tensor(int32)": np.int32, "tensor(float)": np.float32}
 
 
 @dataclass(frozen=True)
@@ -32,6 +34,9 @@ class Session:
         The image input.
     input_dtype : type
         Its NumPy element type.
+    size_inputs : tuple of (str, type)
+        Inputs fed the input's ``[[width, height]]`` (RT-DETR's ``orig_target_sizes``, to
+        which its boxes are scaled), with their element types.
     size : tuple of int or None
         ``(H, W)`` of the input, or None where a dimension is dynamic.
     outputs : tuple of OutputInfo
@@ -43,13 +48,17 @@ class Session:
     runtime: Any
     input_name: str
     input_dtype: type
+    size_inputs: tuple[tuple[str, type], ...]
     size: tuple[int, int] | None
     outputs: tuple[OutputInfo, ...]
     metadata: dict[str, str]
 
     def run(self, tensor: np.ndarray) -> list[np.ndarray]:
         """The outputs for one ``(1, 3, H, W)`` input."""
-        return self.runtime.run(None, {self.input_name: tensor.astype(self.input_dtype)})
+        feeds: dict[str, np.ndarray] = {self.input_name: tensor.astype(self.input_dtype)}
+        for name, dtype in self.size_inputs:
+            feeds[name] = np.array([[tensor.shape[3], tensor.shape[2]]], dtype)
+        return self.runtime.run(None, feeds)
 
 
 def open_session(path: Path) -> Session:
@@ -58,8 +67,9 @@ def open_session(path: Path) -> Session:
     Raises
     ------
     ModelError
-        When the file is missing or not an ONNX model ONNX Runtime can run, or when it has
-        other inputs than one float image ``[N, 3, H, W]``.
+        When the file is missing or not an ONNX model ONNX Runtime can run, or when its
+        inputs are not one float image ``[N, 3, H, W]``, first, and optionally sizes ``[N,
+        2]`` (an input whose name holds ``size``).
     """
     if not path.is_file():
         raise ModelError(f"{path}: no such file (the ONNX model)")
@@ -76,13 +86,18 @@ def open_session(path: Path) -> Session:
     except Exception as exc:  # ONNX Runtime raises its own Fail/InvalidProtobuf/... classes
         reason = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         raise ModelError(f"{path}: not an ONNX model ONNX Runtime can run ({reason})") from None
-    inputs = runtime.get_inputs()
-    if len(inputs) != 1:
-        names = ", ".join(i.name for i in inputs)
+    first, *extra = runtime.get_inputs()
+    sizes = [
+        (i.name, SIZE_DTYPES[i.type])
+        for i in extra
+        if "size" in i.name.lower() and i.type in SIZE_DTYPES and tuple(i.shape)[-1:] == (2,)
+    ]
+    if len(sizes) != len(extra):
+        names = ", ".join(i.name for i in (first, *extra))
         raise ModelError(
-            f"{path}: the model has {len(inputs)} inputs ({names}); expected one image"
+            f"{path}: the model's inputs are {names}; expected an image, optionally followed "
+            "by sizes [1, 2]"
         )
-    (first,) = inputs
     shape = tuple(first.shape)
     if len(shape) != 4 or shape[1] != 3 or first.type not in INPUT_DTYPES:
         raise ModelError(
@@ -96,6 +111,7 @@ def open_session(path: Path) -> Session:
         runtime,
         first.name,
         INPUT_DTYPES[first.type],
+        tuple(sizes),
         size,
         tuple(OutputInfo(o.name, tuple(o.shape), o.type) for o in runtime.get_outputs()),
         dict(meta),
