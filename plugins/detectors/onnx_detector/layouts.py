@@ -239,21 +239,23 @@ def decode_boxes(outputs: Sequence[np.ndarray], roles: dict[str, int]) -> Decode
     return finite_rows(boxes, scores, labels)
 
 
-def nms(boxes: np.ndarray, scores: np.ndarray, labels: np.ndarray, iou: float) -> np.ndarray:
-    """Indices of the boxes greedy non-maximum suppression keeps, best first: a box is
-    dropped when its IoU with a kept box of the same label exceeds ``iou`` (ties in score:
-    the earlier box first).
+def nms(
+    boxes: np.ndarray, scores: np.ndarray, labels: np.ndarray, iou: float, limit: int
+) -> np.ndarray:
+    """Indices of the boxes greedy non-maximum suppression keeps, best first, at most
+    ``limit``: a box is dropped when its IoU with a kept box of the same label exceeds ``iou``
+    (ties in score: the earlier box first).
 
     Examples
     --------
     >>> boxes = np.array([[0, 0, 10, 10], [1, 0, 11, 10], [1, 0, 11, 10.0]])
-    >>> nms(boxes, np.array([0.9, 0.8, 0.7]), np.array([0, 0, 1]), 0.5).tolist()
+    >>> nms(boxes, np.array([0.9, 0.8, 0.7]), np.array([0, 0, 1]), 0.5, 300).tolist()
     [0, 2]
     """
     order = np.argsort(-scores, kind="stable")
     areas = np.prod(np.clip(boxes[:, 2:] - boxes[:, :2], 0, None), axis=1)
     kept: list[int] = []
-    while len(order):
+    while len(order) and len(kept) < limit:
         best, rest = order[0], order[1:]
         kept.append(int(best))
         low = np.maximum(boxes[best, :2], boxes[rest, :2])

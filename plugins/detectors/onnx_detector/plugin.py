@@ -190,16 +190,13 @@ class OnnxDetector(Detector):
             keep &= np.isin(labels, p["classes"])
         boxes, scores, labels = boxes[keep], scores[keep], labels[keep]
         if self._layout == "yolo" or len(parts) > 1:
-            order = nms(boxes, scores, labels, p["iou"])
+            order = nms(boxes, scores, labels, p["iou"], p["max_det"])
         else:
-            order = np.argsort(-scores, kind="stable")
+            order = np.argsort(-scores, kind="stable")[: p["max_det"]]
         dropped = sum(d.dropped for d in parts)
         note = f"{self.name}: {dropped} boxes with values that are not finite left out"
         self.notes = (note,) if dropped else ()
-        return [
-            Candidate.from_box(boxes[i], scores[i], self.state(int(labels[i])))
-            for i in order[: p["max_det"]]
-        ]
+        return [Candidate.from_box(boxes[i], scores[i], self.state(int(labels[i]))) for i in order]
 
     def state(self, label: int) -> str | None:
         """The state class ``label``'s name says, None without one."""
