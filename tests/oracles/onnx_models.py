@@ -3,7 +3,9 @@
 - :func:`constant_model`: outputs fixed tensors whatever the image (exact box maths);
 - :func:`brightest_model`: a ``boxes``-layout model that finds the brightest pixel of the
   input's first (red) channel, a 5 x 5 box centred on it, scored by that pixel's value (tiling
-  and end-to-end runs, where the answer must depend on the image).
+  and end-to-end runs, where the answer must depend on the image);
+- :func:`rtdetr_model`: boxes scaled by a second input, the sizes, as RT-DETR's deploy
+  export does.
 """
 
 from __future__ import annotations
