@@ -118,7 +118,7 @@ def trained(tmp_path_factory):
 
 def test_a_trained_network_runs_through_the_plugin_as_onnx(trained):
     path, where, scenes, model, detector = trained
-    assert where.suffix == ".json" and path.with_suffix(".onnx").is_file()
+    assert where.suffix == ".npz" and path.with_suffix(".onnx").is_file()  # weights + network
     assert model.info["onnx_vs_torch_max_difference"] <= 1e-4
     verifier = make(model=str(path), threshold=0.0, overlap=1.0)
     frame = scenes[0].frame
@@ -151,6 +151,8 @@ def test_bad_model_files_are_one_clear_line(trained, tmp_path):
     data[len(data) // 2] ^= 0xFF
     damaged.with_suffix(".onnx").write_bytes(bytes(data))
     damaged.with_suffix(".json").write_text(json.dumps(card))
+    for copy in (damaged, tmp_path / "garbage", tmp_path / "other"):
+        copy.with_suffix(".npz").write_bytes(path.with_suffix(".npz").read_bytes())
     with pytest.raises(ModelError, match="checksum"):
         make(model=str(damaged)).verify(frame, candidates)
 
@@ -226,3 +228,18 @@ def test_tsrkit_train_cnn_verifier_writes_a_model_the_plugin_reads(tmp_path):
     frame = Frame(np.full((64, 64, 3), 90, np.uint8), "grey")
     kept = make(model=str(out), threshold=0.0).verify(frame, [Candidate.from_circle(30, 30, 3, 1)])
     assert len(kept) == 1
+
+
+def test_adapting_to_a_camera_re_estimates_only_the_normalisation(trained):
+    from tsrkit.models import load_model
+    from tsrkit_plugins.verifiers.cnn.training import adapt
+
+    path, _, scenes, _, detector = trained
+    model = load_model(path, "cnn-verifier")
+    frame = scenes[0].frame
+    batch, _ = crops(frame.image, detector.detect(frame))
+    darker = (batch * 0.5).astype(np.uint8)  # the same scene, a darker camera
+    onnx, arrays = adapt(dict(model.arrays), model.info["width"], darker)
+    changed = {k for k in arrays if not np.array_equal(arrays[k], model.arrays[k])}
+    assert changed and all("running" in k or "num_batches" in k for k in changed)
+    assert onnx != model.files["onnx"]

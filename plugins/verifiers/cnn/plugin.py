@@ -388,7 +388,8 @@ class CnnVerifier(Verifier):
             "history": trained.history,
             "onnx_vs_torch_max_difference": trained.difference,
         }
-        return Model(arrays={}, info=info, files={"onnx": trained.onnx})
+        info["width"] = p["width"]
+        return Model(arrays=trained.weights, info=info, files={"onnx": trained.onnx})
 
 
 @hookimpl

@@ -61,6 +61,7 @@ class Trained:
     onnx: bytes
     epoch: int
     difference: float
+    weights: dict[str, np.ndarray] = field(default_factory=dict)
     history: list[dict[str, float]] = field(default_factory=list)
 
 
@@ -257,7 +258,13 @@ def train(
         model.load_state_dict(best[2])
     check = held_x if held_x is not None else _batch(data, positives[:256], None, 0.0)[0]
     onnx, difference = export(model, check)
-    return Trained(onnx, min(kept, len(history)), difference, history)
+    return Trained(onnx, min(kept, len(history)), difference, weights(model), history)
+
+
+def weights(model: Any) -> dict[str, np.ndarray]:
+    """The network's parameters and batch-norm statistics as plain arrays (the model's
+    ``.npz``: what :func:`adapt` starts from)."""
+    return {k: v.detach().numpy().copy() for k, v in model.state_dict().items()}
 
 
 def export(model: Any, check: np.ndarray) -> tuple[bytes, float]:
@@ -309,3 +316,29 @@ def export(model: Any, check: np.ndarray) -> tuple[bytes, float]:
             f"(tolerance {TOLERANCE:g}); the model was not saved"
         )
     return onnx, worst
+
+
+def adapt(
+    arrays: dict[str, np.ndarray], width: int, crops: np.ndarray, batch: int = 256
+) -> tuple[bytes, dict[str, np.ndarray]]:
+    """The network of ``arrays`` with its batch-norm statistics re-estimated on ``crops``
+    (``(N, 32, 32, 3)`` uint8: candidates of the user's own camera, no labels), exported
+    again: the means and variances every layer normalises by become the new camera's, the
+    learned weights stay (test-time adaptation by batch-norm statistics).
+
+    Returns the ONNX bytes and the new arrays.
+    """
+    torch = _torch()
+    model = network(width)
+    model.load_state_dict({k: torch.from_numpy(np.asarray(v)) for k, v in arrays.items()})
+    norms = [m for m in model.modules() if isinstance(m, torch.nn.BatchNorm2d)]
+    for m in norms:
+        m.reset_running_stats()
+        m.momentum = None  # a cumulative average over every batch
+    model.train()
+    x = to_input(crops)
+    with torch.no_grad():
+        for k in range(0, len(x), batch):
+            model(torch.from_numpy(x[k : k + batch]))
+    onnx, _ = export(model, x[:256])
+    return onnx, weights(model)
