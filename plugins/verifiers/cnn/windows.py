@@ -7,8 +7,9 @@ candidate, so the whole housing and some surround are in view whichever lamp is 
 however the head hangs. Windows are cut on the integer pixel grid (parts outside the frame
 repeat its edge) and resized to the network's input side (area averaging when shrinking,
 bilinear when enlarging; a window over twice the input side is first thinned to every k-th
-pixel, which keeps a lit lens's core and costs a tenth of averaging the whole window). Training cuts a window :data:`TRAIN_MARGIN` times wider at the same
-resolution, so that scale, shift and rotation can be drawn without reaching past it.
+pixel, which keeps a lit lens's core and costs a tenth of averaging the whole window).
+Training cuts a window :data:`TRAIN_MARGIN` times wider at the same resolution, so that scale,
+shift and rotation can be drawn without reaching past it.
 
 A housing box is carried in window units: ``(x - x0) / side``, with ``(x0, y0)`` the window's
 top-left corner and ``side`` its side in frame pixels.
