@@ -176,53 +176,114 @@ def family_samples(family: Family) -> list[Sample]:
     return list(open_datasets([family.name]).samples)
 
 
-def evaluate(verifier, candidates: Candidates, family: Family | None, samples, lamp=None) -> dict:
-    """Figures of ``verifier`` on ``samples`` of a held-out family (see the module docstring)."""
+@dataclass
+class Seen:
+    """A test frame as the figures need it: its candidates and the network's outputs on them,
+    its truth (boxes, states; for the Taiwanese keyframes the boxes grown by half), its size."""
+
+    source: str
+    shape: tuple[int, int]
+    found: list
+    boxes: list
+    states: list
+    grown: list | None = None
+    load: object = None
+    out: dict | None = None
+
+    def frame(self) -> Frame:
+        """A frame of this size without pixels (what ``decide`` reads)."""
+        return Frame(np.broadcast_to(np.zeros(1, np.uint8), (*self.shape, 3)), self.source)
+
+
+def seen_samples(samples, candidates: Candidates) -> list[Seen]:
+    out = []
+    for s in samples:
+        frame = s.load()
+        out.append(
+            Seen(
+                frame.source,
+                frame.image.shape[:2],
+                candidates(frame),
+                [a.bbox for a in s.annotations],
+                [a.state for a in s.annotations],
+                load=s.load,
+            )
+        )
+    return out
+
+
+def seen_scenes(scenes, candidates: Candidates) -> list[Seen]:
+    """Seen frames of (scene, grown boxes) pairs (Taiwan) or plain frames (synthetic)."""
+    out = []
+    for item in scenes:
+        scene, grown = item if isinstance(item, tuple) else (Scene(item, [], []), [])
+        frame = scene.frame
+        out.append(
+            Seen(
+                frame.source,
+                frame.image.shape[:2],
+                candidates(frame),
+                list(scene.boxes),
+                [],
+                grown,
+                load=lambda f=frame: f,
+            )
+        )
+    return out
+
+
+def run_network(verifier, seen: list[Seen]) -> None:
+    """The network's outputs on every seen frame's candidates (kept on the frame)."""
+    for s in seen:
+        s.out = verifier.outputs(s.load(), s.found) if s.found else None
+
+
+def kept_of(rule, s: Seen) -> list:
+    """What ``rule`` keeps of the frame's candidates (from the stored outputs, or from the
+    pixels for a rule that reads them)."""
+    if getattr(rule, "reads_pixels", False):
+        return rule.decide(s.load(), s.found, None) if s.found else []
+    return rule.decide(s.frame(), s.found, s.out) if s.found and s.out is not None else []
+
+
+def evaluate(rule, seen: list[Seen], family: Family, lamp=None) -> dict:
+    """Figures of ``rule`` (a verifier deciding on the stored outputs) on a held-out family
+    (see the module docstring); state figures when ``lamp`` is given."""
     frames_gt = hits_frames = 0
     recall_sum = precision_sum = 0.0
-    precision_frames = 0
-    cand_hit = n_gt = 0
-    iou_hit = 0
+    precision_frames = cand_hit = n_gt = iou_hit = 0
     empty_frames = empty_false = 0
     state_rows: list[tuple[str, str, str | None]] = []
-    for sample in samples:
-        frame = sample.load()
-        found = candidates(frame)
-        boxes = [a.bbox for a in sample.annotations]
-        kept = verifier.verify(frame, found) if found else []
-        if not boxes:
+    for s in seen:
+        kept = kept_of(rule, s)
+        if not s.boxes:
             empty_frames += 1
             empty_false += len(kept)
             continue
-        n_gt += len(boxes)
+        n_gt += len(s.boxes)
         frames_gt += 1
-        if found:
-            cand_hit += int(
-                np.asarray(centre_hits([(c.x, c.y) for c in found], boxes)).any(0).sum()
-            )
+        if s.found:
+            hits = np.asarray(centre_hits([(c.x, c.y) for c in s.found], s.boxes))
+            cand_hit += int(hits.any(0).sum())
+        recall = 0.0
         if kept:
-            hits = np.asarray(centre_hits([(c.x, c.y) for c in kept], boxes))
+            hits = np.asarray(centre_hits([(c.x, c.y) for c in kept], s.boxes))
             matched = greedy_match([c.score for c in kept], hits.astype(float), 0.5)
-            recall = len(matched) / len(boxes)
+            recall = len(matched) / len(s.boxes)
             precision_sum += len(matched) / len(kept)
             precision_frames += 1
-            mine = [c.lens_bbox if family and family.box == "lens" else c.object_bbox for c in kept]
-            iou_hit += len(greedy_match([c.score for c in kept], iou_matrix(mine, boxes), 0.5))
-            lamp_states = (
-                [d.state for d in lamp.classify(frame, [kept[i] for i, _ in matched])]
-                if lamp is not None
-                else [None] * len(matched)
-            )
-            for (i, j), other in zip(matched, lamp_states):
-                truth = sample.annotations[j].state
-                if truth in STATE_NAMES:
-                    state_rows.append((truth, kept[i].state or "unknown", other))
-        else:
-            recall = 0.0
+            mine = [c.lens_bbox if family.box == "lens" else c.object_bbox for c in kept]
+            iou_hit += len(greedy_match([c.score for c in kept], iou_matrix(mine, s.boxes), 0.5))
+            if lamp is not None:
+                found = [kept[i] for i, _ in matched]
+                others = [d.state for d in lamp.classify(s.load(), found)] if found else []
+                for (i, j), other in zip(matched, others):
+                    if s.states[j] in STATE_NAMES:
+                        state_rows.append((s.states[j], kept[i].state or "unknown", other))
         recall_sum += recall
         hits_frames += recall > 0
     out = {
-        "frames": len(samples),
+        "frames": len(seen),
         "lights": n_gt,
         "candidate_recall": cand_hit / n_gt if n_gt else None,
         "hit": hits_frames / frames_gt if frames_gt else None,
@@ -232,7 +293,8 @@ def evaluate(verifier, candidates: Candidates, family: Family | None, samples, l
         "empty_frames": empty_frames,
         "false_per_empty_frame": empty_false / empty_frames if empty_frames else None,
     }
-    out.update(state_figures(state_rows))
+    if lamp is not None:
+        out.update(state_figures(state_rows))
     return out
 
 
@@ -251,31 +313,94 @@ def state_figures(rows) -> dict:
     return out
 
 
-def false_lights(verifier, candidates: Candidates, taiwan, synthetic) -> dict:
-    """False lights per frame on the Taiwanese keyframes and the synthetic no-light scenes."""
+def false_lights(rule, taiwan: list[Seen], synthetic: list[Seen]) -> dict:
+    """False lights per frame on the Taiwanese keyframes (a centre in no grown box) and the
+    synthetic no-light scenes."""
     all_false = empty_false = empty_frames = 0
-    for scene, grown in taiwan:
-        kept = verifier.verify(scene.frame, candidates(scene.frame))
-        if grown and kept:
-            inside = np.asarray(centre_hits([(c.x, c.y) for c in kept], grown)).any(1)
-            # the README's rule: a centre in no box grown by half its size
-            inside |= np.array(
-                [any(g[0] <= c.x <= g[2] and g[1] <= c.y <= g[3] for g in grown) for c in kept]
-            )
-            false = int((~inside).sum())
-        else:
-            false = len(kept)
+    for s in taiwan:
+        kept = kept_of(rule, s)
+        inside = np.array(
+            [any(g[0] <= c.x <= g[2] and g[1] <= c.y <= g[3] for g in s.grown) for c in kept],
+            bool,
+        )
+        false = int((~inside).sum()) if kept else 0
         all_false += false
-        if not scene.boxes:
+        if not s.boxes:
             empty_false += false
             empty_frames += 1
-    synth_false = sum(len(verifier.verify(f, candidates(f))) for f in synthetic)
+    synth_false = sum(len(kept_of(rule, s)) for s in synthetic)
     return {
         "taiwan_false_per_keyframe": all_false / len(taiwan),
         "taiwan_false_per_empty_keyframe": empty_false / max(empty_frames, 1),
         "taiwan_empty_keyframes": empty_frames,
         "synthetic_false_per_frame": synth_false / len(synthetic),
     }
+
+
+class Forest:
+    """The forest preset's verifier as a rule (it reads the frame's pixels, not outputs)."""
+
+    reads_pixels = True
+
+    def __init__(self, verifier):
+        self.verifier = verifier
+
+    def decide(self, frame, found, out):
+        return self.verifier.verify(frame, found)
+
+
+#: Keep rules swept on every fold (threshold, relative, prior).
+RULES = tuple(
+    (t, r, p) for t in (0.5, 0.7, 0.8, 0.9, 0.95, 0.98) for r in (0.0, 0.8) for p in (0.0, 0.3)
+)
+
+
+def fold_figures(model_path, params, family, seen, taiwan, synthetic, lamp) -> dict:
+    """The fold's figures at the preset's rule (with states) and at every rule of
+    :data:`RULES` (without)."""
+    network = tsrkit.verifier("cnn-verifier", model=str(model_path))
+    for group in (seen, taiwan, synthetic):
+        run_network(network, group)
+    main = tsrkit.verifier("cnn-verifier", model=str(model_path), **params)
+    figures = evaluate(main, seen, family, lamp)
+    figures.update(false_lights(main, taiwan, synthetic))
+    sweep = {}
+    for t, r, p in RULES:
+        rule = tsrkit.verifier(
+            "cnn-verifier",
+            model=str(model_path),
+            threshold=t,
+            relative=r,
+            prior=p,
+            overlap=params.get("overlap", 0.3),
+        )
+        row = evaluate(rule, seen, family)
+        row.update(false_lights(rule, taiwan, synthetic))
+        sweep[f"t{t:g}_r{r:g}_p{p:g}"] = row
+    figures["rules"] = sweep
+    return figures
+
+
+def adapted_figures(
+    model, crops: CropSet, path: Path, params, family, seen, taiwan, synthetic, lamp
+) -> dict:
+    """The fold's figures after its network's batch-norm statistics were re-estimated on the
+    held-out camera's candidate crops (no labels used: every candidate of its frames)."""
+    from tsrkit_plugins.verifiers.cnn.augment import centre
+    from tsrkit_plugins.verifiers.cnn.training import adapt
+
+    inputs = np.stack([centre(c, 32) for c in crops.crops])
+    onnx, arrays = adapt(dict(model.arrays), model.info["width"], inputs)
+    where = path.with_name(path.name + "_adapted")
+    save_model(
+        where,
+        replace(model, arrays=arrays, files={"onnx": onnx}),
+        plugin="cnn-verifier",
+        plugin_version="0.1.0",
+        params={},
+        training={"fold": family.key, "adapted": True},
+    )
+    return fold_figures(where, params, family, seen, taiwan, synthetic, lamp)
 
 
 def commit() -> str:
@@ -304,6 +429,9 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true", help="10 frames a set (a smoke run)")
     parser.add_argument("--ship", action="store_true", help="train and write the shipped model")
     parser.add_argument(
+        "--adapt", action="store_true", help="also measure batch-norm adaptation per fold"
+    )
+    parser.add_argument(
         "--baseline",
         action="store_true",
         help="also evaluate the forest verifier preset (shipped model)",
@@ -324,10 +452,11 @@ def main() -> None:
         )
         for i, f in enumerate(FAMILIES)
     }
-    taiwan = taiwan_scenes()[:limit]
-    test_unlit = list(no_light_frames(NO_LIGHT_TEST, NO_LIGHT_TEST_SEED))[:limit]
-    for scene, _ in taiwan:
-        candidates(scene.frame)
+    taiwan = seen_scenes(taiwan_scenes()[:limit], candidates)
+    test_unlit = seen_scenes(
+        list(no_light_frames(NO_LIGHT_TEST, NO_LIGHT_TEST_SEED))[:limit], candidates
+    )
+    seen = {f.key: seen_samples(families[f.key], candidates) for f in FAMILIES}
     print(f"candidates and crops: {time.time() - t0:.0f} s", file=sys.stderr)
     for key, crops in family_crops.items():
         print(
@@ -337,14 +466,14 @@ def main() -> None:
     verifier_params = {}
     if chosen.verifier is not None and chosen.verifier.name == "cnn-verifier":
         verifier_params = {
-            k: chosen.verifier.params[k] for k in ("threshold", "relative", "overlap")
+            k: chosen.verifier.params[k] for k in ("threshold", "relative", "overlap", "prior")
         }
     if args.threshold is not None:
         verifier_params["threshold"] = args.threshold
     lamp = tsrkit.classifier("lamp-state")
     results: dict = {}
     folds = [f for f in FAMILIES if not args.only or f.key in args.only]
-    if args.ship:
+    if args.ship or args.baseline:
         folds = []
     for family in folds:
         train = CropSet.concat(
@@ -369,14 +498,35 @@ def main() -> None:
             training={"fold": family.key},
         )
         seconds = time.time() - t0
-        verifier = tsrkit.verifier("cnn-verifier", model=str(path), **verifier_params)
-        figures = evaluate(verifier, candidates, family, families[family.key], lamp)
-        figures.update(false_lights(verifier, candidates, taiwan, test_unlit))
+        figures = fold_figures(
+            path, verifier_params, family, seen[family.key], taiwan, test_unlit, lamp
+        )
         figures["train_seconds"] = seconds
         figures["epochs"] = model.info["epoch_kept"]
+        if args.adapt:
+            figures["adapted"] = adapted_figures(
+                model,
+                family_crops[family.key],
+                path,
+                verifier_params,
+                family,
+                seen[family.key],
+                taiwan,
+                test_unlit,
+                lamp,
+            )
         results[family.key] = figures
         print(family.key, json.dumps(figures), file=sys.stderr)
         (args.out / "folds.json").write_text(json.dumps(results, indent=1))
+    if args.baseline:
+        baseline = tsrkit.select(config="recommended-forest").verifier
+        rows = {}
+        for family in FAMILIES:
+            figures = evaluate(Forest(baseline), seen[family.key], family, lamp)
+            figures.update(false_lights(Forest(baseline), taiwan, test_unlit))
+            rows[family.key] = figures
+            print("forest", family.key, json.dumps(figures), file=sys.stderr)
+        (args.out / "baseline.json").write_text(json.dumps(rows, indent=1))
     if args.ship:
         ship(args, synth_crops, family_crops, results)
 

@@ -21,7 +21,7 @@ from tsrkit.eval.coco import coco_ap, coco_run
 from tsrkit.eval.perframe import frame_score
 from tsrkit.eval.results import fmt
 from tsrkit.eval.stats import format_p, paired_test
-from tsrkit.plugin import Classifier, Detector
+from tsrkit.plugin import Classifier, Detector, Verifier
 from tsrkit.report import RunResult, headline_rows, markdown_table, title
 from tsrkit.types import Dataset
 
@@ -29,6 +29,7 @@ __all__ = [
     "box_ap50",
     "compare",
     "compare_markdown",
+    "compare_runs",
     "frame_recalls",
     "paired_tests",
     "verifier_tests",
@@ -109,17 +110,42 @@ def compare(
     "detectors", "runs", "reports", "paired_tests", "box_ap50"}``.
     """
     names = [d.name for d in detectors]
-    verifier = options.get("verifier")
+    verifier = options.pop("verifier", None)
     ablate = without_verifier and verifier is not None
     if len(set(names)) != len(names) or len(names) < (1 if ablate else 2):
         raise BenchmarkError(f"compare needs at least two different detectors; got {names}")
     plan = [
-        (f"{d.name}+{verifier.name}" if verifier is not None else d.name, d, verifier)
+        (f"{d.name}+{verifier.name}" if verifier is not None else d.name, d, verifier, classifier)
         for d in detectors
     ]
     if ablate:
-        plan = [run for d, with_it in zip(detectors, plan) for run in ((d.name, d, None), with_it)]
-    labels = [label for label, _, _ in plan]
+        plan = [
+            run
+            for d, with_it in zip(detectors, plan)
+            for run in ((d.name, d, None, classifier), with_it)
+        ]
+    return compare_runs(dataset, plan, out=out, pairs_of_two=ablate, **options)
+
+
+Plan = tuple[str, Detector, Verifier | None, Classifier | None]
+
+
+def compare_runs(
+    dataset: Dataset,
+    plan: Sequence[Plan],
+    *,
+    out: str | os.PathLike | None = None,
+    pairs_of_two: bool = False,
+    **options: Any,
+) -> dict[str, Any]:
+    """Benchmark each run of ``plan`` (label, detector, verifier, classifier: whole pipelines,
+    such as two presets) on the same frames and test each pair. ``pairs_of_two``: the runs
+    are pairs without and with a verifier (:func:`verifier_tests` on each pair). Other keyword
+    options are those of :func:`tsrkit.benchmarking.benchmark`.
+    """
+    labels = [label for label, _, _, _ in plan]
+    if len(set(labels)) != len(labels) or len(labels) < (1 if pairs_of_two else 2):
+        raise BenchmarkError(f"compare needs at least two different runs; got {labels}")
     runs = [
         run_benchmark(
             dataset,
@@ -128,17 +154,17 @@ def compare(
             out=Path(out) / label if out is not None else None,
             **{**options, "verifier": stage},
         )
-        for label, detector, stage in plan
+        for label, detector, stage, classifier in plan
     ]
     comparison = {
         "dataset": dataset.name,
-        "detectors": names,
+        "detectors": list(dict.fromkeys(d.name for _, d, _, _ in plan)),
         "runs": labels,
         "reports": [run.report for run in runs],
         "paired_tests": paired_tests(labels, runs),
         "box_ap50": [{"run": label, **box_ap50(run)} for label, run in zip(labels, runs)],
     }
-    if ablate:
+    if pairs_of_two:
         comparison["verifier_tests"] = [
             test
             for k in range(0, len(runs), 2)

@@ -318,6 +318,14 @@ def benchmark_command(
     shell_complete=preset_or_file,
 )
 @click.option(
+    "--configs",
+    default=None,
+    help="Comma-separated run configurations or presets, each a whole pipeline (detector, "
+    "verifier, classifier) run side by side instead of --detectors (e.g. "
+    "recommended,recommended-forest); -p parameters go to each.",
+    shell_complete=preset_or_file,
+)
+@click.option(
     "--html",
     is_flag=True,
     help="Also write OUT/compare.html (as `tsrkit report OUT` does).",
@@ -346,9 +354,11 @@ def compare_command(
     eval_box,
     writers,
     no_plots,
+    configs,
     html,
 ) -> None:
-    """Benchmark several detectors on the same frames; one report side by side.
+    """Benchmark several detectors (or whole pipelines: --configs) on the same frames; one
+    report side by side.
 
     Writes OUT/<run>/ for each run plus OUT/compare.json and OUT/compare.md with a paired
     test (Wilcoxon signed-rank on per-frame recall) for every pair and each run's AP50 on the
@@ -360,25 +370,44 @@ def compare_command(
       tsrkit compare --dataset roboflow_cinta_v2_id --split test --detectors lab-frst,gray-tophat
       tsrkit compare --config recommended --without-verifier --html -o out/verifier
       tsrkit compare -p conspicuity.weights=1,1,2 -p gray-tophat.h_peak=0.8
+      tsrkit compare --dataset roboflow_cinta_v2_id --configs recommended,recommended-forest
     """
     check_engine(engine, scheduler)
+    options = {
+        "detector_names": "--detectors",
+        "verifier": "--verifier",
+        "classifier": "--classifier",
+        "config": "--config",
+        "without_verifier": "--without-verifier",
+    }
+    given = [
+        flag
+        for name, flag in options.items()
+        if ctx.get_parameter_source(name) != click.core.ParameterSource.DEFAULT
+    ]
+    if configs is not None and given:
+        raise click.UsageError(f"--configs names whole pipelines; {given[0]} goes with it")
     start_pool_early(workers, engine)
-    run_compare(
-        dataset_ref,
-        format_name,
-        images,
-        split,
-        detector_names,
-        classifier,
-        params,
-        out,
-        _run_kwargs(
-            workers, engine, scheduler, no_cache, iou_threshold, quiet, eval_box, writers, no_plots
-        ),
-        verifier,
-        config=config,
-        without_verifier=without_verifier,
+    run = _run_kwargs(
+        workers, engine, scheduler, no_cache, iou_threshold, quiet, eval_box, writers, no_plots
     )
+    if configs is not None:
+        compare_configs(dataset_ref, format_name, images, split, configs, params, out, run)
+    else:
+        run_compare(
+            dataset_ref,
+            format_name,
+            images,
+            split,
+            detector_names,
+            classifier,
+            params,
+            out,
+            run,
+            verifier,
+            config=config,
+            without_verifier=without_verifier,
+        )
     if html:
         from tsrkit.cli.report import report_command
 
@@ -422,6 +451,44 @@ def run_compare(
             without_verifier=without_verifier,
             **options,
         )
+    print_verdicts(comparison, out)
+
+
+def compare_configs(
+    dataset_ref,
+    format_name,
+    images,
+    split,
+    configs: str,
+    params: Sequence[str],
+    out: str,
+    options: dict,
+) -> None:
+    """Run each configuration's whole pipeline, compare them, print the table and the paired
+    verdicts."""
+    from pathlib import Path
+
+    from tsrkit.comparison import compare_runs
+
+    names = [n.strip() for n in configs.split(",") if n.strip()]
+    if len(names) < 2:
+        raise UserError(
+            f"--configs {configs!r}: name at least two (e.g. recommended,recommended-forest)"
+        )
+    plan = []
+    for name in names:
+        chosen = build(params=params, config=name)
+        if chosen.detector is None:
+            raise UserError(f"--configs: {name} names no detector")
+        plan.append((Path(name).stem, chosen.detector, chosen.verifier, chosen.classifier))
+    dataset = load_dataset(dataset_ref, format_name, images, split)
+    with reading(dataset_inputs([dataset_ref], dataset)):
+        comparison = compare_runs(dataset, plan, out=out, **options)
+    print_verdicts(comparison, out)
+
+
+def print_verdicts(comparison: dict, out: str) -> None:
+    """The side-by-side table, each paired test's verdict, and where the report is."""
     print_table(comparison["reports"])
     for test in comparison["paired_tests"] + comparison.get("verifier_tests", []):
         click.echo(

@@ -139,6 +139,16 @@ class CnnVerifier(Verifier):
             "rejected too; 0: off",
         ),
         Param(
+            "prior",
+            "float",
+            0.0,
+            min=0.0,
+            max=1.0,
+            help="weight of the detector's own score (clipped to [0, 1], e.g. the union's "
+            "agreement) in the candidate's score: (1 - prior) x probability + prior x score; "
+            "0: the network's probability alone",
+        ),
+        Param(
             "overlap",
             "float",
             0.3,
@@ -184,11 +194,20 @@ class CnnVerifier(Verifier):
         Param(
             "per_camera",
             "int",
-            1500,
+            1000,
             min=10,
             max=10**7,
             help="training: positives drawn per camera and epoch at most (a set with many "
             "lights, as cinTA's near heads, does not outweigh the others)",
+        ),
+        Param(
+            "hard",
+            "float",
+            0.5,
+            min=0.0,
+            max=1.0,
+            help="training: share of each epoch's negatives that are the hardest of a random "
+            "pool (scored by the network so far); 0: all drawn at random",
         ),
         Param(
             "turn",
@@ -281,13 +300,21 @@ class CnnVerifier(Verifier):
     def verify(self, frame: Frame, candidates: Sequence[Candidate]) -> list[Candidate]:
         if not candidates:
             return []
-        out = self.outputs(frame, candidates)
-        light = out["light"]
-        keep = np.flatnonzero(
-            np.isfinite(light) & passes(light, self.params["threshold"], self.params["relative"])
-        )
+        return self.decide(frame, candidates, self.outputs(frame, candidates))
+
+    def decide(
+        self, frame: Frame, candidates: Sequence[Candidate], out: dict[str, np.ndarray]
+    ) -> list[Candidate]:
+        """The candidates kept given the network's ``out`` (:meth:`outputs`) on them: scored
+        (the probability blended with the detector's score by ``prior``), gated by
+        ``threshold`` and ``relative``, boxed (:func:`housings`) and suppressed by ``overlap``,
+        best first."""
+        prior = self.params["prior"]
+        own = np.clip([c.score for c in candidates], 0.0, 1.0)
+        score = (1.0 - prior) * np.nan_to_num(out["light"], nan=0.0) + prior * own
+        keep = np.flatnonzero(passes(score, self.params["threshold"], self.params["relative"]))
         boxes = housings(out["box"][keep], [candidates[i].bbox for i in keep], frame)
-        chosen = suppress(boxes, light[keep], self.params["overlap"])
+        chosen = suppress(boxes, score[keep], self.params["overlap"])
         kept = []
         for k in chosen:
             i = keep[k]
@@ -298,9 +325,9 @@ class CnnVerifier(Verifier):
             kept.append(
                 replace(
                     c,
-                    score=float(light[i]),
+                    score=float(score[i]),
                     housing=tuple(float(v) for v in boxes[k]),
-                    housing_score=float(light[i]),
+                    housing_score=float(out["light"][i]),
                     state=state,
                 )
             )
@@ -370,6 +397,7 @@ class CnnVerifier(Verifier):
             learning_rate=p["learning_rate"],
             negative_ratio=p["negative_ratio"],
             per_camera=p["per_camera"],
+            hard=p["hard"],
             turn=p["turn"],
             seed=p["seed"],
             threads=p["threads"],

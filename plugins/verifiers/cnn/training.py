@@ -5,8 +5,10 @@ after the first three) over the 32x32 crop, a 64-unit layer, and three heads: th
 lit traffic light, the housing box in window units (:mod:`.windows`) and the logits of the
 states of :data:`~.data.STATE_NAMES`. Its loss: binary cross-entropy of the light, smooth L1 of
 the box on positives with a housing box, cross-entropy of the state on positives with a known
-state. Every epoch sees every positive and ``negative_ratio`` times as many negatives drawn
-anew, each crop under a fresh camera augmentation (:mod:`.augment`). With a validation set (a
+state. Every epoch sees the positives (at most ``per_camera`` of each camera) and
+``negative_ratio`` times as many negatives drawn anew, from the second epoch on a share ``hard``
+of them the negatives the network scores highest in a random pool three times as large
+(hard-negative mining); each crop under a fresh camera augmentation (:mod:`.augment`). With a validation set (a
 camera the training never sees) the epoch whose validation average precision of the light is
 best is kept, and training stops after ``patience`` epochs without a better one.
 
@@ -48,7 +50,8 @@ class Settings:
     batch: int = 256
     learning_rate: float = 3e-3
     negative_ratio: float = 3.0
-    per_camera: int = 1500
+    per_camera: int = 1000
+    hard: float = 0.5
     turn: float = 0.2
     seed: int = 0
     threads: int = 1
@@ -212,7 +215,15 @@ def train(
     history: list[dict[str, float]] = []
     for epoch in range(settings.epochs):
         chosen = draw_positives(rng)
-        drawn = rng.permutation(negatives)[: per_epoch - len(chosen)]
+        wanted = per_epoch - len(chosen)
+        if epoch == 0 or settings.hard <= 0:
+            drawn = rng.permutation(negatives)[:wanted]
+        else:  # half drawn at random, half the hardest of a fresh random pool
+            pool = rng.permutation(negatives)[: min(len(negatives), 3 * wanted)]
+            scores = predict(model, _batch(data, pool, None, 0.0)[0])[0]
+            hard = pool[np.argsort(-scores, kind="stable")[: int(settings.hard * wanted)]]
+            rest = np.setdiff1d(negatives, hard)
+            drawn = np.concatenate([hard, rng.permutation(rest)[: wanted - len(hard)]])
         rows = rng.permutation(np.concatenate([chosen, drawn]))
         model.train()
         total, seen = 0.0, 0
