@@ -189,26 +189,49 @@ def iter_frames(
             yield from read_work(work, every)
 
 
+#: Consecutive frames a video may fail to decode before its reader takes the rest as lost too
+#: and stops (a damaged stretch is usually a few frames; a truncated file fails on every grab).
+MAX_LOST_RUN = 250
+
+
 def iter_video(
     path: Path, every: int = 1, start: int = 0, end: int | None = None
 ) -> Iterator[Frame | Skipped]:
-    """Decode ``path`` frame by frame, keeping frames ``start, start+every, ...`` before ``end``."""
+    """Decode ``path`` frame by frame, keeping frames ``start, start+every, ...`` before ``end``.
+
+    A frame FFmpeg cannot decode (a damaged stretch of the file) is lost, not the end of the
+    video: each kept frame lost is yielded as :class:`Skipped` (``PATH#INDEX``) and decoding
+    goes on past it. A failed grab counts as one lost frame when it lies before the frame count
+    the container declares, or when a later frame decodes; the reader stops at a failure at or
+    past the declared count, or after :data:`MAX_LOST_RUN` failures in a row.
+    """
     capture = cv2.VideoCapture(str(path), cv2.CAP_FFMPEG)
     try:
         if not capture.isOpened():
             yield Skipped(str(path), "cannot open video")
             return
         fps = capture.get(cv2.CAP_PROP_FPS) or 0.0
+        declared = int(capture.get(cv2.CAP_PROP_FRAME_COUNT) or 0)
         index = _seek(capture, start)
         decoded = 0
+        failed: list[int] = []  # kept frames whose grab failed since the last decoded frame
+        run = 0  # grabs failed in a row
         while end is None or index < end:
             wanted = index >= start and (index - start) % every == 0
             if not capture.grab():
-                break
+                if run >= MAX_LOST_RUN or (declared and index >= declared):
+                    break
+                run += 1
+                failed += [index] if wanted else []
+                index += 1
+                continue
+            run = 0
+            yield from (_lost(path, k) for k in failed)
+            failed = []
             if wanted:
                 ok, image = capture.retrieve()
                 if not ok or image is None:
-                    yield Skipped(f"{path}#{index}", "frame could not be decoded")
+                    yield _lost(path, index)
                 else:
                     decoded += 1
                     stamp = index / fps if fps > 0 else None
@@ -216,14 +239,22 @@ def iter_video(
                         image=to_bgr8(image), source=str(path), index=index, timestamp=stamp
                     )
             index += 1
+        failed = [k for k in failed if k < declared]
+        yield from (_lost(path, k) for k in failed)
+        index -= run  # the frames after the last one decoded may not exist
         if decoded == 0 and 0 < index <= start:
             yield Skipped(
                 str(path), f"--start {start} is past the end: the video has {index} frames"
             )
-        elif decoded == 0 and index <= start:
+        elif decoded == 0 and index <= start and not failed:
             yield Skipped(str(path), "no frames decoded (empty or unreadable video)")
     finally:
         capture.release()
+
+
+def _lost(path: Path, index: int) -> Skipped:
+    """Frame ``index`` of ``path``, which FFmpeg could not decode, as skipped."""
+    return Skipped(f"{path}#{index}", "frame could not be decoded (damaged video data)")
 
 
 def _seek(capture: cv2.VideoCapture, start: int) -> int:

@@ -16,6 +16,8 @@ import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
+import cv2
+import numpy as np
 import pytest
 from click.testing import CliRunner
 from test_bad_input_matrix import FAST, Row, norm_dataset, png, run_row, write
@@ -631,7 +633,39 @@ RUNS: list[Row] = [
     ),
 ]
 
-MORE = REPORTS + NUMBERS + SPECIALS + PATHS + RUNS
+# ---------------------------------------------------------------------------------------------
+# inputs once mishandled: valid input refused, damage passed over in silence, results changed
+
+
+def damaged_video(tmp: Path, frames: int = 60) -> Path:
+    """A ``frames``-frame MPEG-4 video of noise whose middle 8,000 bytes are inverted: FFmpeg
+    cannot decode a few frames there, and decodes the ones after them."""
+    path = tmp / "damaged.mp4"
+    writer = cv2.VideoWriter(str(path), cv2.VideoWriter.fourcc(*"mp4v"), 10.0, (64, 64))
+    rng = np.random.default_rng(0)
+    for _ in range(frames):
+        writer.write(rng.integers(0, 255, (64, 64, 3), dtype=np.uint8))
+    writer.release()
+    data = bytearray(path.read_bytes())
+    middle = len(data) // 2
+    data[middle : middle + 8000] = bytes(b ^ 0xFF for b in data[middle : middle + 8000])
+    return write(path, bytes(data))
+
+
+def on_damaged_video(*extra: str):
+    return lambda tmp: ["detect", str(damaged_video(tmp)), "-d", "gray-tophat", "-q", *extra]
+
+
+#: Frames decoded and lost in :func:`damaged_video` (each lost frame is one skipped line).
+DAMAGED = r"51 frames, \d+ detections, 9 skipped.*\n.*damaged.mp4#20: frame could not be decoded"
+
+FOUND: list[Row] = [
+    ("video-damaged-middle", on_damaged_video(), 0, DAMAGED),
+    ("video-damaged-middle-workers", on_damaged_video("-w", "2"), 0, DAMAGED),
+    ("video-damaged-middle-every-2", on_damaged_video("--every", "2"), 0, "25 frames.*5 skipped"),
+]
+
+MORE = REPORTS + NUMBERS + SPECIALS + PATHS + RUNS + FOUND
 
 
 def test_the_third_table_is_a_hundred_new_cases():
