@@ -663,7 +663,47 @@ FOUND: list[Row] = [
     ("video-damaged-middle", on_damaged_video(), 0, DAMAGED),
     ("video-damaged-middle-workers", on_damaged_video("-w", "2"), 0, DAMAGED),
     ("video-damaged-middle-every-2", on_damaged_video("--every", "2"), 0, "25 frames.*5 skipped"),
+    ("detect-resume-without-out", detect("--resume"), 2, "--resume .* needs --out"),
+    (
+        "detect-resume-with-agree",
+        lambda tmp: [*detect_video("--agree", "2", "--resume", "-o")(tmp), str(tmp / "o.jsonl")],
+        2,
+        "--resume: a tracker, --key-every and --agree carry lights",
+    ),
+    (
+        "detect-resume-without-partial",
+        lambda tmp: [*detect("--resume", "-o")(tmp), str(tmp / "o.jsonl")],
+        0,
+        "no .*o.jsonl.partial to resume: starting at the first frame",
+    ),
 ]
+
+
+def without_ms(path: Path) -> list[dict]:
+    records = [json.loads(line) for line in path.read_text().splitlines()]
+    return [{k: v for k, v in r.items() if k != "ms"} for r in records]
+
+
+@pytest.mark.parametrize("workers", ["1", "2"])
+def test_resume_goes_on_after_the_frames_of_the_partial(tmp_path, workers):
+    """``detect -o OUT --resume`` after a kill (OUT.partial holds the first 30 records and half
+    of the 31st) writes the records of an uninterrupted run, and runs only the rest."""
+    png(tmp_path / "in" / "a.png", size=48)
+    png(tmp_path / "in" / "b.png", size=48, value=90)
+    damaged_video(tmp_path / "in")
+    args = ["detect", str(tmp_path / "in"), "-d", "gray-tophat", "-q", "-w", workers, "-o"]
+    whole = CliRunner().invoke(cli, [*args, str(tmp_path / "whole.jsonl")])
+    assert whole.exit_code == 0, whole.output
+    lines = (tmp_path / "whole.jsonl").read_text().splitlines(keepends=True)
+    assert len(lines) == 53
+    write(tmp_path / "o.jsonl.partial", "".join(lines[:30]) + lines[30][:40])
+    resumed = CliRunner().invoke(cli, [*args, str(tmp_path / "o.jsonl"), "--resume"])
+    assert resumed.exit_code == 0, resumed.output
+    assert "resuming after the 30 frames" in resumed.output
+    assert "53 frames" in resumed.output and "0 skipped" in resumed.output
+    assert without_ms(tmp_path / "o.jsonl") == without_ms(tmp_path / "whole.jsonl")
+    assert not (tmp_path / "o.jsonl.partial").exists()
+
 
 MORE = REPORTS + NUMBERS + SPECIALS + PATHS + RUNS + FOUND
 
