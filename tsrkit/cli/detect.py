@@ -9,7 +9,7 @@ import sys
 from collections.abc import Iterator
 from contextlib import nullcontext
 from pathlib import Path
-from typing import NamedTuple, TextIO
+from typing import Literal, NamedTuple, TextIO
 
 import click
 import cv2
@@ -144,7 +144,7 @@ def flushed_output(out: Path, resume: bool = False) -> Iterator[TextIO]:
     """
     partial = out.with_name(out.name + ".partial")
     partial.parent.mkdir(parents=True, exist_ok=True)
-    mode = "a" if resume else "w"
+    mode: Literal["a", "w"] = "a" if resume else "w"
     with open(partial, mode, encoding="utf-8", buffering=1) as fh:  # line-buffered: flushed
         try:
             yield fh
