@@ -10,6 +10,7 @@ that could block run under an alarm.
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import signal
 import tempfile
@@ -676,7 +677,31 @@ FOUND: list[Row] = [
         0,
         "no .*o.jsonl.partial to resume: starting at the first frame",
     ),
+    ("detect-lock-of-a-reused-process-id", lambda tmp: locked_by(tmp, "legacy"), 0, "1 frames"),
+    ("detect-lock-of-another-start-time", lambda tmp: locked_by(tmp, "1"), 0, "1 frames"),
+    (
+        "detect-lock-of-a-live-run-named",
+        lambda tmp: locked_by(tmp, "live"),
+        2,
+        r"another run .* \(lock file TMP/\.o\.jsonl\.tsrkit\.lock\)",
+    ),
 ]
+
+
+def locked_by(tmp: Path, started: str) -> list[str]:
+    """``detect -o o.jsonl`` beside a lock of this test's parent process (alive, not this
+    one): with its real start time (``live``), another one, or none in a lock written in 2000,
+    before the process started (``legacy``: its id was reused since)."""
+    from tsrkit.outlock import _start_time
+
+    parent = os.getppid()
+    lock = tmp / ".o.jsonl.tsrkit.lock"
+    if started == "legacy":
+        write(lock, str(parent))
+        os.utime(lock, (946684800, 946684800))
+    else:
+        write(lock, f"{parent} {_start_time(parent) if started == 'live' else started}")
+    return [*detect("-o", str(tmp / "o.jsonl"))(tmp)]
 
 
 def without_ms(path: Path) -> list[dict]:
