@@ -52,6 +52,7 @@ IMAGE_EXTENSIONS = {
     ".ras",
     ".exr",
     ".hdr",
+    ".gif",  # its first frame
 }
 VIDEO_EXTENSIONS = {
     ".mp4",

@@ -21,7 +21,7 @@ import cv2
 import numpy as np
 import pytest
 from click.testing import CliRunner
-from test_bad_input_matrix import FAST, Row, norm_dataset, png, run_row, write
+from test_bad_input_matrix import BASES, FAST, Row, convert, norm_dataset, png, run_row, write
 from test_edge_matrix import FIXES, MAP, fifo, geo, link, tiny_drive, unix_socket, with_video
 
 from tsrkit.cli.main import cli
@@ -685,7 +685,81 @@ FOUND: list[Row] = [
         2,
         r"another run .* \(lock file TMP/\.o\.jsonl\.tsrkit\.lock\)",
     ),
+    (
+        "image-gif-first-frame",
+        lambda tmp: one_image(gif(tmp / "a.gif")),
+        0,
+        r'"width": 30, "height": 20',
+    ),
+    (
+        "image-jpeg-exif-rotated-upright",
+        lambda tmp: one_image(exif_jpeg(tmp / "phone.jpg")),
+        0,
+        r'"width": 20, "height": 40',
+    ),
+    (
+        "coco-utf8-byte-order-mark",
+        convert("coco", b"\xef\xbb\xbf" + BASES["coco"][1].encode()),
+        0,
+        "1 images|->",
+    ),
+    (
+        "coco-one-zero-width-box-left-out",
+        convert(
+            "coco",
+            None,
+            (
+                "[1, 1, 9, 9]}]",
+                '[1, 1, 9, 9]}, {"id": 2, "image_id": 1, "category_id": 1, "bbox": [5, 5, 0, 4]}]',
+            ),
+        ),
+        0,
+        r"warning: .*coco.json: 1 box\(es\) of zero width or height left out: a.png box 1",
+    ),
+    (
+        "config-yaml-merge-key",
+        lambda tmp: (
+            one_image(png(tmp / "a.png", size=64))[:2]
+            + ["--config", str(write(tmp / "run.yaml", MERGED)), "-q"]
+        ),
+        0,
+        "1 frames",
+    ),
 ]
+
+#: A run configuration whose detector merges a shared mapping (``<<: *tophat``) and overrides
+#: one of its keys.
+MERGED = """\
+detector:
+  <<: &tophat {name: gray-tophat, params: {h_peak: 0.1}}
+  params: {h_peak: 0.2}
+"""
+
+
+def one_image(path: Path) -> list[str]:
+    return ["detect", str(path), "-d", "gray-tophat", "-q"]
+
+
+def gif(path: Path) -> Path:
+    """A 30x20 GIF of two frames (the first is read)."""
+    from PIL import Image
+
+    frames = [Image.new("RGB", (30, 20), colour) for colour in ("red", "blue")]
+    path.parent.mkdir(parents=True, exist_ok=True)
+    frames[0].save(path, save_all=True, append_images=frames[1:])
+    return path
+
+
+def exif_jpeg(path: Path) -> Path:
+    """A 40x20 JPEG whose EXIF orientation 6 turns it upright to 20x40, as phones write."""
+    from PIL import Image
+
+    image = Image.new("RGB", (40, 20), "gray")
+    exif = image.getexif()
+    exif[0x0112] = 6
+    path.parent.mkdir(parents=True, exist_ok=True)
+    image.save(path, exif=exif)
+    return path
 
 
 def locked_by(tmp: Path, started: str) -> list[str]:

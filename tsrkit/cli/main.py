@@ -14,26 +14,38 @@ import contextlib
 import importlib
 import os
 import sys
+import warnings
 from importlib import metadata
 
 import click
 
 from tsrkit.cli.errors import UserError, describe_os_error
 from tsrkit.cli.verbs import VERBS
-from tsrkit.errors import TsrkitError
+from tsrkit.errors import TsrkitError, TsrkitWarning
 from tsrkit.hookspecs import ENTRY_POINT_GROUP
 
 __all__ = ["TsrkitGroup", "cli", "main"]
 
 
 class TsrkitGroup(click.Group):
-    """A click group that loads verbs on demand and reports :class:`TsrkitError` and
+    """A click group that loads verbs on demand, reports :class:`TsrkitError` and
     operating-system errors (an unwritable ``--out``, a full disk) as one line and exit
-    status 2."""
+    status 2, and each :class:`TsrkitWarning` as one ``warning:`` line on stderr."""
 
     def invoke(self, ctx: click.Context):
+        shown = warnings.showwarning
+
+        def show(message, category, *args, **kwargs):
+            if issubclass(category, TsrkitWarning):
+                click.echo(f"warning: {message}", err=True)
+            else:
+                shown(message, category, *args, **kwargs)
+
         try:
-            return super().invoke(ctx)
+            with warnings.catch_warnings():
+                warnings.simplefilter("always", TsrkitWarning)
+                warnings.showwarning = show
+                return super().invoke(ctx)
         except TsrkitError as exc:
             raise UserError(str(exc)) from None
         except OSError as exc:
