@@ -717,6 +717,31 @@ FOUND: list[Row] = [
         r"warning: .*coco.json: 1 box\(es\) of zero width or height left out: a.png box 1",
     ),
     (
+        "track-gps-fix-repeated-exactly",
+        geo("".join(FIXES.splitlines(keepends=True)[k] for k in (*range(6), 5, *range(6, 21)))),
+        0,
+        "warning: .*g.csv: line 7: exactly repeats the fix before: left out",
+    ),
+    (
+        "track-gps-glitch-fix",
+        geo(FIXES.replace(FIXES.splitlines()[9], "1780315208,48.5,-122.15")),
+        0,
+        r"warning: .*g.csv: line 10: a glitch: the fix 48.500000, -122.150000 is reached and left "
+        "faster than 90 m/s: left out",
+    ),
+    (
+        "track-gps-jump-of-1000-km",
+        geo(
+            "time,lat,lon\n"
+            + "".join(
+                f"{1780315200 + k},{47.599 + 0.0001 * k + 9 * (k >= 10):.7f},-122.15\n"
+                for k in range(20)
+            )
+        ),
+        0,
+        "warning: .*g.csv: line 12: the log jumps 1,000,... m in 1 s .*split there",
+    ),
+    (
         "config-yaml-merge-key",
         lambda tmp: (
             one_image(png(tmp / "a.png", size=64))[:2]
