@@ -742,6 +742,28 @@ FOUND: list[Row] = [
         "warning: .*g.csv: line 12: the log jumps 1,000,... m in 1 s .*split there",
     ),
     (
+        "detect-agree-on-still-images-keeps-them",
+        detect("--agree", "3"),
+        0,
+        "1 frames, 1 detections",
+    ),
+    ("benchmark-split-empty", bench("--split", ""), 2, "--split.*empty split name"),
+    (
+        "train-split-empty",
+        lambda tmp: [
+            "train",
+            "ab-hist",
+            "--dataset",
+            str(norm_dataset(tmp)),
+            "--split",
+            " ",
+            "--out",
+            str(tmp / "m"),
+        ],
+        2,
+        "--split.*empty split name",
+    ),
+    (
         "config-yaml-merge-key",
         lambda tmp: (
             one_image(png(tmp / "a.png", size=64))[:2]

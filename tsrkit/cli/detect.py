@@ -104,7 +104,8 @@ def run_detect(
     ``workers`` > 1 runs the pipeline in worker processes (:func:`tsrkit.streams.run_pipeline`);
     overlays (``draw``) need the frames here, so they need one worker. ``progress`` shows a
     progress bar (frames done, frames/s) on stderr. ``agree`` > 1 keeps only the detections
-    whose light is found on that many consecutive frames (:class:`tsrkit.agreement.Agreement`).
+    whose light is found on that many consecutive video frames
+    (:class:`tsrkit.agreement.Agreement`; still images keep every detection).
     ``resumed``: the frames an aborted run already wrote, which are not run again (and are
     counted in the totals).
 
@@ -232,7 +233,8 @@ def default_inputs() -> list[str]:
     default=1,
     show_default=True,
     help="Videos: report a detection only when its light is found on at least N consecutive "
-    "frames (from its first frame on; the output lags up to N-1 frames). 1: every detection.",
+    "frames (from its first frame on; the output lags up to N-1 frames). 1: every detection. "
+    "Still images have no next frame: their detections are all reported.",
 )
 @click.option(
     "--quiet",

@@ -32,20 +32,25 @@ class TsrkitGroup(click.Group):
     operating-system errors (an unwritable ``--out``, a full disk) as one line and exit
     status 2, and each :class:`TsrkitWarning` as one ``warning:`` line on stderr."""
 
-    def invoke(self, ctx: click.Context):
+    def main(self, *args, **kwargs):
+        """Run the command line, each :class:`TsrkitWarning` (plugins load while ``--help``
+        is parsed, too) printed as one ``warning:`` line."""
         shown = warnings.showwarning
 
-        def show(message, category, *args, **kwargs):
+        def show(message, category, *rest, **options):
             if issubclass(category, TsrkitWarning):
                 click.echo(f"warning: {message}", err=True)
             else:
-                shown(message, category, *args, **kwargs)
+                shown(message, category, *rest, **options)
 
+        with warnings.catch_warnings():
+            warnings.simplefilter("always", TsrkitWarning)
+            warnings.showwarning = show
+            return super().main(*args, **kwargs)
+
+    def invoke(self, ctx: click.Context):
         try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("always", TsrkitWarning)
-                warnings.showwarning = show
-                return super().invoke(ctx)
+            return super().invoke(ctx)
         except TsrkitError as exc:
             raise UserError(str(exc)) from None
         except OSError as exc:
@@ -139,7 +144,7 @@ def _add_commands() -> None:
     for impl in registry.pm.hook.register_commands.get_hookimpls():
         try:
             impl.function(cli=cli)
-        except Exception as exc:  # one broken plugin must not break the command line
+        except (Exception, SystemExit) as exc:  # one broken plugin must not break the command line
             registry.failures.append(
                 PluginFailure(
                     impl.plugin_name, "?", f"register_commands: {type(exc).__name__}: {exc}"
