@@ -764,6 +764,14 @@ FOUND: list[Row] = [
         "--split.*empty split name",
     ),
     (
+        "coco-two-images-of-one-id",
+        convert(
+            "coco", None, ('"height": 32}]', '"height": 32}, {"id": 1, "file_name": "b.png"}]')
+        ),
+        2,
+        r"coco.json: images\[1\]: image id 1 is also the id of images\[0\]",
+    ),
+    (
         "config-yaml-merge-key",
         lambda tmp: (
             one_image(png(tmp / "a.png", size=64))[:2]
@@ -877,3 +885,47 @@ def test_more_edges(tmp_path, monkeypatch, build, code, fragment):
     finally:
         signal.alarm(0)
         signal.signal(signal.SIGALRM, previous)
+
+
+SOURCE_COCO = {
+    "images": [
+        {"id": 7, "file_name": "a.png", "width": 32, "height": 32},
+        {"id": 3, "file_name": "b.png", "width": 32, "height": 32},
+    ],
+    "annotations": [
+        {"id": 1, "image_id": 7, "category_id": 5, "bbox": [0.1, 0.7, 0.2, 0.1]},
+        {"id": 2, "image_id": 3, "category_id": 2, "bbox": [1.23456789, 2.5, 3.1415926, 4.0001]},
+        {"id": 3, "image_id": 3, "category_id": 5, "bbox": [10, 11, 12.5, 3]},
+    ],
+    "categories": [{"id": 5, "name": "red"}, {"id": 2, "name": "green"}],
+}
+
+
+def test_coco_to_coco_keeps_boxes_and_ids(tmp_path):
+    """``datasets convert`` COCO -> COCO: every box number as written, image and category ids
+    kept (not renumbered); through the normalised format (which has no category ids) too, the
+    boxes and image ids."""
+    png(tmp_path / "a.png")
+    png(tmp_path / "b.png")
+    source = write(tmp_path / "coco.json", json.dumps(SOURCE_COCO))
+    norm, back, direct = tmp_path / "n" / "a.json", tmp_path / "back.json", tmp_path / "o.json"
+    for src, to, out in (
+        (source, "normalized", norm),
+        (norm, "coco", back),
+        (source, "coco", direct),
+    ):
+        result = CliRunner().invoke(
+            cli, ["datasets", "convert", str(src), "--to", to, "--out", str(out)]
+        )
+        assert result.exit_code == 0, result.output
+    expected = [(a["image_id"], a["bbox"]) for a in SOURCE_COCO["annotations"]]
+    for path in (direct, back):
+        written = json.loads(path.read_text())
+        assert [(i["id"], i["file_name"]) for i in written["images"]] == [
+            (7, "a.png"),
+            (3, "b.png"),
+        ]
+        assert [(a["image_id"], a["bbox"]) for a in written["annotations"]] == expected
+    written = json.loads(direct.read_text())
+    assert written["categories"] == [{"id": 2, "name": "green"}, {"id": 5, "name": "red"}]
+    assert [a["category_id"] for a in written["annotations"]] == [5, 2, 5]
