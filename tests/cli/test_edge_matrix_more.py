@@ -772,6 +772,12 @@ FOUND: list[Row] = [
         r"coco.json: images\[1\]: image id 1 is also the id of images\[0\]",
     ),
     (
+        "compare-into-a-folder-a-live-compare-holds",
+        lambda tmp: locked_by(tmp, "live", "o/.tsrkit.lock", compare("-o", str(tmp / "o"))),
+        2,
+        r"TMP/o: another run .* \(lock file TMP/o/\.tsrkit\.lock\)",
+    ),
+    (
         "config-yaml-merge-key",
         lambda tmp: (
             one_image(png(tmp / "a.png", size=64))[:2]
@@ -817,20 +823,21 @@ def exif_jpeg(path: Path) -> Path:
     return path
 
 
-def locked_by(tmp: Path, started: str) -> list[str]:
-    """``detect -o o.jsonl`` beside a lock of this test's parent process (alive, not this
-    one): with its real start time (``live``), another one, or none in a lock written in 2000,
-    before the process started (``legacy``: its id was reused since)."""
+def locked_by(tmp: Path, started: str, lock: str = ".o.jsonl.tsrkit.lock", verb=None):
+    """``verb`` (default ``detect -o o.jsonl``) beside the lock file ``lock`` of this test's
+    parent process (alive, not this one): with its real start time (``live``), another one, or
+    none in a lock written in 2000, before the process started (``legacy``: its id was reused
+    since)."""
     from tsrkit.outlock import _start_time
 
     parent = os.getppid()
-    lock = tmp / ".o.jsonl.tsrkit.lock"
+    path = tmp / lock
     if started == "legacy":
-        write(lock, str(parent))
-        os.utime(lock, (946684800, 946684800))
+        write(path, str(parent))
+        os.utime(path, (946684800, 946684800))
     else:
-        write(lock, f"{parent} {_start_time(parent) if started == 'live' else started}")
-    return [*detect("-o", str(tmp / "o.jsonl"))(tmp)]
+        write(path, f"{parent} {_start_time(parent) if started == 'live' else started}")
+    return (verb or detect("-o", str(tmp / "o.jsonl")))(tmp)
 
 
 def without_ms(path: Path) -> list[dict]:
