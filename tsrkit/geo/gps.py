@@ -18,11 +18,14 @@ from tsrkit.geo.errors import GeoError, read_text
 from tsrkit.geo.gpx import gpx_rows
 from tsrkit.geo.nmea import nmea_rows
 
-__all__ = ["MAX_SPEED", "Rows", "Track", "log_format", "read_track"]
+__all__ = ["MAX_SPEED", "MIN_JUMP_M", "Rows", "Track", "log_format", "read_track"]
 
 #: The fastest a logged vehicle moves between two fixes, m/s (324 km/h, past any road vehicle):
 #: a faster step is a receiver glitch or a jump between two logs, never a drive.
 MAX_SPEED = 90.0
+#: Steps shorter than this, metres, are never a jump, however fast: the position noise of a log
+#: of 10 Hz or more moves a fix that far between neighbours.
+MIN_JUMP_M = 50.0
 
 
 @dataclass(frozen=True)
@@ -190,9 +193,9 @@ def read_track(path: str | os.PathLike) -> Track:
     -----
     TsrkitWarning
         A fix that exactly repeats the one before is left out; so is a glitch fix, reached and
-        left faster than :data:`MAX_SPEED` while its neighbours are not that far apart; any
-        other step faster than that splits the log (:attr:`Track.breaks`). One warning for
-        each, naming the lines.
+        left faster than :data:`MAX_SPEED` (over more than :data:`MIN_JUMP_M`) while its
+        neighbours are not that far apart; any other step that fast splits the log
+        (:attr:`Track.breaks`). One warning for each, naming the line.
     """
     path = Path(path)
     rows, _ = _rows(path)
@@ -232,9 +235,11 @@ def _metres(a: Fix, b: Fix) -> float:
     return 2 * 6_371_008.8 * math.asin(min(1.0, math.sqrt(h)))
 
 
-def _speed(a: Fix, b: Fix) -> float:
-    """Metres per second from fix ``a`` to the later fix ``b``."""
-    return _metres(a, b) / (b[1] - a[1])
+def _too_fast(a: Fix, b: Fix) -> bool:
+    """Whether the step from fix ``a`` to the later fix ``b`` is no drive: faster than
+    :data:`MAX_SPEED` over more than :data:`MIN_JUMP_M`."""
+    metres = _metres(a, b)
+    return metres > MIN_JUMP_M and metres > MAX_SPEED * (b[1] - a[1])
 
 
 def _plausible(path: Path, rows: Rows) -> tuple[Rows, list[int]]:
@@ -244,7 +249,7 @@ def _plausible(path: Path, rows: Rows) -> tuple[Rows, list[int]]:
     k = 1
     while k < len(kept) - 1:
         before, fix, after = kept[k - 1 : k + 2]
-        if min(_speed(before, fix), _speed(fix, after)) > MAX_SPEED >= _speed(before, after):
+        if _too_fast(before, fix) and _too_fast(fix, after) and not _too_fast(before, after):
             _warn(
                 path,
                 fix[0],
@@ -254,7 +259,7 @@ def _plausible(path: Path, rows: Rows) -> tuple[Rows, list[int]]:
             del kept[k]
             continue
         k += 1
-    breaks = [k for k in range(1, len(kept)) if _speed(kept[k - 1], kept[k]) > MAX_SPEED]
+    breaks = [k for k in range(1, len(kept)) if _too_fast(kept[k - 1], kept[k])]
     for k in breaks:
         _warn(
             path,
