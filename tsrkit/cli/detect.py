@@ -73,11 +73,9 @@ def read_partial(partial: Path) -> Resumed:
                 if not line.endswith(b"\n"):
                     break
                 done[record.source] = record.index
-                frames, detections, kept = (
-                    frames + 1,
-                    detections + len(record.detections),
-                    fh.tell(),
-                )
+                frames += 1
+                detections += len(record.detections)
+                kept += len(line)
             fh.truncate(kept)
     except OSError as exc:
         raise UserError(f"{partial}: cannot resume from it: {exc.strerror or exc}") from None
