@@ -8,7 +8,9 @@ it) into chains, and keeps a detection when its chain spans at least ``frames`` 
 the frames after it: a light is reported from its first frame on, never only once it has been
 seen long enough. A frame is therefore held until each of its detections is decided (at most
 ``frames - 1`` frames later). Frames of different sources, or not in increasing order, do not
-link.
+link. It applies to video frames only: the result of a still image (a source that is not a
+video file, :data:`tsrkit.inputs.VIDEO_EXTENSIONS`) has no next frame to agree with and passes
+through whole.
 """
 
 from __future__ import annotations
@@ -17,8 +19,10 @@ import math
 from collections import deque
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field, replace
+from pathlib import Path
 from typing import Any
 
+from tsrkit.inputs import VIDEO_EXTENSIONS
 from tsrkit.pipeline import FrameResult
 from tsrkit.types import Detection
 
@@ -67,13 +71,16 @@ class Agreement:
         self.dropped = 0
 
     def filter(self, pairs: Iterable[tuple[Any, Any]]) -> Iterator[tuple[Any, Any]]:
-        """``(result, extra)`` pairs in order, each :class:`FrameResult` with only its agreed
-        detections; any other result (a skipped input) passes through in its place."""
+        """``(result, extra)`` pairs in order, each :class:`FrameResult` of a video frame with
+        only its agreed detections; any other result (a still image's, a skipped input) passes
+        through in its place."""
         waiting: deque[tuple[Any, Any]] = deque()
         for result, extra in pairs:
-            waiting.append(
-                (self._link(result) if isinstance(result, FrameResult) else result, extra)
+            video = (
+                isinstance(result, FrameResult)
+                and Path(result.source).suffix.lower() in VIDEO_EXTENSIONS
             )
+            waiting.append((self._link(result) if video else result, extra))
             yield from self._ready(waiting, final=False)
         self._end_chains()
         yield from self._ready(waiting, final=True)

@@ -9,6 +9,7 @@ paired tests show what the verifier adds.
 
 from __future__ import annotations
 
+import contextlib
 import os
 from collections.abc import Sequence
 from pathlib import Path
@@ -21,6 +22,7 @@ from tsrkit.eval.coco import coco_ap, coco_run
 from tsrkit.eval.perframe import frame_score
 from tsrkit.eval.results import fmt
 from tsrkit.eval.stats import format_p, paired_test
+from tsrkit.outlock import locked
 from tsrkit.plugin import Classifier, Detector, Verifier
 from tsrkit.report import RunResult, headline_rows, markdown_table, title
 from tsrkit.types import Dataset
@@ -107,7 +109,8 @@ def compare(
     Other keyword options are those of :func:`tsrkit.benchmarking.benchmark` (``verifier=``,
     ``box=``, ``workers=``...). With ``without_verifier`` (and a ``verifier``) every detector
     also runs without it, as ``DETECTOR`` beside ``DETECTOR+VERIFIER``. Returns ``{"dataset",
-    "detectors", "runs", "reports", "paired_tests", "box_ap50"}``.
+    "detectors", "runs", "reports", "paired_tests", "box_ap50"}``. The ``out`` folder is
+    locked for the whole comparison (:func:`tsrkit.outlock.locked`).
     """
     names = [d.name for d in detectors]
     verifier = options.pop("verifier", None)
@@ -141,37 +144,40 @@ def compare_runs(
     """Benchmark each run of ``plan`` (label, detector, verifier, classifier: whole pipelines,
     such as two presets) on the same frames and test each pair. ``pairs_of_two``: the runs
     are pairs without and with a verifier (:func:`verifier_tests` on each pair). Other keyword
-    options are those of :func:`tsrkit.benchmarking.benchmark`.
+    options are those of :func:`tsrkit.benchmarking.benchmark`. The ``out`` folder is locked
+    for the whole comparison (:func:`tsrkit.outlock.locked`).
     """
     labels = [label for label, _, _, _ in plan]
     if len(set(labels)) != len(labels) or len(labels) < (1 if pairs_of_two else 2):
         raise BenchmarkError(f"compare needs at least two different runs; got {labels}")
-    runs = [
-        run_benchmark(
-            dataset,
-            detector,
-            classifier,
-            out=Path(out) / label if out is not None else None,
-            **{**options, "verifier": stage},
-        )
-        for label, detector, stage, classifier in plan
-    ]
-    comparison = {
-        "dataset": dataset.name,
-        "detectors": list(dict.fromkeys(d.name for _, d, _, _ in plan)),
-        "runs": labels,
-        "reports": [run.report for run in runs],
-        "paired_tests": paired_tests(labels, runs),
-        "box_ap50": [{"run": label, **box_ap50(run)} for label, run in zip(labels, runs)],
-    }
-    if pairs_of_two:
-        comparison["verifier_tests"] = [
-            test
-            for k in range(0, len(runs), 2)
-            for test in verifier_tests(runs[k], runs[k + 1], labels[k], labels[k + 1])
+    # the whole folder is this run's: a second compare into it refuses, naming the lock
+    with locked(out) if out is not None else contextlib.nullcontext():
+        runs = [
+            run_benchmark(
+                dataset,
+                detector,
+                classifier,
+                out=Path(out) / label if out is not None else None,
+                **{**options, "verifier": stage},
+            )
+            for label, detector, stage, classifier in plan
         ]
-    if out is not None:
-        write_compare(Path(out), comparison)
+        comparison = {
+            "dataset": dataset.name,
+            "detectors": list(dict.fromkeys(d.name for _, d, _, _ in plan)),
+            "runs": labels,
+            "reports": [run.report for run in runs],
+            "paired_tests": paired_tests(labels, runs),
+            "box_ap50": [{"run": label, **box_ap50(run)} for label, run in zip(labels, runs)],
+        }
+        if pairs_of_two:
+            comparison["verifier_tests"] = [
+                test
+                for k in range(0, len(runs), 2)
+                for test in verifier_tests(runs[k], runs[k + 1], labels[k], labels[k + 1])
+            ]
+        if out is not None:
+            write_compare(Path(out), comparison)
     return comparison
 
 

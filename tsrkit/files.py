@@ -200,11 +200,14 @@ def read_json(path: str | os.PathLike, limit: int = MAX_TEXT_BYTES) -> Any:
 
 class _UniqueKeyLoader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):  # type: ignore[misc]
     """The safe YAML loader, refusing a mapping that repeats a key (YAML leaves it undefined;
-    PyYAML silently keeps the last)."""
+    PyYAML silently keeps the last). Merge keys (``<<: *base``) are YAML 1.1's: the keys a
+    mapping writes itself override the merged ones without counting as repeated."""
 
     def construct_mapping(self, node, deep=False):
         seen: set = set()
         for key_node, _ in node.value:
+            if key_node.tag == "tag:yaml.org,2002:merge":
+                continue
             key = self.construct_object(key_node, deep=deep)
             try:
                 repeated = key in seen

@@ -48,13 +48,29 @@ def as_boxes(boxes) -> np.ndarray:
 def xyxy_to_xywh(box: Sequence[float]) -> list[float]:
     """``(x_min, y_min, x_max, y_max)`` to COCO's ``[x, y, width, height]``.
 
+    Width and height are the shortest decimals that add back to ``x_max`` and ``y_max``
+    exactly, so that a COCO box read (:func:`xywh_to_xyxy`) and written again keeps its numbers
+    (``0.3 - 0.1`` is ``0.19999999999999998``; the width written is ``0.2``).
+
     Examples
     --------
     >>> xyxy_to_xywh((1, 2, 4, 6))
     [1.0, 2.0, 3.0, 4.0]
+    >>> xyxy_to_xywh(xywh_to_xyxy(0.1, 0.7, 0.2, 0.1))
+    [0.1, 0.7, 0.2, 0.1]
     """
     x0, y0, x1, y1 = (float(v) for v in box)
-    return [x0, y0, x1 - x0, y1 - y0]
+    return [x0, y0, _span(x0, x1), _span(y0, y1)]
+
+
+def _span(start: float, end: float) -> float:
+    """``end - start`` in the fewest decimals for which ``start + span == end``."""
+    exact = end - start
+    for digits in range(18):
+        short = round(exact, digits)
+        if start + short == end:
+            return short
+    return exact
 
 
 def xywh_to_xyxy(x: float, y: float, w: float, h: float) -> Box:

@@ -1,7 +1,9 @@
 """Reading one image file as BGR uint8; missing, empty, truncated or undecodable files raise.
 
 16-bit samples are scaled down, alpha is dropped, grayscale is promoted to three channels
-(:func:`to_bgr8`). The error is a :class:`ImageReadError` naming the file and the problem.
+(:func:`to_bgr8`); an EXIF orientation (a phone's upright flag) is applied, as viewers and
+``PIL.ImageOps.exif_transpose`` do, and a GIF gives its first frame. The error is a
+:class:`ImageReadError` naming the file and the problem.
 """
 
 from __future__ import annotations
@@ -32,11 +34,13 @@ def read_image(path: str | os.PathLike) -> np.ndarray:
     Parameters
     ----------
     path : path-like
-        Any format OpenCV decodes (JPEG, PNG incl. 16-bit and RGBA, PPM, BMP, TIFF, WebP...).
+        Any format OpenCV decodes (JPEG, PNG incl. 16-bit and RGBA, PPM, BMP, TIFF, WebP,
+        GIF...).
 
     Returns
     -------
     ndarray of shape (H, W, 3), uint8
+        Upright: turned and mirrored as the file's EXIF orientation says.
 
     Raises
     ------
@@ -61,7 +65,8 @@ def read_image(path: str | os.PathLike) -> np.ndarray:
     if problem:
         raise ImageReadError(f"{path}: {problem}")
     try:
-        image = cv2.imdecode(data, cv2.IMREAD_UNCHANGED)
+        # any depth and colour, with the EXIF orientation applied (IMREAD_UNCHANGED ignores it)
+        image = cv2.imdecode(data, cv2.IMREAD_ANYDEPTH | cv2.IMREAD_ANYCOLOR)
     except cv2.error as exc:
         raise ImageReadError(
             f"{path}: not decodable ({str(exc).strip().splitlines()[-1]})"

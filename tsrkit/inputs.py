@@ -8,7 +8,7 @@ FFmpeg backend.
 from __future__ import annotations
 
 import os
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -52,6 +52,7 @@ IMAGE_EXTENSIONS = {
     ".ras",
     ".exr",
     ".hdr",
+    ".gif",  # its first frame
 }
 VIDEO_EXTENSIONS = {
     ".mp4",
@@ -118,12 +119,14 @@ def check_range(every: int, start: int, end: int | None) -> None:
 
 @dataclass(frozen=True)
 class Work:
-    """A unit of input one reader handles: an image file, or a run of a video's frames."""
+    """A unit of input one reader handles: an image file, or a run of a video's frames
+    (``start`` to ``end``, none before ``after``: those were done by an earlier run)."""
 
     path: str
     video: bool = False
     start: int = 0
     end: int | None = None
+    after: int = 0
 
 
 def plan_work(
@@ -132,27 +135,36 @@ def plan_work(
     start: int = 0,
     end: int | None = None,
     chunk: int | None = None,
+    done: Mapping[str, int] | None = None,
 ) -> Iterator[Work | Skipped]:
     """The units of work of ``paths``: one per image, one per video or, with ``chunk``, one per
     ``chunk`` kept frames of a video whose container declares its frame count (so that workers
-    each decode their own part); unusable paths as :class:`Skipped`."""
+    each decode their own part); unusable paths as :class:`Skipped`.
+
+    ``done`` maps each input an earlier run finished frames of to its last frame done
+    (``detect --resume``): those images are left out, those videos go on after that frame.
+    """
     check_range(every, start, end)
+    done = done or {}
     for item in expand_paths(paths):
         if isinstance(item, Skipped):
             yield item
             continue
         suffix = item.suffix.lower()
+        after = done[str(item)] + 1 if str(item) in done else 0
         if suffix in VIDEO_EXTENSIONS:
             count = video_frame_count(item) if chunk else 0
             if not count:
-                yield Work(str(item), True, start, end)
+                yield Work(str(item), True, start, end, after)
                 continue
             stop = count if end is None else min(end, count)
             step = chunk * every if chunk else stop
             for first in range(start, max(stop, start + 1), step):
-                yield Work(str(item), True, first, min(first + step, stop))
+                if first + step > after:
+                    yield Work(str(item), True, first, min(first + step, stop), after)
         elif suffix in IMAGE_EXTENSIONS:
-            yield Work(str(item))
+            if not after:
+                yield Work(str(item))
         else:
             yield Skipped(str(item), f"not an image or video (unsupported type '{suffix}')")
 
@@ -160,7 +172,7 @@ def plan_work(
 def read_work(work: Work, every: int = 1) -> Iterator[Frame | Skipped]:
     """The frames of one unit of :func:`plan_work` (videos: every ``every``-th frame)."""
     if work.video:
-        yield from iter_video(Path(work.path), every, work.start, work.end)
+        yield from iter_video(Path(work.path), every, work.start, work.end, work.after)
         return
     try:
         yield Frame(image=read_image(work.path), source=work.path)
@@ -169,7 +181,11 @@ def read_work(work: Work, every: int = 1) -> Iterator[Frame | Skipped]:
 
 
 def iter_frames(
-    paths: Iterable[str | os.PathLike], every: int = 1, start: int = 0, end: int | None = None
+    paths: Iterable[str | os.PathLike],
+    every: int = 1,
+    start: int = 0,
+    end: int | None = None,
+    done: Mapping[str, int] | None = None,
 ) -> Iterator[Frame | Skipped]:
     """Yield the frames of images, folders and videos; unusable inputs as :class:`Skipped`.
 
@@ -181,34 +197,61 @@ def iter_frames(
         Keep every N-th video frame.
     start, end : int
         Video frame numbers: the first kept and the one to stop before (None: to the end).
+    done : mapping of str to int, optional
+        The frames an earlier run finished, left out (see :func:`plan_work`).
     """
-    for work in plan_work(paths, every, start, end):
+    for work in plan_work(paths, every, start, end, done=done):
         if isinstance(work, Skipped):
             yield work
         else:
             yield from read_work(work, every)
 
 
+#: Consecutive frames a video may fail to decode before its reader takes the rest as lost too
+#: and stops (a damaged stretch is usually a few frames; a truncated file fails on every grab).
+MAX_LOST_RUN = 250
+
+
 def iter_video(
-    path: Path, every: int = 1, start: int = 0, end: int | None = None
+    path: Path, every: int = 1, start: int = 0, end: int | None = None, after: int = 0
 ) -> Iterator[Frame | Skipped]:
-    """Decode ``path`` frame by frame, keeping frames ``start, start+every, ...`` before ``end``."""
+    """Decode ``path`` frame by frame, keeping frames ``start, start+every, ...`` before ``end``
+    and none before ``after`` (the frames an earlier run did).
+
+    A frame FFmpeg cannot decode (a damaged stretch of the file) is lost, not the end of the
+    video: each kept frame lost is yielded as :class:`Skipped` (``PATH#INDEX``) and decoding
+    goes on past it. A failed grab counts as one lost frame when it lies before the frame count
+    the container declares, or when a later frame decodes; the reader stops at a failure at or
+    past the declared count, or after :data:`MAX_LOST_RUN` failures in a row.
+    """
     capture = cv2.VideoCapture(str(path), cv2.CAP_FFMPEG)
     try:
         if not capture.isOpened():
             yield Skipped(str(path), "cannot open video")
             return
         fps = capture.get(cv2.CAP_PROP_FPS) or 0.0
-        index = _seek(capture, start)
+        declared = int(capture.get(cv2.CAP_PROP_FRAME_COUNT) or 0)
+        first = max(start, after)
+        index = _seek(capture, first)
         decoded = 0
+        failed: list[int] = []  # kept frames whose grab failed since the last decoded frame
+        run = 0  # grabs failed in a row
         while end is None or index < end:
-            wanted = index >= start and (index - start) % every == 0
+            wanted = index >= first and (index - start) % every == 0
             if not capture.grab():
-                break
+                if run >= MAX_LOST_RUN or (declared and index >= declared):
+                    break
+                run += 1
+                failed += [index] if wanted else []
+                index += 1
+                continue
+            run = 0
+            yield from (_lost(path, k) for k in failed)
+            failed = []
             if wanted:
                 ok, image = capture.retrieve()
                 if not ok or image is None:
-                    yield Skipped(f"{path}#{index}", "frame could not be decoded")
+                    yield _lost(path, index)
                 else:
                     decoded += 1
                     stamp = index / fps if fps > 0 else None
@@ -216,14 +259,22 @@ def iter_video(
                         image=to_bgr8(image), source=str(path), index=index, timestamp=stamp
                     )
             index += 1
+        failed = [k for k in failed if k < declared]
+        yield from (_lost(path, k) for k in failed)
+        index -= run  # the frames after the last one decoded may not exist
         if decoded == 0 and 0 < index <= start:
             yield Skipped(
                 str(path), f"--start {start} is past the end: the video has {index} frames"
             )
-        elif decoded == 0 and index <= start:
+        elif decoded == 0 and index <= start and not failed:
             yield Skipped(str(path), "no frames decoded (empty or unreadable video)")
     finally:
         capture.release()
+
+
+def _lost(path: Path, index: int) -> Skipped:
+    """Frame ``index`` of ``path``, which FFmpeg could not decode, as skipped."""
+    return Skipped(f"{path}#{index}", "frame could not be decoded (damaged video data)")
 
 
 def _seek(capture: cv2.VideoCapture, start: int) -> int:

@@ -1,7 +1,10 @@
-"""One run at a time per output folder or file: a lock file holding the writer's process id.
+"""One run at a time per output folder or file: a lock file holding the writer's process id
+and start time (``PID START``, START from ``/proc/PID/stat``, in clock ticks after boot).
 
-A second run into the same ``--out`` while the first is alive refuses with one clear line; a
-lock left by a killed run (its process is gone) is taken over, and the temporary files a killed
+A second run into the same ``--out`` while the first is alive refuses with one clear line
+naming the lock file; a lock left by a killed run (its process is gone, or its process id now
+belongs to a process started at another time, or, in a lock holding no start time, after the
+lock was written) is taken over, and the temporary files a killed
 run left (``.NAME.*.tmp`` of :func:`tsrkit.atomic.atomic_open`, the writers' ``.writing-*``
 folder of :func:`tsrkit.benchmarking.staged`) are removed then.
 """
@@ -72,27 +75,30 @@ _FRESH = 5.0
 
 @contextlib.contextmanager
 def _held(lock: Path, busy: str, clean) -> Iterator[None]:
-    """Create ``lock`` holding this process id, taking over one whose process is gone (and
-    running ``clean`` then); ``busy`` (with ``{}`` for the owner) is the refusal."""
+    """Create ``lock`` holding this process id and start time, taking over one whose process
+    is gone (and running ``clean`` then); ``busy`` (with ``{}`` for the owner) is the refusal."""
     for _ in range(2):
         try:
             fd = os.open(lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
         except FileExistsError:
             try:
                 text = lock.read_text().strip()
-                age = time.time() - lock.stat().st_mtime
+                written = lock.stat().st_mtime
             except OSError:
                 continue  # released meanwhile: try again
-            owner = int(text) if text.isdigit() else 0
-            if (owner and owner != os.getpid() and alive(owner)) or (not text and age < _FRESH):
+            owner, _, started = text.partition(" ")
+            pid = int(owner) if owner.isdigit() else 0
+            live = pid != 0 and pid != os.getpid() and _runs(pid, started, written)
+            if live or (not text and time.time() - written < _FRESH):
                 raise OutputBusy(
-                    busy.format(owner or "starting") + "; wait for it or choose another --out"
+                    busy.format(pid or "starting")
+                    + f" (lock file {lock}); wait for it or choose another --out"
                 ) from None
             lock.unlink(missing_ok=True)  # left by a killed run: take it over
             clean()
             continue
         with os.fdopen(fd, "w") as fh:
-            fh.write(str(os.getpid()))
+            fh.write(f"{os.getpid()} {_start_time(os.getpid())}".strip())
         break
     else:
         raise OutputBusy(f"cannot take the output lock {lock}")
@@ -100,3 +106,33 @@ def _held(lock: Path, busy: str, clean) -> Iterator[None]:
         yield
     finally:
         lock.unlink(missing_ok=True)
+
+
+def _start_time(pid: int) -> str:
+    """Process ``pid``'s start time in clock ticks after boot (``/proc/PID/stat`` field 22), or
+    ``""`` where there is no ``/proc``."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[19]
+    except (OSError, IndexError):
+        return ""
+
+
+def _runs(pid: int, started: str, written: float) -> bool:
+    """Whether the lock's owner, process ``pid`` started at ``started``, still runs: a live
+    process under a reused id does not count. A lock of an older version holds no start time:
+    then a process that started after the lock was ``written`` (a time stamp) is not its owner.
+    """
+    if not alive(pid):
+        return False
+    now = _start_time(pid)
+    if started or not now:
+        return now in ("", started)
+    try:
+        boot = next(
+            float(line.split()[1])
+            for line in Path("/proc/stat").read_text().splitlines()
+            if line.startswith("btime ")
+        )
+    except (OSError, StopIteration, IndexError, ValueError):
+        return True
+    return boot + int(now) / os.sysconf("SC_CLK_TCK") <= written + 1.0  # 1 s: clock ticks

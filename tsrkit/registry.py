@@ -4,7 +4,10 @@ Built-ins load through the same entry points a third-party package declares; the
 metrics are an internal plugin (:data:`INTERNAL`) registered through the same hooks (the command
 line registers the built-in verbs the same way, :mod:`tsrkit.cli.main`). A
 plugin that fails to import or to register is recorded as a :class:`PluginFailure` and the
-others still load. ``TSRKIT_LOAD_PLUGINS`` (comma-separated entry-point names or shell patterns;
+others still load (a plugin that calls ``sys.exit`` while it loads included). Two plugins of
+one kind and name: tsrkit's own is kept over another package's (else the first), and a
+:class:`~tsrkit.errors.TsrkitWarning` names both packages.
+``TSRKIT_LOAD_PLUGINS`` (comma-separated entry-point names or shell patterns;
 empty for none) limits which installed plugins load; report writers (``writer-*``) and the
 internal plugins always load, since every report needs them.
 """
@@ -14,6 +17,7 @@ from __future__ import annotations
 import fnmatch
 import importlib
 import os
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from importlib import metadata
@@ -22,7 +26,7 @@ from typing import Any, Literal, overload
 import pluggy
 
 from tsrkit import hookspecs
-from tsrkit.errors import TsrkitError
+from tsrkit.errors import TsrkitError, TsrkitWarning
 from tsrkit.hookspecs import ENTRY_POINT_GROUP
 from tsrkit.params import PLUGIN_TYPES, Param, ParamError, Part, parse_parts, validate
 from tsrkit.plugin import (
@@ -142,7 +146,7 @@ class Registry:
             try:
                 module = ep.load()
                 self.add(module, ep.name, dist, version)
-            except Exception as exc:  # a broken plugin must not stop the others
+            except (Exception, SystemExit) as exc:  # a broken plugin must not stop the others
                 self.failures.append(PluginFailure(ep.name, dist, _describe(exc)))
         self.pm.check_pending()
 
@@ -248,27 +252,55 @@ class Registry:
             return self._plugins
         self.failures = [f for f in self.failures if not f.error.startswith("register")]
         table: dict[str, dict[str, PluginInfo]] = {k: {} for k in KINDS}
+        owner: dict[tuple[str, str], str] = {}  # (kind, name): the plugin object registering it
         for kind, hook_name in KINDS.items():
             for impl in getattr(self.pm.hook, hook_name).get_hookimpls():
                 package, version = self._origin.get(impl.plugin_name, ("<in-process>", "0"))
                 found: list[type[Plugin]] = []
                 try:
                     impl.function(register=found.append)
-                except Exception as exc:
+                except (Exception, SystemExit) as exc:
                     self.failures.append(
                         PluginFailure(impl.plugin_name, package, f"register: {_describe(exc)}")
                     )
                     continue
                 for cls in found:
-                    problem = _check_class(cls, kind, table[kind])
-                    if problem:
+                    problem = _check_class(cls, kind)
+                    info = PluginInfo(cls, package, version)
+                    earlier = table[kind].get(getattr(cls, "name", ""))
+                    if earlier is not None and not problem:
+                        kept, lost = _clash(kind, earlier, info)
+                        name = impl.plugin_name if lost is info else owner[kind, cls.name]
+                        problem = f"register: {_clashed(kind, kept, lost)}"
+                        self.failures.append(PluginFailure(name, lost.package, problem))
+                        table[kind][cls.name] = kept
+                        owner[kind, cls.name] = impl.plugin_name if kept is info else name
+                    elif problem:
                         self.failures.append(
                             PluginFailure(impl.plugin_name, package, f"register: {problem}")
                         )
                     else:
-                        table[kind][cls.name] = PluginInfo(cls, package, version)
+                        table[kind][cls.name] = info
+                        owner[kind, cls.name] = impl.plugin_name
         self._plugins = table
         return table
+
+
+def _clash(kind: str, earlier: PluginInfo, later: PluginInfo) -> tuple[PluginInfo, PluginInfo]:
+    """The plugin kept and the one left out of two of ``kind`` under one name (tsrkit's own
+    over another package's, else the ``earlier``), said in one warning."""
+    builtin = later.package == "tsrkit" != earlier.package
+    kept, lost = (later, earlier) if builtin else (earlier, later)
+    warnings.warn(_clashed(kind, kept, lost), TsrkitWarning, stacklevel=4)
+    return kept, lost
+
+
+def _clashed(kind: str, kept: PluginInfo, lost: PluginInfo) -> str:
+    """The one line naming both packages of a name clash and the plugin kept."""
+    return (
+        f"duplicate {kind} name '{kept.name}': registered by {lost.package} and by "
+        f"{kept.package}; {kept.package}'s is kept, {lost.package}'s is not used"
+    )
 
 
 def _new_manager() -> pluggy.PluginManager:
@@ -285,21 +317,18 @@ def _tsrkit_version() -> str:
 
 
 def _describe(exc: BaseException) -> str:
+    if isinstance(exc, SystemExit):
+        return f"called sys.exit({exc.code!r}) while loading"
     return f"{type(exc).__name__}: {exc}"
 
 
-def _check_class(cls: object, kind: str, seen: Mapping[str, PluginInfo]) -> str | None:
+def _check_class(cls: object, kind: str) -> str | None:
     if not isinstance(cls, type) or not issubclass(cls, Plugin) or cls.kind != kind:
         return f"{cls!r} is not a {kind} plugin class"
     if not cls.name:
         return f"{cls.__name__} has no name"
     if isinstance(vars(cls).get("params"), tuple):
         return f"{cls.__name__} declares its parameters as 'params'; name the tuple 'PARAMS'"
-    if cls.name in seen:
-        return (
-            f"duplicate {kind} name '{cls.name}' (already registered by "
-            f"{seen[cls.name].package}); the first one is kept"
-        )
     try:
         validate(cls.PARAMS, {}, f"{kind} '{cls.name}'")
     except (ParamError, ValueError) as exc:

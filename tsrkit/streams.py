@@ -11,7 +11,7 @@ however long the video.
 from __future__ import annotations
 
 import os
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Mapping
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 
@@ -56,6 +56,7 @@ def run_pipeline(
     start: int = 0,
     end: int | None = None,
     workers: int = 1,
+    done: Mapping[str, int] | None = None,
 ) -> Iterator[tuple[FrameResult | Skipped, Frame | None]]:
     """Each frame's result (or skip) in input order, with the frame itself when ``workers`` is 1.
 
@@ -70,17 +71,19 @@ def run_pipeline(
         Worker processes; 1 runs here. A tracker follows a video frame by frame, so a pipeline
         with one runs here only. A follower's chunks are a multiple of its key-frame interval,
         so that its records do not depend on ``workers``.
+    done : mapping of str to int, optional
+        The frames an earlier run finished, left out (see :func:`tsrkit.inputs.plan_work`).
     """
     check_workers(workers)
     if workers == 1:
-        for item in iter_frames(paths, every, start, end):
+        for item in iter_frames(paths, every, start, end, done):
             yield (
                 (item, None) if isinstance(item, Skipped) else (process_frame(pipeline, item), item)
             )
         return
     if isinstance(pipeline, Pipeline) and pipeline.tracker is not None:
         raise TsrkitError("a tracker follows a video frame by frame: run it with one worker")
-    units = plan_work(paths, every, start, end, chunk=chunk_frames(pipeline))
+    units = plan_work(paths, every, start, end, chunk=chunk_frames(pipeline), done=done)
     with ProcessPoolExecutor(
         workers,
         mp_context=pool_context(),

@@ -4,7 +4,9 @@ Boxes are ``[x, y, width, height]`` in pixels; ``file_name`` resolves against th
 folder (or ``--images``). Categories are the raw labels; the state goes in each annotation's
 extra ``"state"`` key when it differs from what the label maps to, and non-label attributes in
 ``"attributes"`` (COCO readers ignore unknown keys). Images carry tsrkit's ``split`` and
-``metadata`` the same way. Category and image ids start at 1.
+``metadata`` the same way. The ids of images and categories read from COCO are kept (a
+sample's ``metadata["coco_id"]``, the dataset's ``info["coco_categories"]``); others are
+numbered from 1 (after the kept ones), and a file giving two images one id is refused.
 """
 
 from __future__ import annotations
@@ -61,7 +63,7 @@ class Coco(DatasetFormat):
         data = read_json(path)
         if not _is_coco(data):
             raise DatasetError(path, "expected an object with images, annotations, categories")
-        categories = {}
+        categories: dict[int, str] = {}
         for i, cat in enumerate(field(data, "categories", list, path, "")):
             categories[field(cat, "id", int, path, f"categories[{i}]")] = str(
                 field(cat, "name", (str, int), path, f"categories[{i}]")
@@ -72,9 +74,15 @@ class Coco(DatasetFormat):
                 _annotation(path, ann, f"annotations[{i}]", categories)
             )
         samples = []
+        seen: dict[int, int] = {}
         for i, image in enumerate(field(data, "images", list, path, "")):
             where = f"images[{i}]"
             image_id = field(image, "id", int, path, where)
+            if image_id in seen:
+                raise DatasetError(
+                    path, f"image id {image_id} is also the id of images[{seen[image_id]}]", where
+                )
+            seen[image_id] = i
             size = {k: image[k] for k in ("width", "height") if isinstance(image.get(k), int)}
             metadata = optional(image, "metadata", dict, path, where) or {}
             samples.append(
@@ -92,17 +100,22 @@ class Coco(DatasetFormat):
                 f"annotations refer to unknown image ids {sorted(by_image)[:5]}",
                 "annotations",
             )
-        return Dataset(
-            path.stem, tuple(samples), self.name, str(path.parent), {"annotation_file": str(path)}
-        )
+        info = {
+            "annotation_file": str(path),
+            "coco_categories": {name: cid for cid, name in categories.items()},
+        }
+        return Dataset(path.stem, tuple(samples), self.name, str(path.parent), info)
 
     def write(self, dataset: Dataset, out: Path) -> None:
         out = Path(out)
-        names = class_names(dataset)
-        ids = {name: i for i, name in enumerate(names, 1)}
+        known = dict(dataset.info.get("coco_categories") or {})
+        ids = _numbered(known, [n for n in class_names(dataset) if n not in known])
+        kept = [s.metadata.get("coco_id") for s in dataset]
+        if not all(isinstance(i, int) for i in kept) or len(set(kept)) < len(kept):
+            kept = list(range(1, len(kept) + 1))
         images: list[dict[str, Any]] = []
         annotations: list[dict[str, Any]] = []
-        for image_id, sample in enumerate(dataset, 1):
+        for image_id, sample in zip(kept, dataset):
             image = {
                 "id": image_id,
                 "file_name": relative_source(sample.source, out.parent),
@@ -122,9 +135,17 @@ class Coco(DatasetFormat):
                 "info": {"description": dataset.name, "generator": "tsrkit"},
                 "images": images,
                 "annotations": annotations,
-                "categories": [{"id": i, "name": n} for n, i in ids.items()],
+                "categories": [
+                    {"id": i, "name": n} for n, i in sorted(ids.items(), key=lambda item: item[1])
+                ],
             },
         )
+
+
+def _numbered(known: dict, new) -> dict:
+    """``known`` ids (name: id) and the ``new`` names numbered on after the largest."""
+    start = max(known.values(), default=0) + 1
+    return {**known, **{key: start + k for k, key in enumerate(new)}}
 
 
 def _annotation(path: Path, ann, where: str, categories: dict):
@@ -148,7 +169,7 @@ def _coco_annotation(ann, ann_id: int, image_id: int, ids: dict) -> dict:
         "id": ann_id,
         "image_id": image_id,
         "category_id": ids[label],
-        "bbox": [round(x, 3), round(y, 3), round(w, 3), round(h, 3)],
+        "bbox": [x, y, w, h],
         "area": round(w * h, 3),
         "iscrowd": 0,
     }

@@ -93,7 +93,7 @@ def _record(sample: Sample, folder: Path) -> dict:
     boxes = []
     for ann in sample.annotations:
         label = raw_label(ann)
-        box = {"label": label, **{k: round(float(v), 3) for k, v in zip(COORDS, ann.bbox)}}
+        box = {"label": label, **{k: float(v) for k, v in zip(COORDS, ann.bbox)}}
         if ann.state != to_state(label):
             box["state"] = ann.state
         extra = extra_attributes(ann)

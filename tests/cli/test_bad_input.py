@@ -73,7 +73,7 @@ def test_a_header_lie_in_a_folder_of_good_images_skips_only_that_frame(tmp_path)
                 [
                     {
                         "file": "a.png",
-                        "boxes": [{"label": "red", "x_min": 5, "y_min": 5, "x_max": 5, "y_max": 9}],
+                        "boxes": [{"label": "red", "x_min": 6, "y_min": 5, "x_max": 5, "y_max": 9}],
                     }
                 ]
             ).encode(),

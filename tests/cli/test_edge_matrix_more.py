@@ -10,15 +10,18 @@ that could block run under an alarm.
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import signal
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
+import cv2
+import numpy as np
 import pytest
 from click.testing import CliRunner
-from test_bad_input_matrix import FAST, Row, norm_dataset, png, run_row, write
+from test_bad_input_matrix import BASES, FAST, Row, convert, norm_dataset, png, run_row, write
 from test_edge_matrix import FIXES, MAP, fifo, geo, link, tiny_drive, unix_socket, with_video
 
 from tsrkit.cli.main import cli
@@ -631,7 +634,239 @@ RUNS: list[Row] = [
     ),
 ]
 
-MORE = REPORTS + NUMBERS + SPECIALS + PATHS + RUNS
+# ---------------------------------------------------------------------------------------------
+# inputs once mishandled: valid input refused, damage passed over in silence, results changed
+
+
+def damaged_video(tmp: Path, frames: int = 60) -> Path:
+    """A ``frames``-frame MPEG-4 video of noise whose middle 8,000 bytes are inverted: FFmpeg
+    cannot decode a few frames there, and decodes the ones after them."""
+    path = tmp / "damaged.mp4"
+    writer = cv2.VideoWriter(str(path), cv2.VideoWriter.fourcc(*"mp4v"), 10.0, (64, 64))
+    rng = np.random.default_rng(0)
+    for _ in range(frames):
+        writer.write(rng.integers(0, 255, (64, 64, 3), dtype=np.uint8))
+    writer.release()
+    data = bytearray(path.read_bytes())
+    middle = len(data) // 2
+    data[middle : middle + 8000] = bytes(b ^ 0xFF for b in data[middle : middle + 8000])
+    return write(path, bytes(data))
+
+
+def on_damaged_video(*extra: str):
+    return lambda tmp: ["detect", str(damaged_video(tmp)), "-d", "gray-tophat", "-q", *extra]
+
+
+#: Frames decoded and lost in :func:`damaged_video` (each lost frame is one skipped line).
+DAMAGED = r"51 frames, \d+ detections, 9 skipped.*\n.*damaged.mp4#20: frame could not be decoded"
+
+FOUND: list[Row] = [
+    ("video-damaged-middle", on_damaged_video(), 0, DAMAGED),
+    ("video-damaged-middle-workers", on_damaged_video("-w", "2"), 0, DAMAGED),
+    ("video-damaged-middle-every-2", on_damaged_video("--every", "2"), 0, "25 frames.*5 skipped"),
+    ("detect-resume-without-out", detect("--resume"), 2, "--resume .* needs --out"),
+    (
+        "detect-resume-with-agree",
+        lambda tmp: [*detect_video("--agree", "2", "--resume", "-o")(tmp), str(tmp / "o.jsonl")],
+        2,
+        "--resume: a tracker, --key-every and --agree carry lights",
+    ),
+    (
+        "detect-resume-without-partial",
+        lambda tmp: [*detect("--resume", "-o")(tmp), str(tmp / "o.jsonl")],
+        0,
+        "no .*o.jsonl.partial to resume: starting at the first frame",
+    ),
+    ("detect-lock-of-a-reused-process-id", lambda tmp: locked_by(tmp, "legacy"), 0, "1 frames"),
+    ("detect-lock-of-another-start-time", lambda tmp: locked_by(tmp, "1"), 0, "1 frames"),
+    (
+        "detect-lock-of-a-live-run-named",
+        lambda tmp: locked_by(tmp, "live"),
+        2,
+        r"another run .* \(lock file TMP/\.o\.jsonl\.tsrkit\.lock\)",
+    ),
+    (
+        "image-gif-first-frame",
+        lambda tmp: one_image(gif(tmp / "a.gif")),
+        0,
+        r'"width": 30, "height": 20',
+    ),
+    (
+        "image-jpeg-exif-rotated-upright",
+        lambda tmp: one_image(exif_jpeg(tmp / "phone.jpg")),
+        0,
+        r'"width": 20, "height": 40',
+    ),
+    (
+        "coco-utf8-byte-order-mark",
+        convert("coco", b"\xef\xbb\xbf" + BASES["coco"][1].encode()),
+        0,
+        "1 images|->",
+    ),
+    (
+        "coco-one-zero-width-box-left-out",
+        convert(
+            "coco",
+            None,
+            (
+                "[1, 1, 9, 9]}]",
+                '[1, 1, 9, 9]}, {"id": 2, "image_id": 1, "category_id": 1, "bbox": [5, 5, 0, 4]}]',
+            ),
+        ),
+        0,
+        r"warning: .*coco.json: 1 box\(es\) of zero width or height left out: a.png box 1",
+    ),
+    (
+        "track-gps-fix-repeated-exactly",
+        geo("".join(FIXES.splitlines(keepends=True)[k] for k in (*range(6), 5, *range(6, 21)))),
+        0,
+        "warning: .*g.csv: line 7: exactly repeats the fix before: left out",
+    ),
+    (
+        "track-gps-glitch-fix",
+        geo(FIXES.replace(FIXES.splitlines()[9], "1780315208,48.5,-122.15")),
+        0,
+        r"warning: .*g.csv: line 10: a glitch: the fix 48.500000, -122.150000 is reached and left "
+        "faster than 90 m/s: left out",
+    ),
+    (
+        "track-gps-jump-of-1000-km",
+        geo(
+            "time,lat,lon\n"
+            + "".join(
+                f"{1780315200 + k},{47.599 + 0.0001 * k + 9 * (k >= 10):.7f},-122.15\n"
+                for k in range(20)
+            )
+        ),
+        0,
+        "warning: .*g.csv: line 12: the log jumps 1,000,... m in 1 s .*split there",
+    ),
+    (
+        "detect-agree-on-still-images-keeps-them",
+        detect("--agree", "3"),
+        0,
+        "1 frames, 1 detections",
+    ),
+    ("benchmark-split-empty", bench("--split", ""), 2, "--split.*empty split name"),
+    (
+        "train-split-empty",
+        lambda tmp: [
+            "train",
+            "ab-hist",
+            "--dataset",
+            str(norm_dataset(tmp)),
+            "--split",
+            " ",
+            "--out",
+            str(tmp / "m"),
+        ],
+        2,
+        "--split.*empty split name",
+    ),
+    (
+        "coco-two-images-of-one-id",
+        convert(
+            "coco", None, ('"height": 32}]', '"height": 32}, {"id": 1, "file_name": "b.png"}]')
+        ),
+        2,
+        r"coco.json: images\[1\]: image id 1 is also the id of images\[0\]",
+    ),
+    (
+        "compare-into-a-folder-a-live-compare-holds",
+        lambda tmp: locked_by(tmp, "live", "o/.tsrkit.lock", compare("-o", str(tmp / "o"))),
+        2,
+        r"TMP/o: another run .* \(lock file TMP/o/\.tsrkit\.lock\)",
+    ),
+    (
+        "config-yaml-merge-key",
+        lambda tmp: (
+            one_image(png(tmp / "a.png", size=64))[:2]
+            + ["--config", str(write(tmp / "run.yaml", MERGED)), "-q"]
+        ),
+        0,
+        "1 frames",
+    ),
+]
+
+#: A run configuration whose detector merges a shared mapping (``<<: *tophat``) and overrides
+#: one of its keys.
+MERGED = """\
+detector:
+  <<: &tophat {name: gray-tophat, params: {h_peak: 0.1}}
+  params: {h_peak: 0.2}
+"""
+
+
+def one_image(path: Path) -> list[str]:
+    return ["detect", str(path), "-d", "gray-tophat", "-q"]
+
+
+def gif(path: Path) -> Path:
+    """A 30x20 GIF of two frames (the first is read)."""
+    from PIL import Image
+
+    frames = [Image.new("RGB", (30, 20), colour) for colour in ("red", "blue")]
+    path.parent.mkdir(parents=True, exist_ok=True)
+    frames[0].save(path, save_all=True, append_images=frames[1:])
+    return path
+
+
+def exif_jpeg(path: Path) -> Path:
+    """A 40x20 JPEG whose EXIF orientation 6 turns it upright to 20x40, as phones write."""
+    from PIL import Image
+
+    image = Image.new("RGB", (40, 20), "gray")
+    exif = image.getexif()
+    exif[0x0112] = 6
+    path.parent.mkdir(parents=True, exist_ok=True)
+    image.save(path, exif=exif)
+    return path
+
+
+def locked_by(tmp: Path, started: str, lock: str = ".o.jsonl.tsrkit.lock", verb=None):
+    """``verb`` (default ``detect -o o.jsonl``) beside the lock file ``lock`` of this test's
+    parent process (alive, not this one): with its real start time (``live``), another one, or
+    none in a lock written in 2000, before the process started (``legacy``: its id was reused
+    since)."""
+    from tsrkit.outlock import _start_time
+
+    parent = os.getppid()
+    path = tmp / lock
+    if started == "legacy":
+        write(path, str(parent))
+        os.utime(path, (946684800, 946684800))
+    else:
+        write(path, f"{parent} {_start_time(parent) if started == 'live' else started}")
+    return (verb or detect("-o", str(tmp / "o.jsonl")))(tmp)
+
+
+def without_ms(path: Path) -> list[dict]:
+    records = [json.loads(line) for line in path.read_text().splitlines()]
+    return [{k: v for k, v in r.items() if k != "ms"} for r in records]
+
+
+@pytest.mark.parametrize("workers", ["1", "2"])
+def test_resume_goes_on_after_the_frames_of_the_partial(tmp_path, workers):
+    """``detect -o OUT --resume`` after a kill (OUT.partial holds the first 30 records and half
+    of the 31st) writes the records of an uninterrupted run, and runs only the rest."""
+    png(tmp_path / "in" / "a.png", size=48)
+    png(tmp_path / "in" / "b.png", size=48, value=90)
+    damaged_video(tmp_path / "in")
+    args = ["detect", str(tmp_path / "in"), "-d", "gray-tophat", "-q", "-w", workers, "-o"]
+    whole = CliRunner().invoke(cli, [*args, str(tmp_path / "whole.jsonl")])
+    assert whole.exit_code == 0, whole.output
+    lines = (tmp_path / "whole.jsonl").read_text().splitlines(keepends=True)
+    assert len(lines) == 53
+    write(tmp_path / "o.jsonl.partial", "".join(lines[:30]) + lines[30][:40])
+    resumed = CliRunner().invoke(cli, [*args, str(tmp_path / "o.jsonl"), "--resume"])
+    assert resumed.exit_code == 0, resumed.output
+    assert "resuming after the 30 frames" in resumed.output
+    assert "53 frames" in resumed.output and "0 skipped" in resumed.output
+    assert without_ms(tmp_path / "o.jsonl") == without_ms(tmp_path / "whole.jsonl")
+    assert not (tmp_path / "o.jsonl.partial").exists()
+
+
+MORE = REPORTS + NUMBERS + SPECIALS + PATHS + RUNS + FOUND
 
 
 def test_the_third_table_is_a_hundred_new_cases():
@@ -657,3 +892,47 @@ def test_more_edges(tmp_path, monkeypatch, build, code, fragment):
     finally:
         signal.alarm(0)
         signal.signal(signal.SIGALRM, previous)
+
+
+SOURCE_COCO = {
+    "images": [
+        {"id": 7, "file_name": "a.png", "width": 32, "height": 32},
+        {"id": 3, "file_name": "b.png", "width": 32, "height": 32},
+    ],
+    "annotations": [
+        {"id": 1, "image_id": 7, "category_id": 5, "bbox": [0.1, 0.7, 0.2, 0.1]},
+        {"id": 2, "image_id": 3, "category_id": 2, "bbox": [1.23456789, 2.5, 3.1415926, 4.0001]},
+        {"id": 3, "image_id": 3, "category_id": 5, "bbox": [10, 11, 12.5, 3]},
+    ],
+    "categories": [{"id": 5, "name": "red"}, {"id": 2, "name": "green"}],
+}
+
+
+def test_coco_to_coco_keeps_boxes_and_ids(tmp_path):
+    """``datasets convert`` COCO -> COCO: every box number as written, image and category ids
+    kept (not renumbered); through the normalised format (which has no category ids) too, the
+    boxes and image ids."""
+    png(tmp_path / "a.png")
+    png(tmp_path / "b.png")
+    source = write(tmp_path / "coco.json", json.dumps(SOURCE_COCO))
+    norm, back, direct = tmp_path / "n" / "a.json", tmp_path / "back.json", tmp_path / "o.json"
+    for src, to, out in (
+        (source, "normalized", norm),
+        (norm, "coco", back),
+        (source, "coco", direct),
+    ):
+        result = CliRunner().invoke(
+            cli, ["datasets", "convert", str(src), "--to", to, "--out", str(out)]
+        )
+        assert result.exit_code == 0, result.output
+    expected = [(a["image_id"], a["bbox"]) for a in SOURCE_COCO["annotations"]]
+    for path in (direct, back):
+        written = json.loads(path.read_text())
+        assert [(i["id"], i["file_name"]) for i in written["images"]] == [
+            (7, "a.png"),
+            (3, "b.png"),
+        ]
+        assert [(a["image_id"], a["bbox"]) for a in written["annotations"]] == expected
+    written = json.loads(direct.read_text())
+    assert written["categories"] == [{"id": 2, "name": "green"}, {"id": 5, "name": "red"}]
+    assert [a["category_id"] for a in written["annotations"]] == [5, 2, 5]

@@ -33,17 +33,24 @@ def test_recommended_runs_the_learned_verifier_and_a_state_classifier():
     )
 
 
-def test_files_win_over_preset_names_and_unknown_names_are_one_error(tmp_path, monkeypatch):
+def test_preset_names_win_over_files_named_alike_and_unknown_names_are_one_error(
+    tmp_path, monkeypatch
+):
+    """A value is a file when it holds a separator or ends in .yaml/.yml, else a preset: a
+    file ``recommended`` in the working folder does not hide the shipped preset."""
     mine = tmp_path / "recommended"
     mine.write_text("detector: gray-tophat\n")
     assert resolve_config(mine) == mine
     monkeypatch.chdir(tmp_path)
-    assert load_config("recommended")["detector"]["name"] == "gray-tophat"
+    assert load_config("recommended")["detector"]["name"] == "union"
+    assert load_config("./recommended")["detector"]["name"] == "gray-tophat"
     assert resolve_config("missing.yaml").name == "missing.yaml"  # a file name stays a file
     with pytest.raises(TsrkitError, match=r"presets: .*recommended"):
         preset_path("nope")
+    (tmp_path / "nope").write_text("detector: gray-tophat\n")
     result = CliRunner().invoke(cli, ["benchmark", "--config", "nope", "-q"])
     assert result.exit_code == 2 and "no preset called 'nope'" in result.output
+    assert "for the file, write ./nope" in result.output
 
 
 def test_presets_command_lists_and_shows():

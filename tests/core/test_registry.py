@@ -1,6 +1,7 @@
 """The plugin registry: in-process registration, entry-point discovery, failures, filtering."""
 
 import json
+import os
 import subprocess
 import sys
 
@@ -169,3 +170,71 @@ def test_a_plugin_receives_the_plugin_it_is_built_on_and_old_schemas_fail_clearl
     with pytest.raises(ParamError, match="cannot be built on itself"):
         reg.create("detector", "stacked", {"inner": "stacked"})
     assert "name the tuple 'PARAMS'" in " ".join(f.error for f in reg.failures)
+
+
+def installed_package(site, name: str, code: str):
+    """A distribution ``name`` installed on the folder ``site`` (a ``.dist-info`` folder and
+    one module) whose one ``tsrkit`` entry point is its module, holding ``code``."""
+    module = name.replace("-", "_")
+    (site / f"{module}.py").write_text(code)
+    info = site / f"{module}-1.0.dist-info"
+    info.mkdir(parents=True)
+    (info / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {name}\nVersion: 1.0\n")
+    (info / "entry_points.txt").write_text(f"[tsrkit]\n{module} = {module}\n")
+    return site
+
+
+def run_with(site, *args: str) -> subprocess.CompletedProcess:
+    """``tsrkit ARGS`` in a fresh interpreter that sees the packages installed on ``site``."""
+    env = {**os.environ, "PYTHONPATH": str(site)}
+    command = [sys.executable, "-m", "tsrkit", *args]
+    return subprocess.run(command, capture_output=True, text=True, env=env, timeout=300)
+
+
+def test_a_plugin_calling_sys_exit_at_import_is_a_failed_plugin(tmp_path):
+    site = installed_package(tmp_path, "acme-exits", "import sys\nsys.exit(3)\n")
+    helped = run_with(site, "--help")
+    assert helped.returncode == 0 and "detect" in helped.stdout, helped.stderr
+    listed = run_with(site, "plugins", "--json")
+    failed = [p for p in json.loads(listed.stdout) if p["kind"] == "failed"]
+    assert failed == [
+        {
+            "name": "acme_exits",
+            "kind": "failed",
+            "package": "acme-exits",
+            "error": "called sys.exit(3) while loading",
+        }
+    ]
+
+
+CLASH = """\
+import tsrkit
+from tsrkit.hookspecs import hookimpl
+
+
+class Mine(tsrkit.Detector):
+    name = "gray-tophat"
+    summary = "another package's detector of a built-in's name"
+
+    def detect(self, frame):
+        return []
+
+
+@hookimpl
+def register_detectors(register):
+    register(Mine)
+"""
+
+
+def test_a_plugin_of_a_builtins_name_is_one_warning_and_the_builtin_stays(tmp_path):
+    site = installed_package(tmp_path, "acme-clash", CLASH)
+    result = run_with(site, "plugins", "--json")
+    assert result.returncode == 0, result.stderr
+    warning = (
+        "warning: duplicate detector name 'gray-tophat': registered by acme-clash and by "
+        "tsrkit; tsrkit's is kept, acme-clash's is not used\n"
+    )
+    assert result.stderr == warning
+    plugins = json.loads(result.stdout)
+    tophat = [p for p in plugins if p["name"] == "gray-tophat"]
+    assert [p["package"] for p in tophat] == ["tsrkit"]

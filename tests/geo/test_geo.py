@@ -76,10 +76,10 @@ def test_movement_follows_eq_3_29_threshold():
 
 def test_interpolation_reports_gaps_instead_of_bridging(tmp_path):
     path = tmp_path / "g.csv"
-    path.write_text("time,lat,lon\n0,47.0,-122.0\n1,47.001,-122.0\n20,47.002,-122.0\n")
+    path.write_text("time,lat,lon\n0,47.0,-122.0\n1,47.0005,-122.0\n20,47.001,-122.0\n")
     track = read_track(path)
     lat, _ = track.at(np.array([0.5, 10.0, 30.0]))
-    assert lat[0] == pytest.approx(47.0005) and np.isnan(lat[1]) and np.isnan(lat[2])
+    assert lat[0] == pytest.approx(47.00025) and np.isnan(lat[1]) and np.isnan(lat[2])
     assert track.gaps() == [(1.0, 20.0)]
 
 

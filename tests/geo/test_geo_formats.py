@@ -137,7 +137,10 @@ RMC = "$GPRMC,123519,A,4807.038,N,01131.000,E,022.4,084.4,230394,003.1,W*6A"
             "line 1: bad GGA field",
         ),
         (RMC.replace("4807.038", "9107.038")[:-3], "line 1: latitude 91.1173 / longitude"),
-        (RMC + "\n" + RMC + "\n", "line 2: times are not increasing"),
+        (
+            RMC + "\n" + RMC.replace("4807.038", "4807.039")[:-3] + "\n",
+            "line 2: times are not increasing",
+        ),
     ],
 )
 def test_malformed_nmea_names_the_line(tmp_path, text, fragment):

@@ -103,11 +103,15 @@ def test_mutated_files_read_or_fail_with_one_clear_line(tmp_path, suffix):
     check()
 
 
+#: Tracks a vehicle can drive: each step at most 0.0005 degrees in latitude and longitude
+#: (79 m) in at least 1 s, below ``read_track``'s plausible speed.
 tracks = st.integers(1, 30).flatmap(
     lambda n: st.tuples(
         st.lists(st.integers(1, 600), min_size=n, max_size=n),
-        st.lists(st.floats(-89.0, 89.0), min_size=n, max_size=n),
-        st.lists(st.floats(-179.0, 179.0), min_size=n, max_size=n),
+        st.floats(-88.0, 88.0),
+        st.floats(-178.0, 178.0),
+        st.lists(st.floats(-0.0005, 0.0005), min_size=n, max_size=n),
+        st.lists(st.floats(-0.0005, 0.0005), min_size=n, max_size=n),
     )
 )
 
@@ -115,7 +119,8 @@ tracks = st.integers(1, 30).flatmap(
 @FAST
 @given(tracks, st.sampled_from([".csv", ".gpx", ".nmea"]))
 def test_any_valid_track_round_trips(tmp_path, columns, suffix):
-    steps, lat, lon = columns
+    steps, lat0, lon0, north, east = columns
+    lat, lon = (lat0 + np.cumsum(north)).tolist(), (lon0 + np.cumsum(east)).tolist()
     track = Track("t", 946684800.0 + np.cumsum(steps), np.array(lat), np.array(lon))
     path = tmp_path / f"drive{suffix}"
     if suffix == ".csv":

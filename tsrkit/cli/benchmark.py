@@ -12,7 +12,7 @@ from collections.abc import Sequence
 
 import click
 
-from tsrkit.cli.common import FiniteFloatRange, plugin_options
+from tsrkit.cli.common import FiniteFloatRange, plugin_options, split_name
 from tsrkit.cli.completion import dataset_names, plugin_list, plugin_names, preset_or_file
 from tsrkit.cli.errors import UserError
 from tsrkit.eval.settings import BOX_OPTIONS
@@ -61,7 +61,9 @@ def dataset_options(func):
             type=click.Path(file_okay=False),
             help="Root that image paths inside the annotation file resolve against.",
         ),
-        click.option("--split", default=None, help="Use only this split (e.g. test)."),
+        click.option(
+            "--split", default=None, callback=split_name, help="Use only this split (e.g. test)."
+        ),
     ]
     for option in reversed(options):
         func = option(func)

@@ -11,7 +11,7 @@ import click
 from tsrkit.cli.completion import plugin_names, preset_or_file
 from tsrkit.selection import DEFAULT_DETECTOR
 
-__all__ = ["FiniteFloatRange", "plugin_options"]
+__all__ = ["FiniteFloatRange", "plugin_options", "split_name"]
 
 
 def plugin_options(func=None, *, tracker: bool = True):
@@ -69,13 +69,21 @@ def plugin_options(func=None, *, tracker: bool = True):
             type=click.Path(dir_okay=False),
             default=None,
             help="YAML run configuration (plugins and their params) or a preset name "
-            "(tsrkit presets).",
+            "(tsrkit presets). A file when it holds a / or ends in .yaml or .yml, else a preset "
+            "(./NAME for a file NAME).",
             shell_complete=preset_or_file,
         ),
     ]
     for option in reversed(options):
         func = option(func)
     return func
+
+
+def split_name(ctx: click.Context, param: click.Parameter, value: str | None) -> str | None:
+    """The ``--split`` callback: refuse the empty name, which would keep every split."""
+    if value is not None and not value.strip():
+        raise click.BadParameter("empty split name (leave --split out for every split)")
+    return value
 
 
 class FiniteFloatRange(click.FloatRange):

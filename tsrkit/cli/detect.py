@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import contextlib
+import json
 import os
 import sys
 from collections.abc import Iterator
 from contextlib import nullcontext
 from pathlib import Path
-from typing import TextIO
+from typing import Literal, NamedTuple, TextIO
 
 import click
 import cv2
@@ -24,13 +25,61 @@ from tsrkit.follow import Follower
 from tsrkit.inputs import IMAGE_EXTENSIONS, VIDEO_EXTENSIONS, check_range
 from tsrkit.outlock import locked_file
 from tsrkit.outputs import reading, refuse_input, refuse_special, writing
+from tsrkit.records import FrameRecord
 from tsrkit.report import ProgressBar
 from tsrkit.selection import build
 from tsrkit.streams import Runner, run_pipeline
 from tsrkit.types import Frame, Skipped
 from tsrkit.workers import check_workers
 
-__all__ = ["default_inputs", "detect_command", "flushed_output", "run_detect"]
+__all__ = [
+    "Resumed",
+    "default_inputs",
+    "detect_command",
+    "flushed_output",
+    "read_partial",
+    "run_detect",
+]
+
+
+class Resumed(NamedTuple):
+    """What the ``OUT.partial`` of an aborted run holds (``detect --resume``)."""
+
+    #: Each input's last frame done (0 for an image).
+    done: dict[str, int]
+    #: Frames and detections written.
+    frames: int
+    detections: int
+
+
+def read_partial(partial: Path) -> Resumed:
+    """The frames an aborted run wrote to ``partial``, which is cut after its last whole record
+    (a run killed while writing a line leaves half of one).
+
+    Raises
+    ------
+    UserError
+        When ``partial`` cannot be read.
+    """
+    done: dict[str, int] = {}
+    frames = detections = kept = 0
+    try:
+        with open(partial, "r+b") as fh:
+            for line in fh:
+                try:
+                    record = FrameRecord.from_json(json.loads(line))
+                except (ValueError, KeyError, TypeError):
+                    break
+                if not line.endswith(b"\n"):
+                    break
+                done[record.source] = record.index
+                frames += 1
+                detections += len(record.detections)
+                kept += len(line)
+            fh.truncate(kept)
+    except OSError as exc:
+        raise UserError(f"{partial}: cannot resume from it: {exc.strerror or exc}") from None
+    return Resumed(done, frames, detections)
 
 
 def run_detect(
@@ -44,6 +93,7 @@ def run_detect(
     workers: int = 1,
     progress: bool = False,
     agree: int = 1,
+    resumed: Resumed | None = None,
 ) -> tuple[int, int, list[Skipped]]:
     """Write one JSON Lines record per frame to the text stream ``out``, in input order.
 
@@ -52,7 +102,10 @@ def run_detect(
     ``workers`` > 1 runs the pipeline in worker processes (:func:`tsrkit.streams.run_pipeline`);
     overlays (``draw``) need the frames here, so they need one worker. ``progress`` shows a
     progress bar (frames done, frames/s) on stderr. ``agree`` > 1 keeps only the detections
-    whose light is found on that many consecutive frames (:class:`tsrkit.agreement.Agreement`).
+    whose light is found on that many consecutive video frames
+    (:class:`tsrkit.agreement.Agreement`; still images keep every detection).
+    ``resumed``: the frames an aborted run already wrote, which are not run again (and are
+    counted in the totals).
 
     Returns
     -------
@@ -60,9 +113,11 @@ def run_detect(
     """
     if draw is not None and workers > 1:
         raise TsrkitError("--draw needs the frames in this process: use it with --workers 1")
-    frames = detections = 0
+    done, frames, detections = resumed or Resumed({}, 0, 0)
     skipped: list[Skipped] = []
-    stream = run_pipeline(pipeline, paths, every=every, start=start, end=end, workers=workers)
+    stream = run_pipeline(
+        pipeline, paths, every=every, start=start, end=end, workers=workers, done=done
+    )
     if agree > 1:
         stream = Agreement(agree).filter(stream)
     with ProgressBar(None, progress, "detect") as bar:  # type: ignore[arg-type]
@@ -79,15 +134,17 @@ def run_detect(
 
 
 @contextlib.contextmanager
-def flushed_output(out: Path) -> Iterator[TextIO]:
+def flushed_output(out: Path, resume: bool = False) -> Iterator[TextIO]:
     """Write ``OUT.partial`` one flushed line per frame, renamed to ``OUT`` when the run ends.
 
     A run that aborts (an error, Ctrl-C) keeps ``OUT.partial`` with every frame done so far and
-    says so; ``OUT`` itself is only ever a complete run's output.
+    says so; ``OUT`` itself is only ever a complete run's output. ``resume`` appends to an
+    existing ``OUT.partial`` instead of starting it anew.
     """
     partial = out.with_name(out.name + ".partial")
     partial.parent.mkdir(parents=True, exist_ok=True)
-    with open(partial, "w", encoding="utf-8", buffering=1) as fh:  # line-buffered: flushed
+    mode: Literal["a", "w"] = "a" if resume else "w"
+    with open(partial, mode, encoding="utf-8", buffering=1) as fh:  # line-buffered: flushed
         try:
             yield fh
         except BaseException:
@@ -137,6 +194,13 @@ def default_inputs() -> list[str]:
     "as it completes, and renamed to OUT at the end (an aborted run keeps OUT.partial).",
 )
 @click.option(
+    "--resume",
+    is_flag=True,
+    help="Go on with the OUT.partial an aborted run left (same PATHS and options): its frames "
+    "are kept and not run again. Not with a tracker, --key-every or --agree, which carry "
+    "lights from frame to frame.",
+)
+@click.option(
     "--draw",
     type=click.Path(file_okay=False),
     default=None,
@@ -167,7 +231,8 @@ def default_inputs() -> list[str]:
     default=1,
     show_default=True,
     help="Videos: report a detection only when its light is found on at least N consecutive "
-    "frames (from its first frame on; the output lags up to N-1 frames). 1: every detection.",
+    "frames (from its first frame on; the output lags up to N-1 frames). 1: every detection. "
+    "Still images have no next frame: their detections are all reported.",
 )
 @click.option(
     "--quiet",
@@ -184,6 +249,7 @@ def detect_command(
     params,
     config,
     out,
+    resume,
     draw,
     every,
     start,
@@ -223,18 +289,42 @@ def detect_command(
         pipeline = build(detector, verifier, classifier, tracker, params, config).pipeline()
     if key_every > 1 and pipeline.tracker is not None:
         raise UserError("--key-every and --tracker both carry lights between frames: choose one")
+    if resume and out is None:
+        raise UserError("--resume goes on with OUT.partial: it needs --out OUT")
+    if resume and (pipeline.tracker is not None or key_every > 1 or agree > 1):
+        raise UserError(
+            "--resume: a tracker, --key-every and --agree carry lights from frame to frame, "
+            "so a resumed run would differ; run again without --resume"
+        )
     runner = Follower(pipeline, key_every) if key_every > 1 else pipeline
     if draw_dir is not None:
         draw_dir.mkdir(parents=True, exist_ok=True)
-    sink = flushed_output(out) if out else nullcontext(sys.stdout)
     progress = not quiet and Console(stderr=True).is_terminal  # no bar in redirected logs
     partial = out.with_name(out.name + ".partial") if out else None
     lock = locked_file(out) if out else nullcontext()
-    with lock, writing([out, partial, draw_dir]), sink as stream:
-        frames, found, skipped = run_detect(
-            runner, inputs, stream, draw_dir, every, start, end, workers, progress, agree
-        )
     console = Console(stderr=True, soft_wrap=True)  # one line per skipped input, never wrapped
+    with lock, writing([out, partial, draw_dir]):
+        resumed = None
+        if resume and partial is not None and partial.is_file():
+            resumed = read_partial(partial)
+            console.print(f"resuming after the {resumed.frames} frames in {partial}", markup=False)
+        elif resume:
+            console.print(f"no {partial} to resume: starting at the first frame", markup=False)
+        sink = flushed_output(out, resumed is not None) if out else nullcontext(sys.stdout)
+        with sink as stream:
+            frames, found, skipped = run_detect(
+                runner,
+                inputs,
+                stream,
+                draw_dir,
+                every,
+                start,
+                end,
+                workers,
+                progress,
+                agree,
+                resumed,
+            )
     console.print(
         f"[bold]{frames}[/bold] frames, [bold]{found}[/bold] detections, "
         f"[bold]{len(skipped)}[/bold] skipped" + (f" -> {out}" if out else "")

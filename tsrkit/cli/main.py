@@ -14,22 +14,39 @@ import contextlib
 import importlib
 import os
 import sys
+import warnings
 from importlib import metadata
 
 import click
 
 from tsrkit.cli.errors import UserError, describe_os_error
 from tsrkit.cli.verbs import VERBS
-from tsrkit.errors import TsrkitError
+from tsrkit.errors import TsrkitError, TsrkitWarning
 from tsrkit.hookspecs import ENTRY_POINT_GROUP
 
 __all__ = ["TsrkitGroup", "cli", "main"]
 
 
 class TsrkitGroup(click.Group):
-    """A click group that loads verbs on demand and reports :class:`TsrkitError` and
+    """A click group that loads verbs on demand, reports :class:`TsrkitError` and
     operating-system errors (an unwritable ``--out``, a full disk) as one line and exit
-    status 2."""
+    status 2, and each :class:`TsrkitWarning` as one ``warning:`` line on stderr."""
+
+    def main(self, *args, **kwargs):
+        """Run the command line, each :class:`TsrkitWarning` (plugins load while ``--help``
+        is parsed, too) printed as one ``warning:`` line."""
+        shown = warnings.showwarning
+
+        def show(message, category, *rest, **options):
+            if issubclass(category, TsrkitWarning):
+                click.echo(f"warning: {message}", err=True)
+            else:
+                shown(message, category, *rest, **options)
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("always", TsrkitWarning)
+            warnings.showwarning = show
+            return super().main(*args, **kwargs)
 
     def invoke(self, ctx: click.Context):
         try:
@@ -127,7 +144,7 @@ def _add_commands() -> None:
     for impl in registry.pm.hook.register_commands.get_hookimpls():
         try:
             impl.function(cli=cli)
-        except Exception as exc:  # one broken plugin must not break the command line
+        except (Exception, SystemExit) as exc:  # one broken plugin must not break the command line
             registry.failures.append(
                 PluginFailure(
                     impl.plugin_name, "?", f"register_commands: {type(exc).__name__}: {exc}"

@@ -7,6 +7,7 @@ from contextlib import nullcontext
 import click
 from rich.console import Console
 
+from tsrkit.cli.common import split_name
 from tsrkit.cli.completion import dataset_names, plugin_names, trainable_names
 from tsrkit.errors import TsrkitError
 from tsrkit.models import model_paths
@@ -45,7 +46,10 @@ __all__ = ["train_command"]
     help="Root that image paths inside the annotation file resolve against.",
 )
 @click.option(
-    "--split", default=None, help="Use only this split (e.g. train) of datasets given without one."
+    "--split",
+    default=None,
+    callback=split_name,
+    help="Use only this split (e.g. train) of datasets given without one.",
 )
 @click.option(
     "--param",

@@ -41,7 +41,8 @@ class DatasetError(TsrkitError):
 
 
 def read_text(path: str | os.PathLike, missing: str = "file not found") -> str:
-    """The whole text of a UTF-8 file.
+    """The whole text of a UTF-8 file (a byte-order mark, which Windows tools write, is
+    dropped).
 
     Raises
     ------
@@ -68,7 +69,7 @@ def read_text(path: str | os.PathLike, missing: str = "file not found") -> str:
             path, missing if exc.problem == "no such file" else exc.problem
         ) from None
     try:
-        return data.decode("utf-8")
+        return data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
         line = data.count(b"\n", 0, exc.start) + 1
         problem = f"not valid UTF-8 (byte 0x{data[exc.start]:02x} at offset {exc.start})"

@@ -12,7 +12,9 @@ __all__ = ["image_size"]
 
 
 def image_size(path: str | os.PathLike) -> tuple[int, int]:
-    """``(width, height)`` of the image at ``path``, read from its header by Pillow.
+    """``(width, height)`` of the image at ``path``, read from its header by Pillow, upright:
+    swapped when its EXIF orientation turns it by 90 degrees (as
+    :func:`tsrkit.images.read_image` does).
 
     Raises
     ------
@@ -21,8 +23,10 @@ def image_size(path: str | os.PathLike) -> tuple[int, int]:
     """
     try:
         with Image.open(path) as image:
-            return int(image.width), int(image.height)
+            turned = image.getexif().get(0x0112) in (5, 6, 7, 8)  # 0x0112: Orientation
+            size = int(image.width), int(image.height)
     except FileNotFoundError:
         raise DatasetError(path, "image not found (needed for its size)") from None
     except (UnidentifiedImageError, OSError) as exc:
         raise DatasetError(path, f"cannot read image size ({exc})") from None
+    return (size[1], size[0]) if turned else size

@@ -9,13 +9,14 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
+import warnings
 from collections.abc import Mapping
 from pathlib import Path
 
 from tsrkit.datasets.errors import DatasetError
 from tsrkit.datasets.registry import DatasetEntry, load_registry
 from tsrkit.datasets.states import check_mapping, to_state
-from tsrkit.errors import TsrkitError
+from tsrkit.errors import TsrkitError, TsrkitWarning
 from tsrkit.files import InputFileError, not_regular, read_json
 from tsrkit.registry import get_registry
 from tsrkit.types import Annotation, Dataset
@@ -90,9 +91,14 @@ def read_dataset(path: Path, format: str, images: Path | None = None) -> Dataset
     ------
     DatasetError
         A malformed file: the reader's own error, or one made here of what a reader let
-        through (invalid UTF-8, values of the wrong type, a box that is not finite or has no
-        area, or lies wholly outside the image size its sample declares), naming the file and
-        the problem.
+        through (invalid UTF-8, values of the wrong type, a box that is not finite, or lies
+        wholly outside the image size its sample declares), naming the file and the problem.
+
+    Warns
+    -----
+    TsrkitWarning
+        Boxes of zero width or height (a stray click in a labelling tool) are left out, and
+        one warning names them.
     """
     reader = get_registry().create("format", format)
     try:
@@ -102,21 +108,49 @@ def read_dataset(path: Path, format: str, images: Path | None = None) -> Dataset
     except (UnicodeDecodeError, TypeError, KeyError, IndexError, ValueError, AttributeError) as exc:
         problem = f"malformed {format} data ({type(exc).__name__}: {exc})"
         raise DatasetError(path, problem) from None
+    flat: list[str] = []
     for sample in dataset.samples:
         for k, ann in enumerate(sample.annotations):
             x0, y0, x1, y1 = (float(v) for v in ann.bbox)
-            if not all(math.isfinite(v) for v in (x0, y0, x1, y1)) or x1 <= x0 or y1 <= y0:
+            if not all(math.isfinite(v) for v in (x0, y0, x1, y1)) or x1 < x0 or y1 < y0:
                 where = f"{Path(sample.source).name}, box {k}"
                 raise DatasetError(
                     path, f"box {tuple(ann.bbox)} is not finite or has no area", where
                 )
+            if x1 == x0 or y1 == y0:
+                flat.append(f"{Path(sample.source).name} box {k} {tuple(ann.bbox)}")
             w, h = sample.width, sample.height
             if w and h and (x0 >= w or y0 >= h or x1 <= 0 or y1 <= 0):
                 where = f"{Path(sample.source).name}, box {k}"
                 raise DatasetError(
                     path, f"box {tuple(ann.bbox)} lies outside the {w}x{h} image", where
                 )
+    if flat:
+        warnings.warn(
+            f"{path}: {len(flat)} box(es) of zero width or height left out: "
+            + "; ".join(flat[:3])
+            + ("; ..." if len(flat) > 3 else ""),
+            TsrkitWarning,
+            stacklevel=2,
+        )
+        dataset = _without_flat_boxes(dataset)
     return dataset
+
+
+def _without_flat_boxes(dataset: Dataset) -> Dataset:
+    """``dataset`` without its boxes of zero width or height."""
+    return dataclasses.replace(
+        dataset,
+        samples=tuple(
+            dataclasses.replace(
+                sample,
+                annotations=tuple(
+                    a for a in sample.annotations if a.bbox[2] > a.bbox[0] and a.bbox[3] > a.bbox[1]
+                ),
+            )
+            for sample in dataset.samples
+        ),
+    )
 
 
 def detect_format(path: Path) -> str:

@@ -6,35 +6,50 @@ from __future__ import annotations
 import csv
 import math
 import os
+import warnings
 from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
 
 import numpy as np
 
+from tsrkit.errors import TsrkitWarning
 from tsrkit.geo.errors import GeoError, read_text
 from tsrkit.geo.gpx import gpx_rows
 from tsrkit.geo.nmea import nmea_rows
 
-__all__ = ["Rows", "Track", "log_format", "read_track"]
+__all__ = ["MAX_SPEED", "MIN_JUMP_M", "Rows", "Track", "log_format", "read_track"]
+
+#: The fastest a logged vehicle moves between two fixes, m/s (324 km/h, past any road vehicle):
+#: a faster step is a receiver glitch or a jump between two logs, never a drive.
+MAX_SPEED = 90.0
+#: Steps shorter than this, metres, are never a jump, however fast: the position noise of a log
+#: of 10 Hz or more moves a fix that far between neighbours.
+MIN_JUMP_M = 50.0
 
 
 @dataclass(frozen=True)
 class Track:
-    """GPS fixes in time order: UTC seconds since the epoch, latitude and longitude (degrees)."""
+    """GPS fixes in time order: UTC seconds since the epoch, latitude and longitude (degrees).
+
+    ``breaks`` are the indices of the fixes that start a new piece of the log: the step from
+    the fix before is faster than :data:`MAX_SPEED`, so no position is interpolated across it.
+    """
 
     source: str
     time: np.ndarray
     lat: np.ndarray
     lon: np.ndarray
+    breaks: tuple[int, ...] = ()
 
     def __len__(self) -> int:
         return len(self.time)
 
     def at(self, times: np.ndarray, max_gap: float = 5.0) -> tuple[np.ndarray, np.ndarray]:
         """Latitude and longitude at ``times`` by linear interpolation between the two fixes
-        around each (Eq. 4.2); NaN where the fixes are more than ``max_gap`` seconds apart or
-        ``times`` lie outside the track: a gap is reported, never bridged."""
+        around each (Eq. 4.2); NaN where the fixes are more than ``max_gap`` seconds apart, or
+        across one of the ``breaks``, or ``times`` lie outside the track: a gap is reported,
+        never bridged."""
         times = np.asarray(times, np.float64)
         right = np.clip(np.searchsorted(self.time, times), 1, len(self.time) - 1)
         left = right - 1
@@ -42,15 +57,16 @@ class Track:
         w = np.where(span > 0, (times - self.time[left]) / np.where(span > 0, span, 1), 0.0)
         lat = self.lat[left] + w * (self.lat[right] - self.lat[left])
         lon = self.lon[left] + w * (self.lon[right] - self.lon[left])
-        bad = (span > max_gap) | (times < self.time[0]) | (times > self.time[-1])
+        jump = np.isin(right, self.breaks) & (times < self.time[right])
+        bad = (span > max_gap) | jump | (times < self.time[0]) | (times > self.time[-1])
         return np.where(bad, np.nan, lat), np.where(bad, np.nan, lon)
 
     def gaps(self, max_gap: float = 5.0) -> list[tuple[float, float]]:
-        """(start, end) UTC seconds of every gap between fixes longer than ``max_gap``."""
+        """(start, end) UTC seconds of every gap between fixes longer than ``max_gap``, and of
+        every one of the ``breaks``."""
         step = np.diff(self.time)
-        return [
-            (float(self.time[i]), float(self.time[i + 1])) for i in np.flatnonzero(step > max_gap)
-        ]
+        ends = sorted({*np.flatnonzero(step > max_gap).tolist(), *(i - 1 for i in self.breaks)})
+        return [(float(self.time[i]), float(self.time[i + 1])) for i in ends]
 
 
 def _whitespace_time(date: str, clock: str) -> float:
@@ -172,12 +188,21 @@ def read_track(path: str | os.PathLike) -> Track:
         Naming the file and line (GPX: track point): missing file, invalid text, wrong column
         count or tags, a value that is not a number, NaN, a time outside the years 1970-9999,
         a latitude or longitude out of range, times not increasing, or no fix at all.
+
+    Warns
+    -----
+    TsrkitWarning
+        A fix that exactly repeats the one before is left out; so is a glitch fix, reached and
+        left faster than :data:`MAX_SPEED` (over more than :data:`MIN_JUMP_M`) while its
+        neighbours are not that far apart; any other step that fast splits the log
+        (:attr:`Track.breaks`). One warning for each, naming the line.
     """
     path = Path(path)
     rows, _ = _rows(path)
     if not rows:
         raise GeoError(path, "no GPS fix in the file")
     previous = -math.inf
+    kept: Rows = []
     for number, t, la, lo in rows:
         if not all(math.isfinite(v) for v in (t, la, lo)):
             raise GeoError(path, "time, latitude or longitude is not finite", number)
@@ -185,8 +210,67 @@ def read_track(path: str | os.PathLike) -> Track:
             raise GeoError(path, f"time {t:g} s is outside the years 1970-9999", number)
         if not -90 <= la <= 90 or not -180 <= lo <= 180:
             raise GeoError(path, f"latitude {la} / longitude {lo} out of range", number)
+        if kept and kept[-1][1:] == (t, la, lo):
+            _warn(path, number, "exactly repeats the fix before: left out")
+            continue
         if t <= previous:
             raise GeoError(path, "times are not increasing (sort the log)", number)
         previous = t
-    columns = np.array([row[1:] for row in rows], np.float64)
-    return Track(str(path), columns[:, 0], columns[:, 1], columns[:, 2])
+        kept.append((number, t, la, lo))
+    kept, breaks = _plausible(path, kept)
+    columns = np.array([row[1:] for row in kept], np.float64)
+    return Track(str(path), columns[:, 0], columns[:, 1], columns[:, 2], tuple(breaks))
+
+
+Fix = tuple[int | str, float, float, float]
+
+
+def _metres(a: Fix, b: Fix) -> float:
+    """Great-circle distance from fix ``a`` to fix ``b`` (haversine, mean Earth radius)."""
+    p0, p1 = math.radians(a[2]), math.radians(b[2])
+    h = (
+        math.sin((p1 - p0) / 2) ** 2
+        + math.cos(p0) * math.cos(p1) * math.sin(math.radians(b[3] - a[3]) / 2) ** 2
+    )
+    return 2 * 6_371_008.8 * math.asin(min(1.0, math.sqrt(h)))
+
+
+def _too_fast(a: Fix, b: Fix) -> bool:
+    """Whether the step from fix ``a`` to the later fix ``b`` is no drive: faster than
+    :data:`MAX_SPEED` over more than :data:`MIN_JUMP_M`."""
+    metres = _metres(a, b)
+    return metres > MIN_JUMP_M and metres > MAX_SPEED * (b[1] - a[1])
+
+
+def _plausible(path: Path, rows: Rows) -> tuple[Rows, list[int]]:
+    """``rows`` without glitch fixes, and the indices where a jump faster than
+    :data:`MAX_SPEED` splits what is left (see :func:`read_track`)."""
+    kept = list(rows)
+    k = 1
+    while k < len(kept) - 1:
+        before, fix, after = kept[k - 1 : k + 2]
+        if _too_fast(before, fix) and _too_fast(fix, after) and not _too_fast(before, after):
+            _warn(
+                path,
+                fix[0],
+                f"a glitch: the fix {fix[2]:.6f}, {fix[3]:.6f} is reached and left faster than "
+                f"{MAX_SPEED:g} m/s: left out",
+            )
+            del kept[k]
+            continue
+        k += 1
+    breaks = [k for k in range(1, len(kept)) if _too_fast(kept[k - 1], kept[k])]
+    for k in breaks:
+        _warn(
+            path,
+            kept[k][0],
+            f"the log jumps {_metres(kept[k - 1], kept[k]):,.0f} m in "
+            f"{kept[k][1] - kept[k - 1][1]:g} s (faster than {MAX_SPEED:g} m/s): split there, "
+            "no position is interpolated across the jump",
+        )
+    return kept, breaks
+
+
+def _warn(path: Path, line: int | str, problem: str) -> None:
+    """One :class:`TsrkitWarning` naming ``path`` and ``line``, worded as :class:`GeoError`."""
+    warnings.warn(str(GeoError(path, problem, line)), TsrkitWarning, stacklevel=3)

@@ -2,7 +2,9 @@
 
 A preset is a YAML run configuration (:func:`tsrkit.params.load_config`) in this folder; its
 ``description`` key says in one line what it is for. ``--config`` takes a preset name wherever
-it takes a file.
+it takes a file: a value is a file when it holds a path separator or ends in ``.yaml`` or
+``.yml``, else a preset name (a file ``recommended`` in the working folder does not hide the
+preset; write ``./recommended`` for it).
 
 >>> "recommended" in preset_names()
 True
@@ -44,12 +46,23 @@ def preset_path(name: str) -> Path:
 
 
 def resolve_config(ref: str | os.PathLike) -> Path:
-    """A run configuration's file: ``ref`` itself when it is a path that exists or looks like
-    a file name, else the preset called ``ref``."""
-    path = Path(ref)
-    if path.exists() or path.suffix in (".yaml", ".yml") or len(path.parts) > 1:
-        return path
-    return preset_path(str(ref))
+    """A run configuration's file: ``ref`` itself when it holds a path separator or ends in
+    ``.yaml`` or ``.yml``, else the preset called ``ref``.
+
+    Raises
+    ------
+    TsrkitError
+        When ``ref`` is a name no preset has (saying how to name a file of that name).
+    """
+    text = os.fspath(ref)
+    separators = {"/", os.sep, os.altsep} - {None}
+    if any(s in text for s in separators) or Path(text).suffix.lower() in (".yaml", ".yml"):
+        return Path(text)
+    try:
+        return preset_path(text)
+    except TsrkitError as exc:
+        hint = f"; for the file, write ./{text}" if Path(text).exists() else ""
+        raise TsrkitError(f"{exc}{hint}") from None
 
 
 def describe(name: str) -> str:
