@@ -23,11 +23,11 @@ from pathlib import Path  # noqa: E402
 import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
+from tsrkit.core.geometry import iou_matrix  # noqa: E402
+from tsrkit.core.types import Annotation, Sample  # noqa: E402
 from tsrkit.eval.overlap import score_overlap, summarise_overlap  # noqa: E402
-from tsrkit.geometry import iou_matrix  # noqa: E402
-from tsrkit.inputs import iter_frames  # noqa: E402
-from tsrkit.pipeline import Pipeline  # noqa: E402
-from tsrkit.types import Annotation, Sample  # noqa: E402
+from tsrkit.plugin.pipeline import Pipeline  # noqa: E402
+from tsrkit.runner.inputs import iter_frames  # noqa: E402
 from tsrkit_plugins.detectors.adaboost_hsv import AdaBoostHSV  # noqa: E402
 from tsrkit_plugins.trackers.meanshift import MeanShift  # noqa: E402
 

@@ -25,12 +25,12 @@ import harness
 import numpy as np
 from scipy.stats import wilcoxon
 
+from tsrkit.core.geometry import iou_matrix
+from tsrkit.core.types import Candidate
 from tsrkit.eval.overlap import match_by_iou
-from tsrkit.geometry import iou_matrix
-from tsrkit.models import save_model
-from tsrkit.registry import get_registry
+from tsrkit.plugin.models import save_model
+from tsrkit.plugin.registry import get_registry
 from tsrkit.synth.sunlit import sweep
-from tsrkit.types import Candidate
 
 #: Lee's sequences A-G (Sun behind) and H-K (Sun ahead), by their mean relative azimuth.
 SEQUENCES = {"A": 75, "B": 62, "C": 34, "D": 19, "E": 1, "F": 8, "G": 13,

@@ -23,12 +23,12 @@ from pathlib import Path
 import harness
 import numpy as np
 
+from tsrkit.core.types import Candidate
 from tsrkit.eval.overlap import match_by_iou
-from tsrkit.models import save_model
-from tsrkit.params import parse_assignments
-from tsrkit.registry import get_registry
+from tsrkit.plugin.models import save_model
+from tsrkit.plugin.params import parse_assignments
+from tsrkit.plugin.registry import get_registry
 from tsrkit.synth.sunlit import LENSES, sweep
-from tsrkit.types import Candidate
 
 SEQUENCES = {"A": 75, "B": 62, "C": 34, "D": 19, "E": 1, "F": 8, "G": 13,
              "H": 96, "I": 112, "J": 154, "K": 172}  # fmt: skip

@@ -48,6 +48,8 @@ Names are imported on first use (PEP 562), so that loading a plugin costs only w
 
 from __future__ import annotations
 
-from tsrkit._lazy import attach_stub
+import lazy_loader as _lazy
 
-__getattr__, __dir__, __all__ = attach_stub(__name__, __file__)
+# The stub's imports are relative to the package (``from .core.types import Frame``), as
+# lazy_loader reads them: each name resolves against ``tsrkit`` on first use.
+__getattr__, __dir__, __all__ = _lazy.attach_stub("tsrkit", __file__)

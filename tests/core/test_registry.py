@@ -7,9 +7,9 @@ import sys
 import pytest
 
 import tsrkit
-from tsrkit.hookspecs import hookimpl
-from tsrkit.params import Param, ParamError
-from tsrkit.registry import PluginNotFound, Registry
+from tsrkit.plugin.hookspecs import hookimpl
+from tsrkit.plugin.params import Param, ParamError
+from tsrkit.plugin.registry import PluginNotFound, Registry
 
 
 class Dummy(tsrkit.Detector):

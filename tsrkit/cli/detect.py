@@ -14,21 +14,21 @@ import click
 import cv2
 from rich.console import Console
 
-from tsrkit.agreement import Agreement
-from tsrkit.atomic import atomic_open, json_line
 from tsrkit.cli.common import plugin_options
 from tsrkit.cli.errors import UserError
-from tsrkit.draw import draw_detections
-from tsrkit.errors import TsrkitError
-from tsrkit.follow import Follower
-from tsrkit.inputs import IMAGE_EXTENSIONS, VIDEO_EXTENSIONS, check_range
-from tsrkit.outlock import locked_file
-from tsrkit.outputs import reading, refuse_input, refuse_special, writing
-from tsrkit.report import ProgressBar
-from tsrkit.selection import build
-from tsrkit.streams import Runner, run_pipeline
-from tsrkit.types import Frame, Skipped
-from tsrkit.workers import check_workers
+from tsrkit.core.atomic import atomic_open, json_line
+from tsrkit.core.errors import TsrkitError
+from tsrkit.core.outputs import reading, refuse_input, refuse_special, writing
+from tsrkit.core.types import Frame, Skipped
+from tsrkit.plugin.selection import build
+from tsrkit.reporting.draw import draw_detections
+from tsrkit.reporting.report import ProgressBar
+from tsrkit.runner.agreement import Agreement
+from tsrkit.runner.follow import Follower
+from tsrkit.runner.inputs import IMAGE_EXTENSIONS, VIDEO_EXTENSIONS, check_range
+from tsrkit.runner.outlock import locked_file
+from tsrkit.runner.streams import Runner, run_pipeline
+from tsrkit.runner.workers import check_workers
 
 __all__ = ["default_inputs", "detect_command", "flushed_output", "run_detect"]
 
@@ -49,10 +49,12 @@ def run_detect(
 
     A frame on which a plugin crashes is reported as skipped and the run goes on; a
     :class:`TsrkitError` from a plugin (a setup problem such as a mismatched model) stops it.
-    ``workers`` > 1 runs the pipeline in worker processes (:func:`tsrkit.streams.run_pipeline`);
+    ``workers`` > 1 runs the pipeline in worker processes
+    (:func:`tsrkit.runner.streams.run_pipeline`);
     overlays (``draw``) need the frames here, so they need one worker. ``progress`` shows a
     progress bar (frames done, frames/s) on stderr. ``agree`` > 1 keeps only the detections
-    whose light is found on that many consecutive frames (:class:`tsrkit.agreement.Agreement`).
+    whose light is found on that many consecutive frames
+    (:class:`tsrkit.runner.agreement.Agreement`).
 
     Returns
     -------

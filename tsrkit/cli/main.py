@@ -20,8 +20,8 @@ import click
 
 from tsrkit.cli.errors import UserError, describe_os_error
 from tsrkit.cli.verbs import VERBS
-from tsrkit.errors import TsrkitError
-from tsrkit.hookspecs import ENTRY_POINT_GROUP
+from tsrkit.core.errors import TsrkitError
+from tsrkit.plugin.hookspecs import ENTRY_POINT_GROUP
 
 __all__ = ["TsrkitGroup", "cli", "main"]
 
@@ -116,7 +116,7 @@ def _add_commands() -> None:
     """Every verb registered through ``register_commands``: the built-in ones (the CLI
     registers :mod:`tsrkit.cli.commands` as an internal plugin) and the plugins'; runs once."""
     from tsrkit.cli import commands
-    from tsrkit.registry import PluginFailure, get_registry
+    from tsrkit.plugin.registry import PluginFailure, get_registry
 
     if getattr(cli, "_hooks_done", False):
         return

@@ -36,8 +36,8 @@ def report_command(run_dir, writers) -> None:
       tsrkit report runs/kr --writer markdown --writer html
     """
     from tsrkit.eval.guard import Failure
-    from tsrkit.registry import get_registry
-    from tsrkit.runfolder import load_run, read_comparison
+    from tsrkit.plugin.registry import get_registry
+    from tsrkit.reporting.runfolder import load_run, read_comparison
 
     folder = Path(run_dir)
     chosen = [get_registry().create("writer", name) for name in writers]

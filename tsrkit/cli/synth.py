@@ -8,9 +8,9 @@ from pathlib import Path
 import click
 from rich.console import Console
 
-from tsrkit.errors import TsrkitError
-from tsrkit.outlock import locked_file
-from tsrkit.outputs import refuse_special
+from tsrkit.core.errors import TsrkitError
+from tsrkit.core.outputs import refuse_special
+from tsrkit.runner.outlock import locked_file
 from tsrkit.synth import LIGHTINGS, generate
 
 __all__ = ["synth_command"]
@@ -72,7 +72,7 @@ def synth_command(
       tsrkit datasets synth --out clip/ --frames 60 --video clip.mp4
     """
     conditions = tuple(c.strip() for c in lighting.split(",") if c.strip())
-    from tsrkit.report import ProgressBar
+    from tsrkit.reporting.report import ProgressBar
 
     if video is not None:
         refuse_special(video, "--video")

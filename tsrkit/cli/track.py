@@ -12,13 +12,13 @@ import click
 from rich.console import Console
 from rich.table import Table
 
-from tsrkit.atomic import atomic_open, json_line
 from tsrkit.cli.common import FiniteFloatRange, plugin_options
 from tsrkit.cli.errors import UserError
-from tsrkit.files import not_regular
+from tsrkit.core.atomic import atomic_open, json_line
+from tsrkit.core.files import not_regular
+from tsrkit.core.outputs import reading, refuse_input
 from tsrkit.geo.gps import EARLIEST, LATEST
-from tsrkit.outlock import locked
-from tsrkit.outputs import reading, refuse_input
+from tsrkit.runner.outlock import locked
 
 __all__ = ["track_command"]
 
@@ -243,11 +243,11 @@ def _track_video(
     import contextlib
     import time
 
-    from tsrkit.report import ProgressBar, versions
-    from tsrkit.selection import build
+    from tsrkit.plugin.selection import build
+    from tsrkit.reporting.report import ProgressBar, versions
+    from tsrkit.reporting.track import write_track_run
     from tsrkit.spatiotemporal.evaluate import evaluate_traversal, read_truth, temporal_section
     from tsrkit.spatiotemporal.ranges import frame_profile, frame_traversals
-    from tsrkit.spatiotemporal.results import write_track_run
     from tsrkit.spatiotemporal.run import identity, track_video, video_facts
 
     selection = build(*plugins)
@@ -358,7 +358,7 @@ def no_signals(signals, osm) -> None:
 
 
 def _print_traversals(console, records, evaluations, frames, clip_frames, elapsed) -> None:
-    from tsrkit.spatiotemporal.results import ACCURACY_NOTE, summary_rows
+    from tsrkit.reporting.track import ACCURACY_NOTE, summary_rows
 
     table = Table(
         title=f"{len(records)} traversals; {clip_frames} of {frames} frames decoded "

@@ -10,7 +10,7 @@ from tsrkit.eval.notes import FrameNotes
 from tsrkit.eval.overlap import OverlapPR
 from tsrkit.eval.perframe import ZhengPerFrame
 from tsrkit.eval.state import StateMetric
-from tsrkit.hookspecs import hookimpl
+from tsrkit.plugin.hookspecs import hookimpl
 
 __all__ = ["register_metrics"]
 

@@ -12,8 +12,8 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar
 
+from tsrkit.core.results import MetricResult, Plot, Table, fmt
 from tsrkit.eval.perframe import FrameScore, FrameScoreMetric, summarise
-from tsrkit.eval.results import MetricResult, Plot, Table, fmt
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure as MplFigure

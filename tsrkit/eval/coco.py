@@ -14,12 +14,12 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar
 
-from tsrkit.eval.results import Figure, MetricResult, Plot
+from tsrkit.core.geometry import xyxy_to_xywh
+from tsrkit.core.records import FrameRecord
+from tsrkit.core.results import Figure, MetricResult, Plot
+from tsrkit.core.types import Sample
 from tsrkit.eval.settings import EvalSettings
-from tsrkit.geometry import xyxy_to_xywh
-from tsrkit.plugin import Metric
-from tsrkit.records import FrameRecord
-from tsrkit.types import Sample
+from tsrkit.plugin.base import Metric
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure as MplFigure

@@ -6,11 +6,11 @@ from collections import Counter
 from dataclasses import dataclass
 from typing import ClassVar
 
-from tsrkit.eval.results import MetricResult, Table
+from tsrkit.core.records import FrameRecord
+from tsrkit.core.results import MetricResult, Table
+from tsrkit.core.types import Sample
 from tsrkit.eval.settings import EvalSettings
-from tsrkit.plugin import Metric
-from tsrkit.records import FrameRecord
-from tsrkit.types import Sample
+from tsrkit.plugin.base import Metric
 
 __all__ = ["FrameNotes", "FrameNotesResult"]
 

@@ -14,13 +14,13 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from tsrkit.core.geometry import box_areas, intersection_matrix, iou_matrix
+from tsrkit.core.records import FrameRecord
+from tsrkit.core.results import MetricResult, Table, fmt
+from tsrkit.core.types import Sample
 from tsrkit.eval.matching import greedy_match
-from tsrkit.eval.results import MetricResult, Table, fmt
 from tsrkit.eval.settings import NOT_DETECTION, EvalSettings
-from tsrkit.geometry import box_areas, intersection_matrix, iou_matrix
-from tsrkit.plugin import Metric
-from tsrkit.records import FrameRecord
-from tsrkit.types import Sample
+from tsrkit.plugin.base import Metric
 
 __all__ = [
     "COLUMNS",

@@ -20,13 +20,13 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from tsrkit.core.records import FrameRecord
+from tsrkit.core.results import Figure, MetricResult
+from tsrkit.core.types import Sample
 from tsrkit.eval.matching import centre_hits
-from tsrkit.eval.results import Figure, MetricResult
 from tsrkit.eval.settings import NOT_DETECTION, EvalSettings
 from tsrkit.eval.stats import bootstrap_interval
-from tsrkit.plugin import Metric
-from tsrkit.records import FrameRecord
-from tsrkit.types import Sample
+from tsrkit.plugin.base import Metric
 
 __all__ = [
     "FIGURES",

@@ -10,7 +10,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from tsrkit.errors import TsrkitError
+from tsrkit.core.errors import TsrkitError
 
 __all__ = ["BOX_OPTIONS", "NOT_DETECTION", "EvalSettings", "not_exhaustive_note", "resolve_box"]
 

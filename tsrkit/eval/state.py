@@ -14,12 +14,12 @@ from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
+from tsrkit.core.records import FrameRecord
+from tsrkit.core.results import Figure, MetricResult, Plot, Table, fmt
+from tsrkit.core.types import STATES, Sample
 from tsrkit.eval.matching import centre_hits, greedy_match
-from tsrkit.eval.results import Figure, MetricResult, Plot, Table, fmt
 from tsrkit.eval.settings import EvalSettings
-from tsrkit.plugin import Metric
-from tsrkit.records import FrameRecord
-from tsrkit.types import STATES, Sample
+from tsrkit.plugin.base import Metric
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure as MplFigure
@@ -66,7 +66,7 @@ def state_metrics(
     Parameters
     ----------
     truth, predicted : sequences of str
-        Labels of matched pairs: signal states (:data:`tsrkit.types.STATES`, kept in that
+        Labels of matched pairs: signal states (:data:`tsrkit.core.types.STATES`, kept in that
         order) or any other class names, e.g. sign classes (sorted).
     scores : sequence of mappings, optional
         The predictions' ``state_scores`` for the discriminative-ratio figures.

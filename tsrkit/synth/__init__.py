@@ -5,7 +5,7 @@ that make the bundled sample (:func:`sample_path`) and ``tsrkit datasets synth``
 renderers (for example Sun-lit scenes or drives along a GPS path) live beside it.
 """
 
-from tsrkit.synth.scenes import (
+from tsrkit.datasets.scenes import (
     LIGHTINGS,
     SAMPLE_FRAMES,
     SAMPLE_SEED,
