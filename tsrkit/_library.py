@@ -28,6 +28,7 @@ __all__ = [
 
 def detector(name: str, **params: Any) -> Detector:
     """An installed detector, its parameters validated against its schema."""
+    # on first call: ``import tsrkit`` loads neither NumPy nor the plugins
     from tsrkit.plugin.registry import get_registry
 
     return get_registry().create("detector", name, params)
@@ -35,6 +36,7 @@ def detector(name: str, **params: Any) -> Detector:
 
 def classifier(name: str, **params: Any) -> Classifier:
     """An installed classifier, its parameters validated against its schema."""
+    # on first call: ``import tsrkit`` loads neither NumPy nor the plugins
     from tsrkit.plugin.registry import get_registry
 
     return get_registry().create("classifier", name, params)
@@ -42,6 +44,7 @@ def classifier(name: str, **params: Any) -> Classifier:
 
 def verifier(name: str, **params: Any) -> Verifier:
     """An installed verifier, its parameters validated against its schema."""
+    # on first call: ``import tsrkit`` loads neither NumPy nor the plugins
     from tsrkit.plugin.registry import get_registry
 
     return get_registry().create("verifier", name, params)
@@ -49,6 +52,7 @@ def verifier(name: str, **params: Any) -> Verifier:
 
 def tracker(name: str, **params: Any) -> Tracker:
     """An installed tracker, its parameters validated against its schema."""
+    # on first call: ``import tsrkit`` loads neither NumPy nor the plugins
     from tsrkit.plugin.registry import get_registry
 
     return get_registry().create("tracker", name, params)
@@ -56,6 +60,7 @@ def tracker(name: str, **params: Any) -> Tracker:
 
 def plugins(kind: str | None = None) -> list[dict[str, Any]]:
     """Installed plugins as JSON-ready dicts (failed ones have ``kind == "failed"``)."""
+    # on first call: ``import tsrkit`` loads neither NumPy nor the plugins
     from tsrkit.plugin.registry import get_registry
 
     registry = get_registry()
@@ -65,6 +70,7 @@ def plugins(kind: str | None = None) -> list[dict[str, Any]]:
 
 def read_frame(path: str) -> Frame:
     """Read one image file as a :class:`Frame`."""
+    # on first call: ``import tsrkit`` loads neither NumPy nor the plugins
     from tsrkit.core.images import read_image
     from tsrkit.core.types import Frame
 
@@ -73,6 +79,7 @@ def read_frame(path: str) -> Frame:
 
 def dataset(ref: str, format: str | None = None, images: str | None = None) -> Dataset:
     """A dataset by registry name or path (format auto-detected where unambiguous)."""
+    # on first call: ``import tsrkit`` loads neither NumPy nor the plugins
     from tsrkit.datasets import open_dataset
 
     return open_dataset(ref, format=format, images=images)
@@ -90,6 +97,7 @@ def benchmark(
     ``box=``,
     ``workers=``, ``out=``...).
     """
+    # on first call: ``import tsrkit`` loads neither NumPy nor the plugins
     from tsrkit.reporting.benchmarking import benchmark as _benchmark
 
     return _benchmark(dataset, detector, classifier, **options)
@@ -103,6 +111,7 @@ def compare(
 ) -> dict[str, Any]:
     """Benchmark several detectors on the same frames, with paired tests
     (:func:`tsrkit.reporting.comparison.compare`)."""
+    # on first call: ``import tsrkit`` loads neither NumPy nor the plugins
     from tsrkit.reporting.comparison import compare as _compare
 
     return _compare(dataset, detectors, classifier, **options)
@@ -113,6 +122,7 @@ def train(name: str, dataset: Dataset, out: str, detector: Detector | None = Non
 
     ``detector`` is the detector a trainable verifier learns on.
     """
+    # on first call: ``import tsrkit`` loads neither NumPy nor the plugins
     from tsrkit.runner.training import train as _train
 
     return _train(name, dataset, out, params, detector)

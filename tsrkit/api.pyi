@@ -80,6 +80,7 @@ from .eval.perframe import (
 )
 from .eval.settings import (
     EvalSettings as EvalSettings,
+    eval_settings as eval_settings,
 )
 from .eval.state import (
     discriminative_ratio as discriminative_ratio,
@@ -118,9 +119,6 @@ from .plugin.params import (
     Part as Part,
     parse_assignments as parse_assignments,
     validate as validate,
-)
-from .reporting.benchmarking import (
-    eval_settings as eval_settings,
 )
 from .reporting.report import (
     RunResult as RunResult,

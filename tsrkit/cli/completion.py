@@ -39,6 +39,7 @@ def plugin_names(kind: str) -> Complete:
     """Complete the installed plugins of ``kind`` (detector, classifier, format, writer...)."""
 
     def names() -> list[str]:
+        # only when the shell asks for completions: start-up stays fast
         from tsrkit.plugin.registry import get_registry
 
         return [info.name for info in get_registry().plugins(kind)]
@@ -62,6 +63,7 @@ def trainable_names(ctx, param, incomplete: str) -> list[CompletionItem]:
     """Complete the trainable plugins (``tsrkit train PLUGIN``)."""
 
     def names() -> list[str]:
+        # only when the shell asks for completions: start-up stays fast
         from tsrkit.plugin.base import is_trainable
         from tsrkit.plugin.registry import get_registry
 
@@ -74,6 +76,7 @@ def dataset_names(ctx, param, incomplete: str) -> list[CompletionItem]:
     """Complete registered dataset names and ``sample``; paths are completed by the shell."""
 
     def names() -> list[str]:
+        # only when the shell asks for completions: start-up stays fast
         from tsrkit.datasets import load_registry
 
         return ["sample", *load_registry()]
@@ -84,6 +87,7 @@ def dataset_names(ctx, param, incomplete: str) -> list[CompletionItem]:
 
 def preset_or_file(ctx, param, incomplete: str) -> list[CompletionItem]:
     """Complete preset names for ``--config``, else let the shell complete a file."""
+    # only when the shell asks for completions: start-up stays fast
     from tsrkit.plugin.presets import preset_names
 
     found = _items(preset_names, incomplete)
@@ -92,6 +96,7 @@ def preset_or_file(ctx, param, incomplete: str) -> list[CompletionItem]:
 
 def preset_names_only(ctx, param, incomplete: str) -> list[CompletionItem]:
     """Complete preset names (``tsrkit presets --show``)."""
+    # only when the shell asks for completions: start-up stays fast
     from tsrkit.plugin.presets import preset_names
 
     return _items(preset_names, incomplete)

@@ -122,6 +122,7 @@ def printable(text: str) -> str:
 
 def default_inputs() -> list[str]:
     """The bundled synthetic sample's images (generated on first use)."""
+    # cv2 and NumPy of the renderer: only when no input is given
     from tsrkit.synth import sample_path
 
     return [str(sample_path().parent / "images")]

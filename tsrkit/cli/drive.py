@@ -44,6 +44,7 @@ def drive_command(out: Path, route: str, width: int, height: int, fps: float, se
       tsrkit track city/drive.mp4 --gps city/gps.csv --map city/map.osm --out runs/city
       tsrkit datasets drive --out town/ --route through,left,right --width 640 --height 480
     """
+    # pyproj and the renderer: only when the verb runs
     from tsrkit.runner.outlock import locked
     from tsrkit.synth.drive import DriveOptions, render_drive
 

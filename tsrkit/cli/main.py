@@ -95,6 +95,7 @@ def cli(ctx: click.Context) -> None:
       tsrkit plugins
     """
     if ctx.invoked_subcommand is None:
+        # when needed: ``tsrkit --help`` loads no verb and no plugin
         from tsrkit.cli.benchmark import run_default
 
         ctx.invoke(run_default)
@@ -115,6 +116,7 @@ BUILTIN_VERBS = "tsrkit-commands"
 def _add_commands() -> None:
     """Every verb registered through ``register_commands``: the built-in ones (the CLI
     registers :mod:`tsrkit.cli.commands` as an internal plugin) and the plugins'; runs once."""
+    # when needed: ``tsrkit --help`` loads no verb and no plugin
     from tsrkit.cli import commands
     from tsrkit.plugin.registry import PluginFailure, get_registry
 

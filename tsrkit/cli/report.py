@@ -35,6 +35,7 @@ def report_command(run_dir, writers) -> None:
       tsrkit report runs/drive                 # a track run: report.html
       tsrkit report runs/kr --writer markdown --writer html
     """
+    # when the verb runs: ``tsrkit --help`` stays fast
     from tsrkit.eval.guard import Failure
     from tsrkit.plugin.registry import get_registry
     from tsrkit.reporting.runfolder import load_run, read_comparison

@@ -72,6 +72,7 @@ def synth_command(
       tsrkit datasets synth --out clip/ --frames 60 --video clip.mp4
     """
     conditions = tuple(c.strip() for c in lighting.split(",") if c.strip())
+    # when the verb runs: ``tsrkit --help`` stays fast
     from tsrkit.reporting.report import ProgressBar
 
     if video is not None:
@@ -94,6 +95,7 @@ def synth_command(
         f"({', '.join(f'{k} {v}' for k, v in sorted(states.items()))}) to {out}"
     )
     if video is not None:
+        # when the verb runs: ``tsrkit --help`` stays fast
         from tsrkit.synth.video import write_video
 
         click.echo(f"video: {write_video(dataset, video)}")

@@ -4,7 +4,9 @@ traversal (3.4.4-3.4.5), evaluated against ground truth when given (5.4)."""
 
 from __future__ import annotations
 
+import contextlib
 import json
+import time
 from datetime import UTC, datetime
 from pathlib import Path
 
@@ -173,6 +175,7 @@ def track_command(
       tsrkit track drive.mp4 --gps gps.csv --map map.osm -d conspicuity -c ab-hist \\
           -p h_peak=0.8 --vicinity 50 --truth truth.jsonl --out runs/drive
     """
+    # pyproj, SciPy and the plugins: only when the verb runs
     from tsrkit.geo import read_signals, read_track, traversals
 
     if video is None:
@@ -194,6 +197,7 @@ def track_command(
         raise UserError(f"{gps}: one GPS fix only; a track needs at least two GPS fixes")
     console = Console()
     if video is not None:
+        # pyproj, SciPy and the plugins: only when the verb runs
         from tsrkit.spatiotemporal.run import TrackSettings
 
         settings = TrackSettings(vicinity, upstream, downstream, top, slack, flow_margin, roi_top)
@@ -240,12 +244,10 @@ def _track_video(
     video, track, signals, settings, plugins, start_utc, truth, quiet, out, console
 ) -> None:
     """The video mode of ``tsrkit track`` (see :func:`tsrkit.spatiotemporal.track_video`)."""
-    import contextlib
-    import time
-
+    # pyproj, SciPy and the plugins: only when the verb runs
     from tsrkit.plugin.selection import build
     from tsrkit.reporting.report import ProgressBar, versions
-    from tsrkit.reporting.track import write_track_run
+    from tsrkit.reporting.runfolder import write_track_run
     from tsrkit.spatiotemporal.evaluate import evaluate_traversal, read_truth, temporal_section
     from tsrkit.spatiotemporal.ranges import frame_profile, frame_traversals
     from tsrkit.spatiotemporal.run import identity, track_video, video_facts
@@ -358,6 +360,7 @@ def no_signals(signals, osm) -> None:
 
 
 def _print_traversals(console, records, evaluations, frames, clip_frames, elapsed) -> None:
+    # the report's tables: only when the verb runs (``tsrkit --help`` stays fast)
     from tsrkit.reporting.track import ACCURACY_NOTE, summary_rows
 
     table = Table(

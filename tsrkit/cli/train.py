@@ -84,6 +84,7 @@ def train_command(
       tsrkit train verifier --dataset roboflow_traffic_light_kr:valid -d lab-frst \\
           -p detector.top=15 --out models/verifier
     """
+    # when the verb runs: ``tsrkit --help`` stays fast
     from tsrkit.datasets import open_datasets
 
     assignments = parse_assignments(params)

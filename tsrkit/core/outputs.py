@@ -17,6 +17,7 @@ import stat
 from collections.abc import Iterable, Iterator
 
 from tsrkit.core.errors import TsrkitError
+from tsrkit.core.files import not_regular
 
 __all__ = [
     "OutputIsInput",
@@ -116,8 +117,6 @@ def refuse_special(
     tsrkit.core.outputs.OutputIsSpecial: --out /dev/null: not a regular file (a character device); \
 outputs are written beside their path and renamed over it: choose a file
     """
-    from tsrkit.core.files import not_regular
-
     try:
         mode = os.stat(path).st_mode if follow else os.lstat(path).st_mode
     except OSError:  # missing (to be made) or unreachable: the writer says so

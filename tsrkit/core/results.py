@@ -111,6 +111,7 @@ class Plot:
 
     def png(self, dpi: int = 110) -> bytes:
         """The plot drawn and encoded as PNG (matplotlib's Agg canvas, no pyplot state)."""
+        # matplotlib: only when a plot is drawn
         from matplotlib.figure import Figure as MplFigure
 
         figure = MplFigure(figsize=self.size)

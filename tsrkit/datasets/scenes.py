@@ -52,6 +52,7 @@ import numpy as np
 from tsrkit.core.atomic import json_text
 from tsrkit.core.errors import TsrkitError
 from tsrkit.core.types import Annotation, Dataset, Sample
+from tsrkit.datasets.opening import write_dataset
 
 __all__ = [
     "ANNOTATION_FILES",
@@ -926,8 +927,6 @@ ANNOTATION_FILES = {"annotations.json": "normalized", "coco.json": "coco"}
 
 def write_annotations(dataset: Dataset, folder: Path) -> None:
     """Write the :data:`ANNOTATION_FILES` of ``dataset`` into ``folder``."""
-    from tsrkit.datasets import write_dataset
-
     for file, format_name in ANNOTATION_FILES.items():
         write_dataset(dataset, format_name, folder / file)
 

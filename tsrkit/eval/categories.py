@@ -211,6 +211,7 @@ def draw_bubbles(figure: MplFigure, rows: Sequence[Mapping[str, Any]]) -> None:
     precision (right) bubbles, circle area proportional to the share of the category's frames,
     bluer towards (FPR 0, recall 1) and redder away from it, with ``N = frames`` in grey.
     """
+    # matplotlib: only when a plot is drawn
     from matplotlib import colormaps
     from matplotlib.cm import ScalarMappable
     from matplotlib.colors import Normalize

@@ -113,6 +113,7 @@ def coco_ap(ground_truth: Mapping[str, Any], results: list[dict[str, Any]]) -> d
     curve is COCOeval's interpolated precision at IoU 0.5 on its 101 recall points); the APs are
     0 when there are no detections and None when there is no ground-truth box.
     """
+    # pycocotools: only when COCO AP is computed
     from pycocotools.coco import COCO
     from pycocotools.cocoeval import COCOeval
 

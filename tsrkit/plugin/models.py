@@ -84,6 +84,7 @@ def save_model(
     np.savez_compressed(buffer, **arrays)  # type: ignore[arg-type]
     with atomic_open(npz_path, "wb") as fh:
         fh.write(buffer.getvalue())
+    # reads the installed metadata: only when a model is saved
     from tsrkit.core.version import __version__
 
     write_json(

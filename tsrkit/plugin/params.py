@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 from tsrkit.core.errors import TsrkitError
 from tsrkit.core.files import InputFileError, not_regular, read_yaml
+from tsrkit.plugin.presets import resolve_config
 
 if TYPE_CHECKING:
     from tsrkit.plugin.base import Plugin
@@ -337,8 +338,6 @@ def load_config(path: str | os.PathLike) -> dict[str, Any]:
     ParamError
         When the file cannot be read or does not have that shape.
     """
-    from tsrkit.plugin.presets import resolve_config
-
     path = resolve_config(path)
     try:
         data = read_yaml(path, MAX_CONFIG_BYTES)

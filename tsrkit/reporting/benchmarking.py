@@ -31,11 +31,16 @@ from tsrkit.core.records import FrameRecord
 from tsrkit.core.types import Dataset
 from tsrkit.eval.guard import Failure, GuardedMetrics
 from tsrkit.eval.runfacts import run_facts
-from tsrkit.eval.settings import EvalSettings, not_exhaustive_note, resolve_box
-from tsrkit.plugin.base import Classifier, Detector, ReportWriter, Verifier
+from tsrkit.eval.settings import EvalSettings, eval_settings, not_exhaustive_note
+from tsrkit.plugin.base import Classifier, Detector, Verifier
 from tsrkit.plugin.registry import get_registry
 from tsrkit.reporting.report import REPORT_KEYS, ProgressBar, RunResult, build_report, ordered
-from tsrkit.reporting.runfolder import refuse_foreign_report, remove_stale_files, write_run
+from tsrkit.reporting.runfolder import (
+    refuse_foreign_report,
+    remove_stale_files,
+    write_run,
+    writers_for,
+)
 from tsrkit.runner.engine import (
     BenchmarkError,
     Job,
@@ -55,20 +60,6 @@ __all__ = [
 ]
 
 
-def eval_settings(
-    dataset: Dataset, detection: bool = True, iou_threshold: float = 0.5, box: str = "auto"
-) -> EvalSettings:
-    """The evaluation settings of ``dataset``: the box (``auto`` follows its registry ``box``
-    convention) and whether it is exhaustively labelled (registry ``exhaustive``)."""
-    return EvalSettings(
-        dataset.name,
-        iou_threshold,
-        resolve_box(box, dataset.info),
-        dataset.info.get("exhaustive", True) is not False,
-        detection,
-    )
-
-
 def metrics_for(settings: EvalSettings) -> GuardedMetrics:
     """Every registered metric, reset for a new evaluation (one that fails is left out)."""
     registry = get_registry()
@@ -79,16 +70,6 @@ def metrics_for(settings: EvalSettings) -> GuardedMetrics:
         },
         settings,
     )
-
-
-def writers_for(names: Sequence[str] | None) -> list[ReportWriter]:
-    """The named report writers, or every registered writer that runs by default."""
-    registry = get_registry()
-    if names is None:
-        names = [
-            info.name for info in registry.plugins("writer") if getattr(info.cls, "default", False)
-        ]
-    return [registry.create("writer", name) for name in names]
 
 
 def evaluate(

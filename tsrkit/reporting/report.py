@@ -28,6 +28,7 @@ from tsrkit.eval.guard import Failure
 from tsrkit.eval.runfacts import run_facts
 from tsrkit.eval.settings import EvalSettings
 from tsrkit.plugin.base import Metric
+from tsrkit.plugin.registry import PluginNotFound, get_registry
 
 __all__ = [
     "LEGACY_METRICS",
@@ -200,8 +201,6 @@ def run_results(report: Mapping[str, Any]) -> tuple[MetricResult, ...]:
     of several reports): the run's facts, each metric's result of the class its registered
     metric declares (the generic one when that metric is no longer installed), the timing and
     skipped inputs, in their display order."""
-    from tsrkit.plugin.registry import PluginNotFound, get_registry
-
     facts = run_facts(report)
     results = []
     written = report["metrics"] if "metrics" in report else legacy_metrics(report)

@@ -16,14 +16,20 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from tsrkit.core.errors import TsrkitError
 from tsrkit.core.files import loads_json, read_text
 from tsrkit.core.outputs import refuse_input
 from tsrkit.core.records import FrameRecord
 from tsrkit.core.types import Dataset
+from tsrkit.datasets import open_dataset
 from tsrkit.eval.guard import Failure
+from tsrkit.eval.settings import eval_settings
 from tsrkit.plugin.base import ReportWriter
-from tsrkit.reporting.report import RunResult, run_results
+from tsrkit.plugin.registry import get_registry
+from tsrkit.reporting.report import RunResult, run_results, with_outputs
+from tsrkit.reporting.track import TrackFacts, TraversalsResult, is_track_report, load_track_run
 
 __all__ = [
     "ReportBuilder",
@@ -36,6 +42,8 @@ __all__ = [
     "remove_stale_files",
     "reopen",
     "write_run",
+    "write_track_run",
+    "writers_for",
 ]
 
 #: Builds the run's report from the files the writers write and the failures so far.
@@ -155,7 +163,6 @@ def load_run(folder: Path) -> RunResult:
         writes (naming the file, the line and the problem).
     """
     report = read_object(folder / "report.json")
-    from tsrkit.reporting.track import is_track_report, load_track_run
 
     if is_track_report(report):
         return load_track_run(folder, report)
@@ -169,8 +176,6 @@ def load_run(folder: Path) -> RunResult:
     dataset = reopen(report.get("dataset") or {})
     if dataset is None:
         return RunResult(report, results=results)
-    from tsrkit.reporting.benchmarking import eval_settings
-
     index = {s.source: k for k, s in enumerate(dataset.samples)}
     kept = [
         dataclasses.replace(r, index=index[r.source])
@@ -268,8 +273,6 @@ def read_records(path: Path) -> list[FrameRecord]:
 def reopen(described: Mapping[str, Any]) -> Dataset | None:
     """The dataset a report's ``dataset`` entry describes, opened again; None when it cannot be
     (no ``opened_as``, or the files moved)."""
-    from tsrkit.datasets import open_dataset
-
     opened = described.get("opened_as")
     if not isinstance(opened, Mapping) or not opened.get("ref"):
         return None
@@ -283,3 +286,33 @@ def reopen(described: Mapping[str, Any]) -> Dataset | None:
     if name.startswith(dataset.name + ":"):  # the run used one split
         return dataset.split(name[len(dataset.name) + 1 :])
     return dataset
+
+
+def writers_for(names: Sequence[str] | None) -> list[ReportWriter]:
+    """The named report writers, or every registered writer that runs by default."""
+    registry = get_registry()
+    if names is None:
+        names = [
+            info.name for info in registry.plugins("writer") if getattr(info.cls, "default", False)
+        ]
+    return [registry.create("writer", name) for name in names]
+
+
+def write_track_run(
+    out: Path,
+    report: Mapping[str, Any],
+    records: Sequence[Mapping[str, Any]],
+    profile: tuple[np.ndarray, np.ndarray],
+    vicinity: float,
+) -> RunResult:
+    """Write a track run's folder with the default report writers (``report.json``,
+    ``summary.md``, ``report.html``, ``headline.csv``, ``plots/``...)."""
+    counted = {k: report[k] for k in ("traversals", "temporal") if k in report}
+    frames, distance = profile
+    traversals = TraversalsResult(counted, "traversals", tuple(records), frames, distance, vicinity)
+    run = RunResult(dict(report), results=(TrackFacts(report, "run"), traversals))
+
+    def build(files: Sequence[str], failures: Sequence[Failure]) -> dict[str, Any]:
+        return with_outputs(report, files, failures=failures)
+
+    return write_run(run, writers_for(None), out, build)

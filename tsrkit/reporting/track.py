@@ -15,10 +15,10 @@ from typing import Any, ClassVar
 import numpy as np
 
 from tsrkit.core.errors import TsrkitError
+from tsrkit.core.files import loads_json, read_text
 from tsrkit.core.results import Figure, MetricResult, Plot, Table, fmt
-from tsrkit.eval.guard import Failure
 from tsrkit.eval.runfacts import STAGES, description_tables
-from tsrkit.reporting.report import RunResult, with_outputs
+from tsrkit.reporting.report import RunResult
 from tsrkit.reporting.track_plots import draw_timeline, draw_vicinity
 
 __all__ = [
@@ -29,7 +29,6 @@ __all__ = [
     "load_track_run",
     "read_traversals",
     "summary_rows",
-    "write_track_run",
 ]
 
 #: What a record of ``traversals.jsonl`` holds (its number and the fields the reports read).
@@ -184,29 +183,6 @@ class TraversalsResult(MetricResult):
         return plots
 
 
-def write_track_run(
-    out: Path,
-    report: Mapping[str, Any],
-    records: Sequence[Mapping[str, Any]],
-    profile: tuple[np.ndarray, np.ndarray],
-    vicinity: float,
-) -> RunResult:
-    """Write a track run's folder with the default report writers (``report.json``,
-    ``summary.md``, ``report.html``, ``headline.csv``, ``plots/``...)."""
-    from tsrkit.reporting.benchmarking import writers_for
-    from tsrkit.reporting.runfolder import write_run
-
-    counted = {k: report[k] for k in ("traversals", "temporal") if k in report}
-    frames, distance = profile
-    traversals = TraversalsResult(counted, "traversals", tuple(records), frames, distance, vicinity)
-    run = RunResult(dict(report), results=(TrackFacts(report, "run"), traversals))
-
-    def build(files: Sequence[str], failures: Sequence[Failure]) -> dict[str, Any]:
-        return with_outputs(report, files, failures=failures)
-
-    return write_run(run, writers_for(None), out, build)
-
-
 def is_track_report(report: Mapping[str, Any]) -> bool:
     """Whether ``report`` (a ``report.json``) is a ``tsrkit track VIDEO`` run's."""
     return "dataset" not in report and all(k in report for k in ("video", "gps", "map"))
@@ -220,8 +196,6 @@ def read_traversals(path: Path) -> list[dict[str, Any]]:
     TsrkitError
         Missing file, or a line that is not a traversal record (naming the line).
     """
-    from tsrkit.core.files import loads_json, read_text
-
     if not path.exists():
         raise TsrkitError(f"{path.parent}: not a track run folder ({path.name} missing)")
     lines = read_text(path).splitlines()  # InputFileError: one line naming the file
@@ -271,6 +245,7 @@ def _profile(
 ) -> tuple[np.ndarray, np.ndarray]:
     """The run's vicinity profile from the GPS log and map it names; empty when they cannot be
     read again."""
+    # pyproj and the map reader: only when a run is reloaded with its map
     from tsrkit.geo import read_signals, read_track
     from tsrkit.spatiotemporal.ranges import frame_profile
 

@@ -21,8 +21,11 @@ from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, replace
+from multiprocessing import forkserver
 from pathlib import Path
 from typing import Any, TypeVar
+
+import cv2
 
 from tsrkit.core.atomic import atomic_open, json_line
 from tsrkit.core.errors import TsrkitError
@@ -202,8 +205,6 @@ def _init_worker(job: Job, run: int) -> None:
 
 def single_thread() -> None:
     """One OpenCV thread per worker process: the workers are the parallelism."""
-    import cv2
-
     cv2.setNumThreads(1)
 
 
@@ -219,8 +220,6 @@ def pool_context():
 def start_pool_server() -> None:
     """Start the worker pools' fork server now (if it is not running), so that its imports run
     on another core while the caller is still starting up, not after the pool is asked for."""
-    from multiprocessing import forkserver
-
     pool_context()
     forkserver.ensure_running()
 
