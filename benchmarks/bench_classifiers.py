@@ -16,9 +16,12 @@ import tempfile  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-from tsrkit.core.types import Candidate, Dataset  # noqa: E402
-from tsrkit.datasets import open_dataset  # noqa: E402
-from tsrkit.plugin.registry import get_registry  # noqa: E402
+from tsrkit import (  # noqa: E402
+    Candidate,
+    Dataset,
+    get_registry,
+)
+from tsrkit.api import open_dataset  # noqa: E402
 from tsrkit.runner.training import train as train_model  # noqa: E402
 
 CLASSIFIERS = ("ab-hist", "hsi-backprojection")

@@ -31,8 +31,8 @@ harness.single_thread()
 
 from track_drive import SHORT, rendered  # noqa: E402
 
-from tsrkit.core.types import Frame  # noqa: E402
-from tsrkit.eval.matching import centre_hits  # noqa: E402
+from tsrkit import Frame  # noqa: E402
+from tsrkit.api import centre_hits  # noqa: E402
 from tsrkit.plugin.selection import build  # noqa: E402
 from tsrkit.runner.agreement import Agreement  # noqa: E402
 from tsrkit.runner.follow import Follower  # noqa: E402

@@ -25,8 +25,8 @@ import time  # noqa: E402
 import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
-from tsrkit.core.types import Frame  # noqa: E402
-from tsrkit.datasets import open_dataset  # noqa: E402
+from tsrkit import Frame  # noqa: E402
+from tsrkit.api import open_dataset  # noqa: E402
 from tsrkit.reporting.benchmarking import benchmark  # noqa: E402
 from tsrkit_plugins.detectors import adaboost_hsv as ab  # noqa: E402
 

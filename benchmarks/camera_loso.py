@@ -58,15 +58,22 @@ import numpy as np  # noqa: E402
 import yaml  # noqa: E402
 
 import tsrkit  # noqa: E402
-from tsrkit.core.geometry import iou_matrix, xyxy_to_xywh  # noqa: E402
-from tsrkit.core.types import Annotation, Candidate, Sample  # noqa: E402
-from tsrkit.datasets import open_datasets  # noqa: E402
+from tsrkit import (  # noqa: E402
+    Annotation,
+    Candidate,
+    Detector,
+    Sample,
+    get_registry,
+)
+from tsrkit.api import (  # noqa: E402
+    centre_hits,
+    iou_matrix,
+    open_datasets,
+    parse_assignments,
+    xyxy_to_xywh,
+)
 from tsrkit.eval.coco import coco_ap, coco_dataset  # noqa: E402
-from tsrkit.eval.matching import centre_hits  # noqa: E402
-from tsrkit.plugin.base import Detector  # noqa: E402
-from tsrkit.plugin.params import parse_assignments  # noqa: E402
 from tsrkit.plugin.presets import resolve_config  # noqa: E402
-from tsrkit.plugin.registry import get_registry  # noqa: E402
 from tsrkit.runner.training import train  # noqa: E402
 from tsrkit.synth.heads import LAMP_COLOURS, render_head  # noqa: E402
 from tsrkit_plugins.verifiers.learned import passes  # noqa: E402

@@ -33,12 +33,8 @@ import cv2
 import harness
 import numpy as np
 
-from tsrkit.core.errors import TsrkitError
-from tsrkit.core.images import read_image
-from tsrkit.core.types import Dataset
-from tsrkit.datasets import open_dataset
-from tsrkit.plugin.params import Param, validate
-from tsrkit.plugin.registry import get_registry
+from tsrkit import Dataset, Param, TsrkitError, get_registry, read_image
+from tsrkit.api import open_dataset, validate
 from tsrkit.synth import generate
 
 
@@ -188,7 +184,8 @@ def seed_file_surface(folder: Path, fmt: str):
 
 
 def config_surface(folder: Path):
-    from tsrkit.plugin.params import ParamError, load_config
+    from tsrkit import ParamError
+    from tsrkit.plugin.params import load_config
 
     path = folder / "run.yaml"
     seeds = [
@@ -204,7 +201,7 @@ def config_surface(folder: Path):
 
 
 def model_surface(folder: Path):
-    from tsrkit.plugin.models import Model, ModelError, load_model, save_model
+    from tsrkit import Model, ModelError, load_model, save_model
 
     base = folder / "model"
     save_model(
@@ -239,7 +236,7 @@ def params_surface():
         target.k += 1  # type: ignore[attr-defined]
 
     target.k = 0  # type: ignore[attr-defined]
-    from tsrkit.plugin.params import ParamError
+    from tsrkit import ParamError
 
     return seeds, target, ParamError
 

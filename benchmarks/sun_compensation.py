@@ -25,11 +25,9 @@ import harness
 import numpy as np
 from scipy.stats import wilcoxon
 
-from tsrkit.core.geometry import iou_matrix
-from tsrkit.core.types import Candidate
+from tsrkit import Candidate, get_registry, save_model
+from tsrkit.api import iou_matrix
 from tsrkit.eval.overlap import match_by_iou
-from tsrkit.plugin.models import save_model
-from tsrkit.plugin.registry import get_registry
 from tsrkit.synth.sunlit import sweep
 
 #: Lee's sequences A-G (Sun behind) and H-K (Sun ahead), by their mean relative azimuth.

@@ -23,11 +23,9 @@ from pathlib import Path
 import harness
 import numpy as np
 
-from tsrkit.core.types import Candidate
+from tsrkit import Candidate, get_registry, save_model
+from tsrkit.api import parse_assignments
 from tsrkit.eval.overlap import match_by_iou
-from tsrkit.plugin.models import save_model
-from tsrkit.plugin.params import parse_assignments
-from tsrkit.plugin.registry import get_registry
 from tsrkit.synth.sunlit import LENSES, sweep
 
 SEQUENCES = {"A": 75, "B": 62, "C": 34, "D": 19, "E": 1, "F": 8, "G": 13,

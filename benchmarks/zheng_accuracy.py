@@ -24,16 +24,11 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 
 import tsrkit  # noqa: E402
-from tsrkit.eval.perframe import (  # noqa: E402
-    FrameScore,
-    frame_score,
-    score_frame,
-    summarise,
-)
+from tsrkit.api import fmt, frame_score, markdown_table  # noqa: E402
+from tsrkit.eval.perframe import FrameScore, score_frame, summarise  # noqa: E402
 from tsrkit.eval.stats import paired_test  # noqa: E402
 from tsrkit.reporting.benchmarking import run_benchmark  # noqa: E402
 from tsrkit.reporting.comparison import compare  # noqa: E402
-from tsrkit.reporting.report import fmt, markdown_table  # noqa: E402
 from tsrkit.synth import generate  # noqa: E402
 
 DETECTORS = ("conspicuity", "gray-tophat", "lab-frst")

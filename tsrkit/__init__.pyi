@@ -61,7 +61,7 @@ from .plugin.models import (
 )
 from .plugin.params import Param as Param, ParamError as ParamError
 from .plugin.pipeline import FrameResult as FrameResult, Pipeline as Pipeline
-from .plugin.registry import PluginNotFound as PluginNotFound
+from .plugin.registry import PluginNotFound as PluginNotFound, get_registry as get_registry
 from .plugin.selection import Selection as Selection, select as select
 from .reporting.report import RunResult as RunResult
 from .runner.inputs import iter_frames as iter_frames
