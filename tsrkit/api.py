@@ -36,6 +36,12 @@ The names, by what they are for:
 - metric results, which every report writer renders: :class:`MetricResult` (a metric's
   ``compute`` returns one) with its :class:`Figure` (headline), :class:`Table` and
   :class:`Plot` parts;
+- what the built-in metrics (``plugins/metrics/``) compute and return: :data:`NOT_DETECTION`,
+  :class:`FrameScore`, :func:`summarise`, :func:`headline_intervals`, :class:`PerFrameResult`,
+  :func:`category_table`, :class:`CategoriesResult`, :class:`OverlapScore`,
+  :func:`score_overlap`, :func:`summarise_overlap`, :class:`OverlapResult`, :func:`coco_frame`,
+  :func:`coco_dataset`, :func:`coco_ap`, :class:`CocoResult`, :func:`state_metrics`,
+  :class:`StateResult`, :class:`FrameNotesResult`;
 - reports: :class:`RunResult`, :func:`heading`, :func:`headline`, :func:`headline_rows`,
   :func:`headline_table`, :func:`figure_notes`, :func:`fmt`, :func:`format_p`,
   :func:`markdown_table`, :func:`title`, :func:`read_comparison`;

@@ -65,25 +65,47 @@ from .datasets.imagesize import (
     image_size as image_size,
 )
 from .eval.categories import (
+    CategoriesResult as CategoriesResult,
+    category_table as category_table,
     radius_label as radius_label,
     recall_sort_key as recall_sort_key,
 )
 from .eval.coco import (
+    CocoResult as CocoResult,
+    coco_ap as coco_ap,
+    coco_dataset as coco_dataset,
+    coco_frame as coco_frame,
     coco_run as coco_run,
 )
 from .eval.matching import (
     centre_hits as centre_hits,
     greedy_match as greedy_match,
 )
+from .eval.notes import (
+    FrameNotesResult as FrameNotesResult,
+)
+from .eval.overlap import (
+    OverlapResult as OverlapResult,
+    OverlapScore as OverlapScore,
+    score_overlap as score_overlap,
+    summarise_overlap as summarise_overlap,
+)
 from .eval.perframe import (
+    FrameScore as FrameScore,
+    PerFrameResult as PerFrameResult,
     frame_score as frame_score,
+    headline_intervals as headline_intervals,
+    summarise as summarise,
 )
 from .eval.settings import (
+    NOT_DETECTION as NOT_DETECTION,
     EvalSettings as EvalSettings,
     eval_settings as eval_settings,
 )
 from .eval.state import (
+    StateResult as StateResult,
     discriminative_ratio as discriminative_ratio,
+    state_metrics as state_metrics,
 )
 from .eval.stats import (
     format_p as format_p,

@@ -1,4 +1,4 @@
-"""Evaluation: the metrics (Zheng per-frame, lighting x size, IoU, COCO AP, states), their
-settings, matching, statistics and the lighting of a frame; beside ``datasets``, below the runs."""
+"""Evaluation: what the metrics compute and show (Zheng per-frame, lighting x size, IoU, COCO AP,
+states; the metrics are plugins, ``plugins/metrics/``), settings, matching, statistics, lighting."""
 
 __all__: list[str] = []

@@ -1,18 +1,17 @@
 """The plugin manager: discovery through the ``tsrkit`` entry-point group, and look-up by name.
 
-Built-ins load through the same entry points a third-party package declares; the core's own
-metrics are an internal plugin (:data:`INTERNAL`) registered through the same hooks (the command
-line registers the built-in verbs the same way, :mod:`tsrkit.cli.main`). A
+Built-ins, the metrics among them, load through the same entry points a third-party package
+declares (the command line registers the built-in verbs through the same hooks,
+:mod:`tsrkit.cli.main`). A
 plugin that fails to import or to register is recorded as a :class:`PluginFailure` and the
 others still load. ``TSRKIT_LOAD_PLUGINS`` (comma-separated entry-point names or shell patterns;
-empty for none) limits which installed plugins load; report writers (``writer-*``) and the
-internal plugins always load, since every report needs them.
+empty for none) limits which installed plugins load; report writers (``writer-*``) and metrics
+(``metric-*``) always load, since every report needs them.
 """
 
 from __future__ import annotations
 
 import fnmatch
-import importlib
 import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -39,7 +38,6 @@ from tsrkit.plugin.params import PLUGIN_TYPES, Param, ParamError, Part, parse_pa
 
 __all__ = [
     "ENTRY_POINT_GROUP",
-    "INTERNAL",
     "LOAD_ENV",
     "PluginFailure",
     "PluginInfo",
@@ -59,10 +57,8 @@ KINDS = {
     "metric": "register_metrics",
     "writer": "register_report_writers",
 }
-#: The core's own plugin modules: the built-in metrics.
-INTERNAL = {"tsrkit-metrics": "tsrkit.eval.builtin"}
 #: Entry points that load whatever ``TSRKIT_LOAD_PLUGINS`` says.
-ALWAYS_LOAD = ("writer-*",)
+ALWAYS_LOAD = ("writer-*", "metric-*")
 
 
 class PluginNotFound(TsrkitError):
@@ -125,12 +121,7 @@ class Registry:
     _plugins: dict[str, dict[str, PluginInfo]] | None = None
 
     def load_entry_points(self, only: str | None = None) -> None:
-        """Register the internal plugins, then import and register every entry point of the
-        group that ``only`` admits."""
-        version = _tsrkit_version()
-        for name, module in INTERNAL.items():
-            if name not in self._origin:
-                self.add(importlib.import_module(module), name, "tsrkit", version)
+        """Import and register every entry point of the group that ``only`` admits."""
         patterns = None if only is None else [p.strip() for p in only.split(",") if p.strip()]
         if patterns is not None:
             patterns += ALWAYS_LOAD
@@ -275,13 +266,6 @@ def _new_manager() -> pluggy.PluginManager:
     pm = pluggy.PluginManager("tsrkit")
     pm.add_hookspecs(hookspecs)
     return pm
-
-
-def _tsrkit_version() -> str:
-    try:
-        return metadata.version("tsrkit")
-    except metadata.PackageNotFoundError:
-        return "0+unknown"
 
 
 def _describe(exc: BaseException) -> str:
