@@ -13,9 +13,9 @@ import time
 import harness
 import numpy as np
 
+from tsrkit import get_registry
+from tsrkit.api import parse_assignments
 from tsrkit.eval.overlap import match_by_iou
-from tsrkit.params import parse_assignments
-from tsrkit.registry import get_registry
 from tsrkit.synth.workzone import generate
 
 BINS = ((5, 10), (10, 20), (20, 30), (30, 50), (50, 60))

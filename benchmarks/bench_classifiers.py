@@ -16,10 +16,13 @@ import tempfile  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-from tsrkit.datasets import open_dataset  # noqa: E402
-from tsrkit.registry import get_registry  # noqa: E402
-from tsrkit.training import train as train_model  # noqa: E402
-from tsrkit.types import Candidate, Dataset  # noqa: E402
+from tsrkit import (  # noqa: E402
+    Candidate,
+    Dataset,
+    get_registry,
+)
+from tsrkit.api import open_dataset  # noqa: E402
+from tsrkit.runner.training import train as train_model  # noqa: E402
 
 CLASSIFIERS = ("ab-hist", "hsi-backprojection")
 #: The papers' methods as printed (Zheng 3.3, Lee 5.3.3), run beside the defaults.

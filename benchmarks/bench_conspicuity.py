@@ -29,7 +29,7 @@ import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
 import tsrkit  # noqa: E402
-from tsrkit.types import Frame  # noqa: E402
+from tsrkit import Frame  # noqa: E402
 from tsrkit_plugins.detectors.conspicuity import conspicuity_map  # noqa: E402
 from tsrkit_plugins.detectors.localization import localize  # noqa: E402
 

@@ -3,7 +3,7 @@ and finds against the whole pipeline on every frame.
 
 Each run decodes a drive of ``tsrkit.synth.drive`` (the three short drives of
 ``benchmarks/track_drive.py``, rendered once into ``benchmarks/out/track_drive/``) and runs a
-:class:`tsrkit.follow.Follower` over its frames in this process; CPU time is the process's
+:class:`tsrkit.runner.follow.Follower` over its frames in this process; CPU time is the process's
 (``time.process_time``) around the pipeline calls only (decoding excluded), one OpenCV thread.
 Per frame the records are scored against ``truth.jsonl`` with Zheng's centre rule (5.2.1, a
 detection's centre inside a light's minimum enclosing circle):
@@ -31,12 +31,12 @@ harness.single_thread()
 
 from track_drive import SHORT, rendered  # noqa: E402
 
-from tsrkit.agreement import Agreement  # noqa: E402
-from tsrkit.eval.matching import centre_hits  # noqa: E402
-from tsrkit.follow import Follower  # noqa: E402
-from tsrkit.inputs import iter_video  # noqa: E402
-from tsrkit.selection import build  # noqa: E402
-from tsrkit.types import Frame  # noqa: E402
+from tsrkit import Frame  # noqa: E402
+from tsrkit.api import centre_hits  # noqa: E402
+from tsrkit.plugin.selection import build  # noqa: E402
+from tsrkit.runner.agreement import Agreement  # noqa: E402
+from tsrkit.runner.follow import Follower  # noqa: E402
+from tsrkit.runner.inputs import iter_video  # noqa: E402
 
 #: The two detector settings: ``track_drive.py``'s (Zheng's conspicuity with ab-hist) and the
 #: recommended preset.

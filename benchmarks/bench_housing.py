@@ -54,13 +54,19 @@ from pathlib import Path  # noqa: E402
 import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
-from tsrkit.datasets import open_dataset  # noqa: E402
+from tsrkit import (  # noqa: E402
+    Candidate,
+    Frame,
+    get_registry,
+)
+from tsrkit.api import (  # noqa: E402
+    centre_hits,
+    iou_matrix,
+    open_dataset,
+    xyxy_to_xywh,
+)
 from tsrkit.eval.coco import coco_ap, coco_dataset  # noqa: E402
-from tsrkit.eval.matching import centre_hits  # noqa: E402
-from tsrkit.geometry import iou_matrix, xyxy_to_xywh  # noqa: E402
-from tsrkit.registry import get_registry  # noqa: E402
 from tsrkit.synth.heads import LAMP_COLOURS, background, render_head  # noqa: E402
-from tsrkit.types import Candidate, Frame  # noqa: E402
 from tsrkit_plugins.shared.regions import find_lens  # noqa: E402
 from tsrkit_plugins.verifiers.housing.fit import fit_housings  # noqa: E402
 from tsrkit_plugins.verifiers.housing.margin import learn_margin, margin_free_iou, widen  # noqa: E402

@@ -35,7 +35,7 @@ from at_commit import module_at  # noqa: E402
 from lab_frst_straightforward import lab_frst_straightforward  # noqa: E402
 
 import tsrkit  # noqa: E402
-from tsrkit.types import Frame  # noqa: E402
+from tsrkit import Frame  # noqa: E402
 from tsrkit_plugins.detectors.frst.frst import frst  # noqa: E402
 from tsrkit_plugins.detectors.frst.lab_frst import lab_feature_map  # noqa: E402
 

@@ -3,7 +3,8 @@
 1. Held-out pixel accuracy per colour for three training labellings (whole box, lit lens, lit
    lens + unlit-housing hard negatives), tested on lens-labelled pixels: KR -> cinTA, cinTA ->
    KR, and within each set (train on the ``valid`` split, test on ``test``).
-2. The detection-defaults grid, run through tsrkit.benchmarking on the shipped model's TRAINING set
+2. The detection-defaults grid, run through tsrkit.reporting.benchmarking on the shipped model's
+TRAINING set
    (roboflow_cinta_v2_id) only; ranks by the F1 of Zheng's per-frame recall and precision.
 3. ms per 1280x720 frame on one thread (three-colour table vs. evaluating the stumps).
 
@@ -24,9 +25,9 @@ import time  # noqa: E402
 import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
-from tsrkit.benchmarking import benchmark  # noqa: E402
-from tsrkit.datasets import open_dataset  # noqa: E402
-from tsrkit.types import Frame  # noqa: E402
+from tsrkit import Frame  # noqa: E402
+from tsrkit.api import open_dataset  # noqa: E402
+from tsrkit.reporting.benchmarking import benchmark  # noqa: E402
 from tsrkit_plugins.detectors import adaboost_hsv as ab  # noqa: E402
 
 KR, CINTA = "roboflow_traffic_light_kr", "roboflow_cinta_v2_id"

@@ -24,8 +24,8 @@ import numpy as np  # noqa: E402
 from sklearn.metrics import accuracy_score, recall_score  # noqa: E402
 from sklearn.model_selection import train_test_split  # noqa: E402
 
-from tsrkit.datasets import open_dataset  # noqa: E402
-from tsrkit.types import Candidate  # noqa: E402
+from tsrkit import Candidate  # noqa: E402
+from tsrkit.api import open_dataset  # noqa: E402
 from tsrkit_plugins.classifiers.logpolar_svm import LogPolarSVM  # noqa: E402
 
 CONFIGS = (("log-polar", 10), ("none", 10), ("log-polar", 50), ("none", 50))

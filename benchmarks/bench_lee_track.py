@@ -23,11 +23,14 @@ from pathlib import Path  # noqa: E402
 import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
+from tsrkit import (  # noqa: E402
+    Annotation,
+    Pipeline,
+    Sample,
+    iter_frames,
+)
+from tsrkit.api import iou_matrix  # noqa: E402
 from tsrkit.eval.overlap import score_overlap, summarise_overlap  # noqa: E402
-from tsrkit.geometry import iou_matrix  # noqa: E402
-from tsrkit.inputs import iter_frames  # noqa: E402
-from tsrkit.pipeline import Pipeline  # noqa: E402
-from tsrkit.types import Annotation, Sample  # noqa: E402
 from tsrkit_plugins.detectors.adaboost_hsv import AdaBoostHSV  # noqa: E402
 from tsrkit_plugins.trackers.meanshift import MeanShift  # noqa: E402
 

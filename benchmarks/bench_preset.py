@@ -55,8 +55,8 @@ from at_commit import python_at  # noqa: E402
 from conspicuity_filter2d import conspicuity_filter2d  # noqa: E402
 
 import tsrkit  # noqa: E402
-from tsrkit.atomic import write_json  # noqa: E402
-from tsrkit.types import Frame  # noqa: E402
+from tsrkit import Frame  # noqa: E402
+from tsrkit.api import write_json  # noqa: E402
 
 SET = "iwai_japan_tl"
 #: The rows of a 1280x960 frame kept: its middle 720.

@@ -74,8 +74,8 @@ def save():
         json.dump(marks, fh)
 
 atexit.register(save)
-import tsrkit.plugin
-import tsrkit.benchmarking as B
+import tsrkit.plugin.base
+import tsrkit.reporting.benchmarking as B
 
 def timed_write(write, name):
     def timed(self, run, folder):
@@ -89,11 +89,11 @@ def timed_write(write, name):
     return timed
 
 def writer_subclass(cls, **kwargs):
-    super(tsrkit.plugin.ReportWriter, cls).__init_subclass__(**kwargs)
+    super(tsrkit.plugin.base.ReportWriter, cls).__init_subclass__(**kwargs)
     if "write" in cls.__dict__:
         cls.write = timed_write(cls.write, cls.__dict__.get("name", cls.__name__))
 
-tsrkit.plugin.ReportWriter.__init_subclass__ = classmethod(writer_subclass)
+tsrkit.plugin.base.ReportWriter.__init_subclass__ = classmethod(writer_subclass)
 _run = B.run_records
 
 def run_records(*args, **kwargs):

@@ -27,8 +27,8 @@ from memory_benchmark import tree_rss
 def child(frames: int, data: Path, detector: str, classifier: str, workers: int) -> None:
     """Benchmark the first ``frames`` frames of ``data`` (runs in the measured process)."""
     import tsrkit
-    from tsrkit.datasets import open_dataset
-    from tsrkit.types import Dataset
+    from tsrkit import Dataset
+    from tsrkit.api import open_dataset
 
     harness.single_thread()
     full = open_dataset(str(data / "annotations.json"))

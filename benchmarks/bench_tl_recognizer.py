@@ -39,8 +39,8 @@ import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
 import tsrkit  # noqa: E402
-from tsrkit.geometry import iou_matrix  # noqa: E402
-from tsrkit.types import Annotation, Dataset, Frame, Sample  # noqa: E402
+from tsrkit import Annotation, Dataset, Frame, Sample  # noqa: E402
+from tsrkit.api import iou_matrix  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from at_commit import module_at, plugin_at  # noqa: E402

@@ -5,7 +5,7 @@ it never trained on.
 split: no split of a held-out camera is trained on, so all its frames are test frames), and a
 crop fold: real head crops of ``udacity_mit_tl_crops`` test (whole heads) and lit bulbs of
 ``lisa_vgis_bulb_crops`` (20x20, put into the lit slot of a rendered head) pasted into synthetic
-no-light scenes. For a family fold the verifier is trained (``tsrkit.training.train``, the
+no-light scenes. For a family fold the verifier is trained (``tsrkit.runner.training.train``, the
 plugin's own training) on every frame of the three other families; for the crop fold on all
 four families with ``--crop-fold`` (default ``crop_frames=0``: no MIT crop pasted, since the
 fold tests MIT's camera; VGIS is in no verifier training).
@@ -58,17 +58,24 @@ import numpy as np  # noqa: E402
 import yaml  # noqa: E402
 
 import tsrkit  # noqa: E402
-from tsrkit.datasets import open_datasets  # noqa: E402
+from tsrkit import (  # noqa: E402
+    Annotation,
+    Candidate,
+    Detector,
+    Sample,
+    get_registry,
+)
+from tsrkit.api import (  # noqa: E402
+    centre_hits,
+    iou_matrix,
+    open_datasets,
+    parse_assignments,
+    xyxy_to_xywh,
+)
 from tsrkit.eval.coco import coco_ap, coco_dataset  # noqa: E402
-from tsrkit.eval.matching import centre_hits  # noqa: E402
-from tsrkit.geometry import iou_matrix, xyxy_to_xywh  # noqa: E402
-from tsrkit.params import parse_assignments  # noqa: E402
-from tsrkit.plugin import Detector  # noqa: E402
-from tsrkit.presets import resolve_config  # noqa: E402
-from tsrkit.registry import get_registry  # noqa: E402
+from tsrkit.plugin.presets import resolve_config  # noqa: E402
+from tsrkit.runner.training import train  # noqa: E402
 from tsrkit.synth.heads import LAMP_COLOURS, render_head  # noqa: E402
-from tsrkit.training import train  # noqa: E402
-from tsrkit.types import Annotation, Candidate, Sample  # noqa: E402
 from tsrkit_plugins.verifiers.learned import passes  # noqa: E402
 from tsrkit_plugins.verifiers.pasting import feathered_alpha, paste, place  # noqa: E402
 from tsrkit_plugins.verifiers.unlit import no_light_frames  # noqa: E402

@@ -40,13 +40,20 @@ from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-from tsrkit.atomic import write_json  # noqa: E402
-from tsrkit.datasets import open_dataset, open_datasets  # noqa: E402
-from tsrkit.errors import TsrkitError  # noqa: E402
-from tsrkit.eval.matching import centre_hits  # noqa: E402
-from tsrkit.params import ParamError, parse_parts  # noqa: E402
-from tsrkit.registry import get_registry  # noqa: E402
-from tsrkit.types import Candidate, Sample  # noqa: E402
+from tsrkit import (  # noqa: E402
+    Candidate,
+    ParamError,
+    Sample,
+    TsrkitError,
+    get_registry,
+)
+from tsrkit.api import (  # noqa: E402
+    centre_hits,
+    open_dataset,
+    open_datasets,
+    write_json,
+)
+from tsrkit.plugin.params import parse_parts  # noqa: E402
 from tsrkit_plugins.detectors.union import (  # noqa: E402
     DEFAULT_MEMBERS,
     merge,

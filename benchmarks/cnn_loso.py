@@ -56,6 +56,7 @@ from tsrkit.api import (  # noqa: E402
     centre_hits,
     greedy_match,
     iou_matrix,
+    load_model,
     open_datasets,
     save_model,
 )
@@ -351,7 +352,10 @@ class Forest:
 
 #: Keep rules swept on every fold (threshold, relative, prior).
 RULES = tuple(
-    (t, r, p) for t in (0.5, 0.7, 0.8, 0.9, 0.95, 0.98) for r in (0.0, 0.8) for p in (0.0, 0.3)
+    (t, r, p)
+    for t in (0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 0.95)
+    for r in (0.0, 0.8)
+    for p in (0.0, 0.3, 0.5, 0.7)
 )
 
 
@@ -432,6 +436,9 @@ def main() -> None:
         "--adapt", action="store_true", help="also measure batch-norm adaptation per fold"
     )
     parser.add_argument(
+        "--evaluate", action="store_true", help="evaluate the folds' saved models (no training)"
+    )
+    parser.add_argument(
         "--baseline",
         action="store_true",
         help="also evaluate the forest verifier preset (shipped model)",
@@ -480,23 +487,26 @@ def main() -> None:
             [synth_crops] + [c for k, c in family_crops.items() if k != family.key]
         )
         path = args.out / f"model_{family.key}"
-        trainer = tsrkit.verifier(
-            "cnn-verifier",
-            epochs=args.epochs,
-            width=args.width,
-            seed=args.seed,
-            threads=args.threads,
-        )
         t0 = time.time()
-        model = trainer.fit_crops(train)
-        save_model(
-            path,
-            model,
-            plugin="cnn-verifier",
-            plugin_version="0.1.0",
-            params=trainer.params,
-            training={"fold": family.key},
-        )
+        if args.evaluate:
+            model = load_model(path, "cnn-verifier")
+        else:
+            trainer = tsrkit.verifier(
+                "cnn-verifier",
+                epochs=args.epochs,
+                width=args.width,
+                seed=args.seed,
+                threads=args.threads,
+            )
+            model = trainer.fit_crops(train)
+            save_model(
+                path,
+                model,
+                plugin="cnn-verifier",
+                plugin_version="0.1.0",
+                params=trainer.params,
+                training={"fold": family.key},
+            )
         seconds = time.time() - t0
         figures = fold_figures(
             path, verifier_params, family, seen[family.key], taiwan, test_unlit, lamp
@@ -517,7 +527,8 @@ def main() -> None:
             )
         results[family.key] = figures
         print(family.key, json.dumps(figures), file=sys.stderr)
-        (args.out / "folds.json").write_text(json.dumps(results, indent=1))
+        name = "folds_evaluated.json" if args.evaluate else "folds.json"
+        (args.out / name).write_text(json.dumps(results, indent=1))
     if args.baseline:
         baseline = tsrkit.select(config="recommended-forest").verifier
         rows = {}

@@ -44,7 +44,7 @@ import numpy as np  # noqa: E402
 from numba import njit  # noqa: E402
 
 import tsrkit  # noqa: E402
-from tsrkit.types import Frame  # noqa: E402
+from tsrkit import Frame  # noqa: E402
 from tsrkit_plugins.detectors import localization  # noqa: E402
 from tsrkit_plugins.detectors.conspicuity import conspicuity as cs  # noqa: E402
 from tsrkit_plugins.detectors.conspicuity.conspicuity_kernel import (  # noqa: E402

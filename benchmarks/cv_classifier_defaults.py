@@ -24,10 +24,13 @@ from pathlib import Path  # noqa: E402
 
 from sklearn.model_selection import StratifiedKFold  # noqa: E402
 
-from tsrkit.datasets import open_dataset  # noqa: E402
-from tsrkit.registry import get_registry  # noqa: E402
-from tsrkit.training import train as train_model  # noqa: E402
-from tsrkit.types import Candidate, Dataset  # noqa: E402
+from tsrkit import (  # noqa: E402
+    Candidate,
+    Dataset,
+    get_registry,
+)
+from tsrkit.api import open_dataset  # noqa: E402
+from tsrkit.runner.training import train as train_model  # noqa: E402
 
 STATES = ("red", "yellow", "green")
 

@@ -3,7 +3,7 @@ than tsrkit's own clear errors (the target is 0).
 
 Surfaces:
 - ``image``: a small PNG and a small JPEG with random byte flips, insertions, deletions,
-  truncations and header-size rewrites, through ``tsrkit.images.read_image`` (allowed:
+  truncations and header-size rewrites, through ``tsrkit.core.images.read_image`` (allowed:
   ``ImageReadError``);
 - ``coco``, ``normalized``, ``voc``, ``yolo``: the annotation files tsrkit writes for a 4-frame
   synthetic set, mutated the same way, through ``open_dataset`` (allowed: ``TsrkitError``);
@@ -33,13 +33,9 @@ import cv2
 import harness
 import numpy as np
 
-from tsrkit.datasets import open_dataset
-from tsrkit.errors import TsrkitError
-from tsrkit.images import read_image
-from tsrkit.params import Param, validate
-from tsrkit.registry import get_registry
+from tsrkit import Dataset, Param, TsrkitError, get_registry, read_image
+from tsrkit.api import open_dataset, validate
 from tsrkit.synth import generate
-from tsrkit.types import Dataset
 
 
 def mutate(data: bytes, rng: np.random.Generator) -> bytes:
@@ -188,7 +184,8 @@ def seed_file_surface(folder: Path, fmt: str):
 
 
 def config_surface(folder: Path):
-    from tsrkit.params import ParamError, load_config
+    from tsrkit import ParamError
+    from tsrkit.plugin.params import load_config
 
     path = folder / "run.yaml"
     seeds = [
@@ -204,7 +201,7 @@ def config_surface(folder: Path):
 
 
 def model_surface(folder: Path):
-    from tsrkit.models import Model, ModelError, load_model, save_model
+    from tsrkit import Model, ModelError, load_model, save_model
 
     base = folder / "model"
     save_model(
@@ -239,7 +236,7 @@ def params_surface():
         target.k += 1  # type: ignore[attr-defined]
 
     target.k = 0  # type: ignore[attr-defined]
-    from tsrkit.params import ParamError
+    from tsrkit import ParamError
 
     return seeds, target, ParamError
 

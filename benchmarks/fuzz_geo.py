@@ -25,7 +25,8 @@ import harness
 import numpy as np
 from fuzz import run_surface  # benchmarks/fuzz.py: the mutations and the outcome counts
 
-from tsrkit.geo import GeoError, Track, read_signals, read_track
+from tsrkit.api import Track, read_track
+from tsrkit.geo import GeoError, read_signals
 from tsrkit.geo.export import to_gpx, to_nmea
 from tsrkit.geo.osm import _nodes
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from tsrkit.types import Candidate
+from tsrkit import Candidate
 from tsrkit_plugins.detectors.frst.frst import gaussian_kernel, kappa
 from tsrkit_plugins.detectors.frst.lab_frst import lab_feature_map, spot_candidates
 

@@ -26,8 +26,8 @@ SIZES = (200, 2000)
 def child(frames: int, data: Path, detector: str, workers: int) -> None:
     """Benchmark the first ``frames`` frames of ``data`` (runs in the measured process)."""
     import tsrkit
-    from tsrkit.datasets import open_dataset
-    from tsrkit.types import Dataset
+    from tsrkit import Dataset
+    from tsrkit.api import open_dataset
 
     harness.single_thread()
     full = open_dataset(str(data / "annotations.json"))

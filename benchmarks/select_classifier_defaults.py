@@ -29,8 +29,8 @@ import numpy as np  # noqa: E402
 from bench_classifiers import STATES, benchmark_sets, evaluate  # noqa: E402
 from cv_classifier_defaults import grid_parser, grid_points  # noqa: E402
 
-from tsrkit.registry import get_registry  # noqa: E402
-from tsrkit.training import train as train_model  # noqa: E402
+from tsrkit import get_registry  # noqa: E402
+from tsrkit.runner.training import train as train_model  # noqa: E402
 
 
 def balanced_accuracy(result: dict) -> float:

@@ -44,9 +44,11 @@ from verifier_speed import candidates  # noqa: E402
 import tsrkit_plugins.classifiers.lamp_state.features as lamp_now  # noqa: E402
 import tsrkit_plugins.shared.forest as forest_now  # noqa: E402
 import tsrkit_plugins.verifiers.features as verifier_now  # noqa: E402
-from tsrkit.registry import get_registry  # noqa: E402
-from tsrkit.synth import SynthOptions, render_frame  # noqa: E402
-from tsrkit.types import Frame  # noqa: E402
+from tsrkit import (  # noqa: E402
+    Frame,
+    get_registry,
+)
+from tsrkit.api import SynthOptions, render_frame  # noqa: E402
 
 cv2.setNumThreads(1)
 

@@ -53,11 +53,15 @@ from collections import Counter  # noqa: E402
 from dataclasses import replace  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-from tsrkit.datasets import open_dataset  # noqa: E402
-from tsrkit.errors import TsrkitError  # noqa: E402
-from tsrkit.models import save_model  # noqa: E402
-from tsrkit.registry import get_registry  # noqa: E402
-from tsrkit.types import Candidate, Dataset, Sample  # noqa: E402
+from tsrkit import (  # noqa: E402
+    Candidate,
+    Dataset,
+    Sample,
+    TsrkitError,
+    get_registry,
+    save_model,
+)
+from tsrkit.api import open_dataset  # noqa: E402
 
 #: The states read and scored (others, such as off, arrows and unknown, are passed over).
 STATES = ("red", "yellow", "green", "red_yellow")

@@ -36,9 +36,11 @@ import argparse  # noqa: E402
 import numpy as np  # noqa: E402
 from state_loso import families, wanted_boxes  # noqa: E402
 
-from tsrkit.datasets import open_dataset  # noqa: E402
-from tsrkit.registry import get_registry  # noqa: E402
-from tsrkit.types import Dataset  # noqa: E402
+from tsrkit import (  # noqa: E402
+    Dataset,
+    get_registry,
+)
+from tsrkit.api import open_dataset  # noqa: E402
 from tsrkit_plugins.classifiers.lamp_state import (  # noqa: E402
     STATES,
     blend,

@@ -25,12 +25,10 @@ import harness
 import numpy as np
 from scipy.stats import wilcoxon
 
+from tsrkit import Candidate, get_registry, save_model
+from tsrkit.api import iou_matrix
 from tsrkit.eval.overlap import match_by_iou
-from tsrkit.geometry import iou_matrix
-from tsrkit.models import save_model
-from tsrkit.registry import get_registry
 from tsrkit.synth.sunlit import sweep
-from tsrkit.types import Candidate
 
 #: Lee's sequences A-G (Sun behind) and H-K (Sun ahead), by their mean relative azimuth.
 SEQUENCES = {"A": 75, "B": 62, "C": 34, "D": 19, "E": 1, "F": 8, "G": 13,

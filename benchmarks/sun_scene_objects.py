@@ -23,12 +23,10 @@ from pathlib import Path
 import harness
 import numpy as np
 
+from tsrkit import Candidate, get_registry, save_model
+from tsrkit.api import parse_assignments
 from tsrkit.eval.overlap import match_by_iou
-from tsrkit.models import save_model
-from tsrkit.params import parse_assignments
-from tsrkit.registry import get_registry
 from tsrkit.synth.sunlit import LENSES, sweep
-from tsrkit.types import Candidate
 
 SEQUENCES = {"A": 75, "B": 62, "C": 34, "D": 19, "E": 1, "F": 8, "G": 13,
              "H": 96, "I": 112, "J": 154, "K": 172}  # fmt: skip

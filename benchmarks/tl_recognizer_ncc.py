@@ -19,7 +19,7 @@ import numpy as np  # noqa: E402
 from sklearn.metrics import roc_auc_score  # noqa: E402
 
 import tsrkit  # noqa: E402
-from tsrkit.eval.matching import centre_hits  # noqa: E402
+from tsrkit.api import centre_hits  # noqa: E402
 
 #: Tuning split of each set (disjoint from the split the accuracy runs test on).
 TUNING = {"roboflow_traffic_light_kr": "valid", "roboflow_cinta_v2_id": "valid", "sample": "train"}

@@ -17,7 +17,7 @@ import math
 import cv2
 import numpy as np
 
-from tsrkit.types import Candidate, Frame
+from tsrkit import Candidate, Frame
 from tsrkit_plugins.detectors.tl_recognizer import tl_geometry as geo
 from tsrkit_plugins.detectors.tl_recognizer.tl_recognizer import (
     PASSES,

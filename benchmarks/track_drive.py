@@ -31,7 +31,7 @@ import harness
 import numpy as np
 
 from tsrkit.geo import LocalProjection
-from tsrkit.inputs import iter_video
+from tsrkit.runner.inputs import iter_video
 from tsrkit.spatiotemporal.flow import project
 from tsrkit.spatiotemporal.points import Point
 from tsrkit.synth.drive import DriveOptions, render_drive

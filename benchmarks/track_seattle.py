@@ -18,7 +18,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 from scipy.spatial import cKDTree
 
-from tsrkit.geo import read_signals, read_track, traversals
+from tsrkit.api import read_track
+from tsrkit.geo import read_signals, traversals
 from tsrkit.geo.osm import _nodes
 from tsrkit.geo.vicinity import vicinity_profile
 

@@ -37,15 +37,21 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 from candidate_recall import SIZE_BINS, bin_label, recall_by_size  # noqa: E402
 
-from tsrkit.benchmarking import run_benchmark  # noqa: E402
-from tsrkit.datasets import open_datasets  # noqa: E402
+from tsrkit import (  # noqa: E402  # noqa: E402
+    Dataset,
+    Detector,
+    Sample,
+    Verifier,
+    get_registry,
+)
+from tsrkit.api import (  # noqa: E402
+    iou_matrix,
+    open_datasets,
+    parse_assignments,
+)
 from tsrkit.eval.perframe import score_frame  # noqa: E402
-from tsrkit.geometry import iou_matrix  # noqa: E402
-from tsrkit.params import parse_assignments  # noqa: E402
-from tsrkit.plugin import Detector, Verifier  # noqa: E402
-from tsrkit.registry import get_registry  # noqa: E402
-from tsrkit.training import train  # noqa: E402
-from tsrkit.types import Dataset, Sample  # noqa: E402
+from tsrkit.reporting.benchmarking import run_benchmark  # noqa: E402
+from tsrkit.runner.training import train  # noqa: E402
 from tsrkit_plugins.verifiers.learned import LearnedVerifier, passes  # noqa: E402
 from tsrkit_plugins.verifiers.mining import no_light_frames  # noqa: E402
 

@@ -27,10 +27,13 @@ from functools import partial  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-from tsrkit.params import load_config  # noqa: E402
-from tsrkit.registry import get_registry  # noqa: E402
-from tsrkit.synth import SynthOptions, render_frame  # noqa: E402
-from tsrkit.types import Candidate, Frame  # noqa: E402
+from tsrkit import (  # noqa: E402
+    Candidate,
+    Frame,
+    get_registry,
+)
+from tsrkit.api import SynthOptions, render_frame  # noqa: E402
+from tsrkit.plugin.params import load_config  # noqa: E402
 from tsrkit_plugins.verifiers.features import candidate_features  # noqa: E402
 
 

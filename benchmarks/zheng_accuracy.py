@@ -1,6 +1,7 @@
 """Zheng 2016, 5.2.1-5.2.3: accuracy of conspicuity against GRAY-TOPHAT and LAB-FRST.
 
-Compares the three detectors with ``tsrkit.comparison.compare`` on two real sets and two synthetic
+Compares the three detectors with ``tsrkit.reporting.comparison.compare`` on two real sets and two
+synthetic
 ones, again with the radius range scaled to each real set's lens sizes, then evaluates a grid of
 conspicuity weights (w_L, w_LC, w_S), chosen per lighting class on one split and reported on the
 other (the 5.2.3 tuning rules). Prints Markdown tables; every run's outputs go under OUT.
@@ -23,16 +24,11 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 
 import tsrkit  # noqa: E402
-from tsrkit.benchmarking import run_benchmark  # noqa: E402
-from tsrkit.comparison import compare  # noqa: E402
-from tsrkit.eval.perframe import (  # noqa: E402
-    FrameScore,
-    frame_score,
-    score_frame,
-    summarise,
-)
+from tsrkit.api import fmt, frame_score, markdown_table  # noqa: E402
+from tsrkit.eval.perframe import FrameScore, score_frame, summarise  # noqa: E402
 from tsrkit.eval.stats import paired_test  # noqa: E402
-from tsrkit.report import fmt, markdown_table  # noqa: E402
+from tsrkit.reporting.benchmarking import run_benchmark  # noqa: E402
+from tsrkit.reporting.comparison import compare  # noqa: E402
 from tsrkit.synth import generate  # noqa: E402
 
 DETECTORS = ("conspicuity", "gray-tophat", "lab-frst")
@@ -263,7 +259,8 @@ PAIRED_HEADER = ["A", "B", "per-frame", "frames", "mean A - B", "p", "verdict"]
 def run_compare(
     dataset: tsrkit.Dataset, radii: list[int] | None, out: Path, options: dict
 ) -> tuple[list[dict], dict[str, dict[int, FrameScore]]]:
-    """``tsrkit.comparison.compare`` of the three detectors; the reports and per-frame scores."""
+    """``tsrkit.reporting.comparison.compare`` of the three detectors; the reports and per-frame
+    scores."""
     comparison = compare(dataset, make_detectors(radii), out=out, **options)
     runs = {name: frame_scores(dataset, out / name / "detections.jsonl") for name in DETECTORS}
     return comparison["reports"], runs

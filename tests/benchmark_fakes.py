@@ -10,11 +10,11 @@ import time
 
 import numpy as np
 
-from tsrkit.errors import TsrkitError
-from tsrkit.hookspecs import hookimpl
-from tsrkit.params import Param
-from tsrkit.plugin import Classifier, Detector
-from tsrkit.types import Annotation, Candidate, Dataset, Detection, Sample
+from tsrkit.core.errors import TsrkitError
+from tsrkit.core.types import Annotation, Candidate, Dataset, Detection, Sample
+from tsrkit.plugin.base import Classifier, Detector
+from tsrkit.plugin.hookspecs import hookimpl
+from tsrkit.plugin.params import Param
 
 
 class OracleDetector(Detector):
@@ -100,6 +100,6 @@ def hand_dataset(frames: int = 6, name: str = "hand") -> Dataset:
 
 def make(cls, **params):
     """Instantiate a fake plugin with its schema's validated parameters."""
-    from tsrkit.params import validate
+    from tsrkit.plugin.params import validate
 
     return cls(**validate(cls.PARAMS, params, cls.name))

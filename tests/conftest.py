@@ -27,7 +27,7 @@ def shared_datasets() -> Path:
 @pytest.fixture
 def registry(monkeypatch):
     """A fresh process-wide registry for the test, discarded afterwards."""
-    from tsrkit import registry as reg
+    from tsrkit.plugin import registry as reg
 
     reg.reset_registry()
     yield reg.get_registry()

@@ -36,6 +36,12 @@ The names, by what they are for:
 - metric results, which every report writer renders: :class:`MetricResult` (a metric's
   ``compute`` returns one) with its :class:`Figure` (headline), :class:`Table` and
   :class:`Plot` parts;
+- what the built-in metrics (``plugins/metrics/``) compute and return: :data:`NOT_DETECTION`,
+  :class:`FrameScore`, :func:`summarise`, :func:`headline_intervals`, :class:`PerFrameResult`,
+  :func:`category_table`, :class:`CategoriesResult`, :class:`OverlapScore`,
+  :func:`score_overlap`, :func:`summarise_overlap`, :class:`OverlapResult`, :func:`coco_frame`,
+  :func:`coco_dataset`, :func:`coco_ap`, :class:`CocoResult`, :func:`state_metrics`,
+  :class:`StateResult`, :class:`FrameNotesResult`;
 - reports: :class:`RunResult`, :func:`heading`, :func:`headline`, :func:`headline_rows`,
   :func:`headline_table`, :func:`figure_notes`, :func:`fmt`, :func:`format_p`,
   :func:`markdown_table`, :func:`title`, :func:`read_comparison`;
@@ -48,6 +54,8 @@ Names are imported on first use (PEP 562), so that loading a plugin costs only w
 
 from __future__ import annotations
 
-from tsrkit._lazy import attach_stub
+import lazy_loader as _lazy
 
-__getattr__, __dir__, __all__ = attach_stub(__name__, __file__)
+# The stub's imports are relative to the package (``from .core.types import Frame``), as
+# lazy_loader reads them: each name resolves against ``tsrkit`` on first use.
+__getattr__, __dir__, __all__ = _lazy.attach_stub("tsrkit", __file__)

@@ -5,7 +5,8 @@ centre (rotation becomes a circular shift along theta), projected on a few princ
 components and classified by an SVM whose classes are the sign classes of its training data.
 Lee 2017, section 3.4.
 
-Not ``skops.io``: the model stays plain arrays + JSON (``tsrkit.models``), readable whatever the
+Not ``skops.io``: the model stays plain arrays + JSON (``tsrkit.plugin.models``), readable whatever
+the
 scikit-learn version; the one-vs-one decision is a few lines, tested equal to ``SVC.predict``.
 """
 

@@ -524,7 +524,7 @@ class AdaBoostHSV(Detector):
     def fit(self, samples: Iterable[Sample], *, detector: Detector | None = None) -> Model:
         """Learn one booster per colour from annotated boxes; see :func:`pixel_labels`.
 
-        When ``samples`` is a :class:`~tsrkit.types.Dataset`, its licence and citation are
+        When ``samples`` is a :class:`~tsrkit.core.types.Dataset`, its licence and citation are
         recorded in the model's info (the shipped model's data terms travel with it).
         """
         p = self.params

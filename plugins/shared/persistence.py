@@ -1,7 +1,8 @@
 """The learned verifier's scikit-learn model inside a tsrkit model file, safely.
 
 The estimator is serialised with ``skops.io`` (no pickle) into a byte array of the model's
-``.npz`` (so :mod:`tsrkit.models` checksums it like any array) and loaded back with an explicit
+``.npz`` (so :mod:`tsrkit.plugin.models` checksums it like any array) and loaded back with an
+explicit
 list of trusted types; anything else in the file is refused. skops names its members by
 ``id()`` of the objects and stamps the time, so the archive is made canonical (members
 numbered in schema order, fixed time stamps): the same estimator always gives the same bytes.

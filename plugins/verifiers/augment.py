@@ -117,7 +117,7 @@ class Augmentation:
 
     Raises
     ------
-    tsrkit.params.ParamError
+    tsrkit.plugin.params.ParamError
         A factor given twice.
     """
 

@@ -275,7 +275,7 @@ class LearnedVerifier(Verifier):
 
         Raises
         ------
-        tsrkit.models.ModelError
+        tsrkit.plugin.models.ModelError
             A missing, corrupt or foreign model, or one trained on another feature layout.
         """
         if self._estimator is None:
@@ -322,7 +322,7 @@ class LearnedVerifier(Verifier):
 
         Raises
         ------
-        tsrkit.models.ModelError
+        tsrkit.plugin.models.ModelError
             ``box_rank`` is 0 (no box model is read).
         """
         self.estimator  # noqa: B018 (loads both models)

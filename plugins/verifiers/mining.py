@@ -60,7 +60,7 @@ def centre_labels(candidates: Sequence[Candidate], boxes: Sequence[Sequence[floa
 
     Examples
     --------
-    >>> from tsrkit.types import Candidate
+    >>> from tsrkit.core.types import Candidate
     >>> c = [Candidate.from_circle(10, 10, 2, 1.0), Candidate.from_circle(40, 10, 2, 1.0)]
     >>> centre_labels(c, [(6, 0, 14, 20)]).tolist()
     [1, 0]
@@ -82,7 +82,7 @@ def box_labels(candidates: Sequence[Candidate], boxes: Sequence[Sequence[float]]
     Examples
     --------
     >>> from dataclasses import replace
-    >>> from tsrkit.types import Candidate
+    >>> from tsrkit.core.types import Candidate
     >>> on = replace(Candidate.from_circle(10, 5, 2, 1.0), housing=(6, 0, 14, 21))
     >>> off = replace(Candidate.from_circle(10, 15, 2, 1.0), housing=(0, 13, 30, 21))
     >>> far = Candidate.from_circle(90, 5, 2, 1.0)

@@ -1,5 +1,5 @@
 """Report writer ``plots``: every result's plots as PNG files under ``plots/``, each drawn once per
-run (:meth:`tsrkit.report.RunResult.plot_images`, shared with the HTML page)."""
+run (:meth:`tsrkit.reporting.report.RunResult.plot_images`, shared with the HTML page)."""
 
 from __future__ import annotations
 

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 from oracles.lamps import COLOURS, lamp, training_set
 
-from tsrkit.models import ModelError, load_model, save_model
-from tsrkit.registry import get_registry
-from tsrkit.types import Candidate, Frame
+from tsrkit.core.types import Candidate, Frame
+from tsrkit.plugin.models import ModelError, load_model, save_model
+from tsrkit.plugin.registry import get_registry
 from tsrkit_plugins.classifiers.ab_hist import ab_cells, ab_histograms, similarities
 from tsrkit_plugins.classifiers.decision import discriminative_ratio
 

@@ -11,9 +11,9 @@ from oracles.ab_hist_oracle import lens_areas, lens_scores
 from oracles.frames import annotated_frames
 from oracles.lamps import training_set
 
-from tsrkit.registry import get_registry
+from tsrkit.core.types import Candidate, Frame
+from tsrkit.plugin.registry import get_registry
 from tsrkit.synth import SynthOptions, render_frame
-from tsrkit.types import Candidate, Frame
 from tsrkit_plugins.shared.regions import labelled_lenses, lens_of
 
 PARAMS = [

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 from oracles.lamps import COLOURS, crop_sample, housing, lamp
 
-from tsrkit.registry import get_registry
-from tsrkit.types import Annotation, Candidate, Frame, Sample
+from tsrkit.core.types import Annotation, Candidate, Frame, Sample
+from tsrkit.plugin.registry import get_registry
 from tsrkit_plugins.classifiers.decision import best_state, discriminative_ratio, fuse_lights
 from tsrkit_plugins.shared.regions import (
     clip_box,

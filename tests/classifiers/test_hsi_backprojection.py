@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 from oracles.lamps import COLOURS, crop_sample, housing, lamp, training_set
 
-from tsrkit.models import Model, ModelError, load_model, save_model
-from tsrkit.registry import get_registry
-from tsrkit.types import Candidate, Frame
+from tsrkit.core.types import Candidate, Frame
+from tsrkit.plugin.models import Model, ModelError, load_model, save_model
+from tsrkit.plugin.registry import get_registry
 from tsrkit_plugins.classifiers.hsi_backprojection import (
     back_project,
     expected_diameter,

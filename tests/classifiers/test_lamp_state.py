@@ -6,8 +6,8 @@ import pytest
 from oracles.lamp_state_oracle import halved
 
 import tsrkit
-from tsrkit.models import ModelError, load_model, save_model
-from tsrkit.types import Annotation, Candidate, Frame, Sample
+from tsrkit.core.types import Annotation, Candidate, Frame, Sample
+from tsrkit.plugin.models import ModelError, load_model, save_model
 from tsrkit_plugins.classifiers.lamp_state import STATES, colour_jitter, labelled_features
 from tsrkit_plugins.classifiers.lamp_state.features import (
     N_FEATURES,

@@ -8,8 +8,8 @@ from oracles.lamps import training_set
 from threadpoolctl import threadpool_limits
 
 import tsrkit
-from tsrkit.models import Model, ModelError, load_model, save_model
-from tsrkit.types import Candidate, Frame
+from tsrkit.core.types import Candidate, Frame
+from tsrkit.plugin.models import Model, ModelError, load_model, save_model
 from tsrkit_plugins.classifiers.lamp_state import labelled_features, prefer_red
 from tsrkit_plugins.classifiers.lamp_state.colour import COLOUR, COLOUR_ARRAY, colour_columns
 from tsrkit_plugins.classifiers.lamp_state.features import N_HUE, lamp_features

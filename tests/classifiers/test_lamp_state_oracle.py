@@ -14,9 +14,9 @@ from oracles.lamps import training_set
 from threadpoolctl import threadpool_limits
 
 import tsrkit
-from tsrkit.models import Model, ModelError, save_model
-from tsrkit.registry import get_registry
-from tsrkit.types import Candidate, Frame
+from tsrkit.core.types import Candidate, Frame
+from tsrkit.plugin.models import Model, ModelError, save_model
+from tsrkit.plugin.registry import get_registry
 from tsrkit_plugins.classifiers.lamp_state.features import VERSION, housing_of, lamp_features
 from tsrkit_plugins.shared.forest import Forest
 from tsrkit_plugins.shared.persistence import estimator_arrays

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 from sklearn.svm import SVC
 
-from tsrkit.errors import TsrkitError
-from tsrkit.models import save_model
-from tsrkit.types import Annotation, Candidate, Frame, Sample
+from tsrkit.core.errors import TsrkitError
+from tsrkit.core.types import Annotation, Candidate, Frame, Sample
+from tsrkit.plugin.models import save_model
 from tsrkit_plugins.classifiers import logpolar_svm as lp
 
 SHAPES = ("disc", "square", "triangle", "cross")

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tsrkit.types import Annotation, Dataset, Sample
+from tsrkit.core.types import Annotation, Dataset, Sample
 from tsrkit_plugins.classifiers.lamp_state import STATES, labelled_features
 from tsrkit_plugins.classifiers.lamp_state.features import N_FEATURES, N_HUE
 

@@ -8,12 +8,12 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from tsrkit.benchmarking import run_benchmark
-from tsrkit.models import Model, ModelError, save_model
-from tsrkit.registry import get_registry
+from tsrkit.core.types import Candidate, Dataset
+from tsrkit.plugin.models import Model, ModelError, save_model
+from tsrkit.plugin.registry import get_registry
+from tsrkit.reporting.benchmarking import run_benchmark
+from tsrkit.runner.training import trainable_plugin
 from tsrkit.synth.sunlit import sweep
-from tsrkit.training import trainable_plugin
-from tsrkit.types import Candidate, Dataset
 from tsrkit_plugins.classifiers.sun_pca import FALLBACK_NOTE
 from tsrkit_plugins.classifiers.sun_pca.model import (
     SPREAD_FLOOR,

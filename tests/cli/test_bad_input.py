@@ -11,13 +11,13 @@ import pytest
 from click.testing import CliRunner
 
 from tsrkit.cli.main import cli
+from tsrkit.core.images import ImageReadError, read_image
+from tsrkit.core.types import Candidate, Sample
 from tsrkit.datasets import open_dataset
 from tsrkit.datasets.errors import DatasetError
-from tsrkit.engine import Job, process_sample
-from tsrkit.images import ImageReadError, read_image
-from tsrkit.params import Param, ParamError, validate
-from tsrkit.plugin import Detector
-from tsrkit.types import Candidate, Sample
+from tsrkit.plugin.base import Detector
+from tsrkit.plugin.params import Param, ParamError, validate
+from tsrkit.runner.engine import Job, process_sample
 
 
 def png_header_lie(path, width, height):

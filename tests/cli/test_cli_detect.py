@@ -104,7 +104,7 @@ def test_bad_input_is_one_line_exit_2(example_plugin, mixed_folder, args, messag
 
 def test_crashing_plugin_costs_a_frame_not_the_run(registry, mixed_folder):
     import tsrkit
-    from tsrkit.hookspecs import hookimpl
+    from tsrkit.plugin.hookspecs import hookimpl
 
     class Crashy(tsrkit.Detector):
         name = "crashy"
@@ -139,7 +139,7 @@ def test_plugins_json_lists_name_kind_package_version_summary(example_plugin):
 def needs_model(registry):
     """A detector that, like a trainable one without its model, raises TsrkitError on use."""
     import tsrkit
-    from tsrkit.hookspecs import hookimpl
+    from tsrkit.plugin.hookspecs import hookimpl
 
     class NeedsModel(tsrkit.Detector):
         name = "needs-model"

@@ -15,7 +15,7 @@ from click.testing import CliRunner
 
 from tsrkit import Detector, hookimpl
 from tsrkit.cli.main import cli
-from tsrkit.types import Candidate, Dataset
+from tsrkit.core.types import Candidate, Dataset
 
 VERBS_WITH_EXAMPLES = [
     ["benchmark"],
@@ -183,7 +183,7 @@ def test_an_aborted_detect_keeps_every_frame_done_so_far(registry, tmp_path):
 
 def test_a_conversion_that_loses_states_warns_with_the_counts(tmp_path):
     from tsrkit.cli.datasets import state_changes
-    from tsrkit.types import Annotation, Sample
+    from tsrkit.core.types import Annotation, Sample
 
     image = tmp_path / "a.png"
     cv2.imwrite(str(image), np.zeros((20, 20, 3), np.uint8))

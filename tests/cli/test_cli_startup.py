@@ -14,7 +14,7 @@ import tsrkit
 from tsrkit.cli.main import cli
 from tsrkit.cli.verbs import VERBS
 
-HEAVY = ("numpy", "cv2", "matplotlib", "sklearn", "dask", "skimage", "tsrkit.registry")
+HEAVY = ("numpy", "cv2", "matplotlib", "sklearn", "dask", "skimage", "tsrkit.plugin.registry")
 
 
 def test_help_imports_no_verb_and_no_heavy_library():
@@ -38,7 +38,7 @@ def test_loading_every_plugin_imports_no_map_reader():
     # sun-pca needs GPS tracks, not the OpenStreetMap reader and its SciPy graph routines
     code = (
         "import sys\n"
-        "from tsrkit.registry import get_registry\n"
+        "from tsrkit.plugin.registry import get_registry\n"
         "get_registry()\n"
         "print([m for m in ('tsrkit.geo.osm', 'tsrkit.geo.vicinity', 'scipy.sparse.csgraph')"
         " if m in sys.modules])\n"
@@ -68,7 +68,7 @@ def test_the_python_api_names_resolve_on_first_use():
     assert tsrkit.select.__name__ == "build"
     from tsrkit import Candidate, hookimpl
 
-    assert Candidate.__module__ == "tsrkit.types" and callable(hookimpl)
+    assert Candidate.__module__ == "tsrkit.core.types" and callable(hookimpl)
     assert set(tsrkit.__all__) <= set(dir(tsrkit))
     assert tsrkit.datasets.open_datasets.__module__ == "tsrkit.datasets.concat"
     assert not hasattr(tsrkit, "no_such_name")

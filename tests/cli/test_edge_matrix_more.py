@@ -828,7 +828,7 @@ def locked_by(tmp: Path, started: str, lock: str = ".o.jsonl.tsrkit.lock", verb=
     parent process (alive, not this one): with its real start time (``live``), another one, or
     none in a lock written in 2000, before the process started (``legacy``: its id was reused
     since)."""
-    from tsrkit.outlock import _start_time
+    from tsrkit.runner.outlock import _start_time
 
     parent = os.getppid()
     path = tmp / lock

@@ -20,13 +20,13 @@ from click.testing import CliRunner
 from hypothesis import HealthCheck, given, settings, strategies as st
 
 from tsrkit.cli.main import cli
-from tsrkit.engine import read_cached
-from tsrkit.errors import TsrkitError
-from tsrkit.files import MAX_DEPTH, InputFileError, loads_json, loads_yaml
-from tsrkit.inputs import check_range, plan_work
-from tsrkit.outputs import OutputIsInput, reading, refuse_input
-from tsrkit.params import CONFIG_KEYS, ParamError, load_config
-from tsrkit.records import FrameRecord
+from tsrkit.core.errors import TsrkitError
+from tsrkit.core.files import MAX_DEPTH, InputFileError, loads_json, loads_yaml
+from tsrkit.core.outputs import OutputIsInput, reading, refuse_input
+from tsrkit.core.records import FrameRecord
+from tsrkit.plugin.params import CONFIG_KEYS, ParamError, load_config
+from tsrkit.runner.engine import read_cached
+from tsrkit.runner.inputs import check_range, plan_work
 
 BOUNDED = settings(
     max_examples=int(os.environ.get("TSRKIT_HYPOTHESIS_EXAMPLES", "40")),

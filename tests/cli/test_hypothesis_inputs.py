@@ -21,11 +21,11 @@ import pytest
 import yaml
 from hypothesis import HealthCheck, given, settings, strategies as st
 
+from tsrkit.core.errors import TsrkitError
+from tsrkit.core.images import ImageReadError, read_image
 from tsrkit.datasets import open_dataset
-from tsrkit.errors import TsrkitError
-from tsrkit.images import ImageReadError, read_image
-from tsrkit.models import Model, ModelError, load_model, save_model
-from tsrkit.params import TYPES, Param, ParamError, load_config, validate
+from tsrkit.plugin.models import Model, ModelError, load_model, save_model
+from tsrkit.plugin.params import TYPES, Param, ParamError, load_config, validate
 
 BOUNDED = settings(
     max_examples=int(os.environ.get("TSRKIT_HYPOTHESIS_EXAMPLES", "40")),

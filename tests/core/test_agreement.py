@@ -3,9 +3,9 @@ dropped, and nothing linked across videos."""
 
 import pytest
 
-from tsrkit.agreement import Agreement
-from tsrkit.pipeline import FrameResult
-from tsrkit.types import Candidate, Detection, Skipped
+from tsrkit.core.types import Candidate, Detection, Skipped
+from tsrkit.plugin.pipeline import FrameResult
+from tsrkit.runner.agreement import Agreement
 
 
 def frame(index, *centres, source="drive.mp4"):

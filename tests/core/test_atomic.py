@@ -6,7 +6,7 @@ import stat
 
 import pytest
 
-from tsrkit.atomic import atomic_open, json_line, write_json
+from tsrkit.core.atomic import atomic_open, json_line, write_json
 
 
 def test_success_replaces_and_uses_umask_permissions(tmp_path):

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 import tsrkit
-from tsrkit.follow import Follower, region, shifted
-from tsrkit.pipeline import Pipeline
-from tsrkit.types import Candidate, Frame
+from tsrkit.core.types import Candidate, Frame
+from tsrkit.plugin.pipeline import Pipeline
+from tsrkit.runner.follow import Follower, region, shifted
 
 
 class RedDiscs(tsrkit.Detector):

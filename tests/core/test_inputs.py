@@ -4,8 +4,8 @@ import cv2
 import numpy as np
 import pytest
 
-from tsrkit.inputs import ImageReadError, iter_frames, read_image, to_bgr8
-from tsrkit.types import Frame, Skipped
+from tsrkit.core.types import Frame, Skipped
+from tsrkit.runner.inputs import ImageReadError, iter_frames, read_image, to_bgr8
 
 
 def scene(h=24, w=32):

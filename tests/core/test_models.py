@@ -5,7 +5,7 @@ import json
 import numpy as np
 import pytest
 
-from tsrkit.models import Model, ModelError, load_model, save_model
+from tsrkit.plugin.models import Model, ModelError, load_model, save_model
 
 
 def saved(tmp_path):

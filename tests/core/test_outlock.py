@@ -6,8 +6,8 @@ import sys
 import pytest
 from benchmark_fakes import OracleDetector, hand_dataset, make
 
-from tsrkit.benchmarking import benchmark
-from tsrkit.outlock import LOCK, OutputBusy, locked
+from tsrkit.reporting.benchmarking import benchmark
+from tsrkit.runner.outlock import LOCK, OutputBusy, locked
 
 
 def test_a_second_live_run_into_the_same_out_refuses(tmp_path):

@@ -2,7 +2,7 @@
 
 import pytest
 
-from tsrkit.params import Param, ParamError, load_config, parse_assignments, validate
+from tsrkit.plugin.params import Param, ParamError, load_config, parse_assignments, validate
 
 SCHEMA = (
     Param("h_peak", "float", 0.9, min=0, max=1),

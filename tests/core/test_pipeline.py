@@ -3,7 +3,7 @@
 import numpy as np
 
 import tsrkit
-from tsrkit.types import Candidate, Detection, Frame
+from tsrkit.core.types import Candidate, Detection, Frame
 
 
 class Fixed(tsrkit.Detector):

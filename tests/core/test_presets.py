@@ -9,10 +9,10 @@ from click.testing import CliRunner
 
 import tsrkit
 from tsrkit.cli.main import cli
-from tsrkit.errors import TsrkitError
-from tsrkit.params import load_config
-from tsrkit.presets import describe, preset_names, preset_path, resolve_config
-from tsrkit.registry import get_registry
+from tsrkit.core.errors import TsrkitError
+from tsrkit.plugin.params import load_config
+from tsrkit.plugin.presets import describe, preset_names, preset_path, resolve_config
+from tsrkit.plugin.registry import get_registry
 
 
 def test_every_preset_loads_and_names_installed_plugins():
@@ -62,7 +62,7 @@ def test_presets_command_lists_and_shows():
 
 
 def test_recommended_verifier_model_was_trained_on_the_presets_candidates():
-    from tsrkit.models import load_model
+    from tsrkit.plugin.models import load_model
     from tsrkit_plugins.verifiers.learned import DEFAULT_MODEL
 
     preset = load_config("recommended")

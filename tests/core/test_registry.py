@@ -8,9 +8,9 @@ import sys
 import pytest
 
 import tsrkit
-from tsrkit.hookspecs import hookimpl
-from tsrkit.params import Param, ParamError
-from tsrkit.registry import PluginNotFound, Registry
+from tsrkit.plugin.hookspecs import hookimpl
+from tsrkit.plugin.params import Param, ParamError
+from tsrkit.plugin.registry import PluginNotFound, Registry
 
 
 class Dummy(tsrkit.Detector):
@@ -209,7 +209,7 @@ def test_a_plugin_calling_sys_exit_at_import_is_a_failed_plugin(tmp_path):
 
 CLASH = """\
 import tsrkit
-from tsrkit.hookspecs import hookimpl
+from tsrkit.plugin.hookspecs import hookimpl
 
 
 class Mine(tsrkit.Detector):

@@ -13,10 +13,10 @@ import numpy as np
 import pytest
 from benchmark_fakes import OracleDetector, RedClassifier, ShiftedDetector, hand_dataset, make
 
-from tsrkit.benchmarking import benchmark
-from tsrkit.comparison import compare
-from tsrkit.engine import BenchmarkError
-from tsrkit.types import Annotation, Dataset, Sample
+from tsrkit.core.types import Annotation, Dataset, Sample
+from tsrkit.reporting.benchmarking import benchmark
+from tsrkit.reporting.comparison import compare
+from tsrkit.runner.engine import BenchmarkError
 
 TESTS = Path(__file__).resolve().parents[1]
 
@@ -190,7 +190,7 @@ SCRIPT = """
 import sys
 sys.path.insert(0, {tests!r})
 from benchmark_fakes import OracleDetector, hand_dataset, make
-from tsrkit.benchmarking import benchmark
+from tsrkit.reporting.benchmarking import benchmark
 benchmark(hand_dataset(30), make(OracleDetector, delay=0.04), out=sys.argv[1])
 """
 

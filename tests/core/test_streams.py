@@ -8,13 +8,13 @@ import pytest
 from benchmark_fakes import FrameCrasher, UntrainedDetector, make
 
 import tsrkit
-from tsrkit.errors import TsrkitError
-from tsrkit.follow import Follower
-from tsrkit.inputs import Work, iter_video, plan_work
-from tsrkit.pipeline import Pipeline
-from tsrkit.streams import CHUNK_FRAMES, run_pipeline
+from tsrkit.core.errors import TsrkitError
+from tsrkit.core.types import Skipped
+from tsrkit.plugin.pipeline import Pipeline
+from tsrkit.runner.follow import Follower
+from tsrkit.runner.inputs import Work, iter_video, plan_work
+from tsrkit.runner.streams import CHUNK_FRAMES, run_pipeline
 from tsrkit.synth import sample_path
-from tsrkit.types import Skipped
 
 
 @pytest.fixture(scope="module")

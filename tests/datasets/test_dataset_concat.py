@@ -8,10 +8,10 @@ import pytest
 from click.testing import CliRunner
 
 from tsrkit.cli.main import cli
+from tsrkit.core.errors import TsrkitError
+from tsrkit.core.types import Annotation, Dataset, Sample
 from tsrkit.datasets import concat_datasets, open_datasets, parse_reference
 from tsrkit.datasets.registry import load_registry
-from tsrkit.errors import TsrkitError
-from tsrkit.types import Annotation, Dataset, Sample
 
 
 def test_parse_reference_takes_the_last_colon_unless_the_path_exists(tmp_path):

@@ -6,8 +6,8 @@ import json
 
 import pytest
 
+from tsrkit.core.errors import TsrkitError
 from tsrkit.datasets import DatasetError, load_registry, open_dataset
-from tsrkit.errors import TsrkitError
 
 REAL = [
     "roboflow_traffic_light_kr",
@@ -127,7 +127,7 @@ def test_sample_resolves_through_synth(tmp_path, monkeypatch):
     file.write_text(
         json.dumps([{"file": "f.jpg", "split": "train", "width": 4, "height": 4, "boxes": []}])
     )
-    monkeypatch.setattr("tsrkit.synth.scenes.sample_path", lambda: file)
+    monkeypatch.setattr("tsrkit.datasets.scenes.sample_path", lambda: file)
     ds = open_dataset("sample")
     assert ds.name == "sample" and ds.format == "normalized" and len(ds) == 1
     assert ds.info["box"] == "lens"

@@ -6,8 +6,8 @@ import cv2
 import numpy as np
 import pytest
 
+from tsrkit.core.types import Annotation, Dataset, Sample
 from tsrkit.datasets import open_dataset, write_dataset
-from tsrkit.types import Annotation, Dataset, Sample
 
 
 @pytest.fixture

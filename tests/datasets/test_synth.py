@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from tsrkit.errors import TsrkitError
-from tsrkit.lighting import mean_v
-from tsrkit.registry import get_registry
-from tsrkit.synth import scenes as synth
+from tsrkit.core.errors import TsrkitError
+from tsrkit.datasets import scenes as synth
+from tsrkit.eval.lighting import mean_v
+from tsrkit.plugin.registry import get_registry
 
 #: OpenCV hue ranges (0-179) that vote for each state; cf. Mascetti Table 6 and 4.1.
 HUE_RANGES = {"red": ((0, 10), (160, 179)), "yellow": ((11, 34),), "green": ((60, 100),)}

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from tsrkit.geo import read_signals, read_track, traversals
-from tsrkit.inputs import iter_video
+from tsrkit.runner.inputs import iter_video
 from tsrkit.synth.drive import (
     HEAD_PAST,
     Camera,

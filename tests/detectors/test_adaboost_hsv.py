@@ -8,9 +8,9 @@ import pytest
 from sklearn.ensemble import AdaBoostClassifier
 from sklearn.tree import DecisionTreeClassifier
 
-from tsrkit.errors import TsrkitError
-from tsrkit.models import load_model, save_model
-from tsrkit.types import Annotation, Frame, Sample
+from tsrkit.core.errors import TsrkitError
+from tsrkit.core.types import Annotation, Frame, Sample
+from tsrkit.plugin.models import load_model, save_model
 from tsrkit_plugins.detectors import adaboost_hsv as ab
 
 RED, GREEN = (20, 30, 230), (60, 200, 40)

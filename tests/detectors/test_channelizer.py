@@ -7,12 +7,12 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from tsrkit.depth import PANEL_HEIGHT_M, distance_from_height, lateral_offset, vertical_offset
+from tsrkit.core.depth import PANEL_HEIGHT_M, distance_from_height, lateral_offset, vertical_offset
+from tsrkit.core.records import DetectionRecord
+from tsrkit.core.types import Candidate, Detection, Frame
 from tsrkit.eval.overlap import match_by_iou
-from tsrkit.records import DetectionRecord
-from tsrkit.registry import get_registry
+from tsrkit.plugin.registry import get_registry
 from tsrkit.synth.workzone import generate, render
-from tsrkit.types import Candidate, Detection, Frame
 from tsrkit_plugins.detectors.channelizer import diagonal_edges, panel_height, runs
 
 

@@ -10,7 +10,7 @@ import pytest
 from oracles.conspicuity_oracle import conspicuity_reference
 
 import tsrkit
-from tsrkit.types import Frame
+from tsrkit.core.types import Frame
 from tsrkit_plugins.detectors.conspicuity import conspicuity as cs, conspicuity_kernel as ck
 from tsrkit_plugins.detectors.conspicuity.colour import lightness_and_saturation
 
@@ -487,7 +487,7 @@ def test_fused_combination_equals_the_integer_steps_bit_for_bit(shared_datasets)
 
 def test_unusable_settings_fail_at_construction_as_a_parameter_error():
     import tsrkit
-    from tsrkit.params import ParamError
+    from tsrkit.plugin.params import ParamError
 
     with pytest.raises(ParamError, match="detector 'conspicuity': weights must be"):
         tsrkit.detector("conspicuity", weights=(0, 0, 0))

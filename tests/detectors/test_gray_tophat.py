@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import tsrkit
-from tsrkit.types import Frame
+from tsrkit.core.types import Frame
 from tsrkit_plugins.detectors.gray_tophat import white_tophat
 
 

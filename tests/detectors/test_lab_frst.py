@@ -9,9 +9,9 @@ from oracles.frst_arrays import frst_arrays
 from oracles.lamps import street
 
 import tsrkit
+from tsrkit.core.types import Frame
 from tsrkit.datasets import open_dataset
 from tsrkit.synth import SynthOptions, render_frame
-from tsrkit.types import Frame
 from tsrkit_plugins.detectors.frst.lab_frst import lab_feature_map, spot_candidates
 
 RED = (40, 40, 235)

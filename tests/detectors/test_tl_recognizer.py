@@ -11,10 +11,10 @@ import pytest
 from oracles.tl_recognizer_loop import scored_loop
 
 import tsrkit
+from tsrkit.core.types import Annotation, Frame, Sample
 from tsrkit.datasets import open_dataset
-from tsrkit.models import load_model, save_model
-from tsrkit.registry import get_registry
-from tsrkit.types import Annotation, Frame, Sample
+from tsrkit.plugin.models import load_model, save_model
+from tsrkit.plugin.registry import get_registry
 from tsrkit_plugins.detectors.tl_recognizer import (
     TlRecognizer,
     enclosed_cores,
@@ -448,7 +448,7 @@ def test_registered_and_listed_as_trainable():
 
 
 def test_real_frames_run_and_states_are_valid(shared_datasets):
-    from tsrkit.inputs import read_image
+    from tsrkit.runner.inputs import read_image
 
     images = sorted((shared_datasets / "roboflow_cinta_v2_id").rglob("*.jpg"))[:8]
     assert images

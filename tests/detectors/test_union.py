@@ -5,10 +5,10 @@ import cv2
 import numpy as np
 import pytest
 
-from tsrkit.params import ParamError
-from tsrkit.registry import get_registry
+from tsrkit.core.types import Candidate, Frame
+from tsrkit.plugin.params import ParamError
+from tsrkit.plugin.registry import get_registry
 from tsrkit.synth.heads import background, render_head
-from tsrkit.types import Candidate, Frame
 from tsrkit_plugins.detectors.union import (
     ScaledMember,
     map_back,

@@ -12,8 +12,8 @@ from click.testing import CliRunner
 
 import tsrkit
 from tsrkit.cli.main import cli
-from tsrkit.comparison import compare
-from tsrkit.types import Annotation, Candidate, Dataset, Sample
+from tsrkit.core.types import Annotation, Candidate, Dataset, Sample
+from tsrkit.reporting.comparison import compare
 
 HOUSING = (10.0, 5.0, 20.0, 35.0)  # a vertical head; its top lamp is lit
 

@@ -9,8 +9,8 @@ from benchmark_fakes import OracleDetector, hand_dataset, make
 from pycocotools.coco import COCO
 from pycocotools.cocoeval import COCOeval
 
-from tsrkit.benchmarking import benchmark
 from tsrkit.eval.coco import coco_ap
+from tsrkit.reporting.benchmarking import benchmark
 
 
 def pycocotools_stats(gt_path, dt_path):

@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
+from tsrkit.core.geometry import enclosing_circles, iou_matrix
 from tsrkit.eval.matching import centre_hits, greedy_match
 from tsrkit.eval.overlap import score_overlap, summarise_overlap
-from tsrkit.geometry import enclosing_circles, iou_matrix
 
 
 def test_enclosing_circle_of_a_3_4_5_box():

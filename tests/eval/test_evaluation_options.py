@@ -13,12 +13,12 @@ from benchmark_fakes import OracleDetector, hand_dataset, make
 from click.testing import CliRunner
 
 import tsrkit
-from tsrkit.benchmarking import benchmark
 from tsrkit.cli.main import cli
-from tsrkit.models import Model
-from tsrkit.params import ParamError
-from tsrkit.selection import build_compare
-from tsrkit.types import Annotation, Dataset
+from tsrkit.core.types import Annotation, Dataset
+from tsrkit.plugin.models import Model
+from tsrkit.plugin.params import ParamError
+from tsrkit.plugin.selection import build_compare
+from tsrkit.reporting.benchmarking import benchmark
 
 
 class HousingVerifier(tsrkit.Verifier):

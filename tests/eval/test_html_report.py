@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 import tsrkit
-from tsrkit.report import fmt
+from tsrkit.reporting.report import fmt
 
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 REFERENCE = Path(__file__).resolve().parents[1] / "data" / "reference_reports"

@@ -6,8 +6,8 @@ import cv2
 import numpy as np
 import pytest
 
-from tsrkit.inputs import read_image
-from tsrkit.lighting import LIGHT_CONDITIONS, condition_of_m, light_condition, mean_v
+from tsrkit.eval.lighting import LIGHT_CONDITIONS, condition_of_m, light_condition, mean_v
+from tsrkit.runner.inputs import read_image
 
 
 def test_mean_v_matches_opencv_hsv():

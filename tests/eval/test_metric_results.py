@@ -20,7 +20,7 @@ from tsrkit.api import Metric, MetricResult, Plot, ReportWriter, Table, hookimpl
 from tsrkit.cli.main import cli
 from tsrkit.eval.guard import GuardedMetrics
 from tsrkit.eval.settings import EvalSettings
-from tsrkit.report import REPORT_KEYS, headline, run_results
+from tsrkit.reporting.report import REPORT_KEYS, headline, run_results
 
 PNG = b"\x89PNG\r\n\x1a\n"
 REFERENCE = Path(__file__).resolve().parents[1] / "data" / "reference_reports"
@@ -184,7 +184,7 @@ def test_a_shared_section_lists_each_metrics_keys():
 
 
 def test_a_report_written_before_results_rendered_themselves_still_renders():
-    from tsrkit.eval.results import fmt
+    from tsrkit.core.results import fmt
 
     stored = json.loads(
         (REFERENCE / "sample_conspicuity_ab-hist.report.json").read_text(encoding="utf-8")

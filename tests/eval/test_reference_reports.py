@@ -15,9 +15,9 @@ from pathlib import Path
 import pytest
 
 import tsrkit
-from tsrkit.benchmarking import eval_settings, evaluate
-from tsrkit.comparison import paired_tests
-from tsrkit.records import FrameRecord
+from tsrkit.core.records import FrameRecord
+from tsrkit.reporting.benchmarking import eval_settings, evaluate
+from tsrkit.reporting.comparison import paired_tests
 
 REFERENCE = Path(__file__).resolve().parents[1] / "data" / "reference_reports"
 

@@ -6,9 +6,9 @@ from pathlib import Path
 
 import numpy as np
 
+from tsrkit.core.types import Candidate
 from tsrkit.datasets import open_dataset
 from tsrkit.synth import SynthOptions, render_frame
-from tsrkit.types import Candidate
 
 #: The real detection sets: lens boxes (KR) and housing boxes (cinTA, DTLD), three cameras.
 CAMERAS = ("roboflow_cinta_v2_id", "dtld_fridtjofs", "roboflow_traffic_light_kr")

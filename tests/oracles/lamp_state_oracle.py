@@ -15,7 +15,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from tsrkit.geometry import clip_box
+from tsrkit.core.geometry import clip_box
 from tsrkit_plugins.classifiers.lamp_state import STATES, blend, prefer_red, red_yellow
 from tsrkit_plugins.classifiers.lamp_state.colour import COLOUR, mix
 from tsrkit_plugins.classifiers.lamp_state.features import (

@@ -6,7 +6,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from tsrkit.types import Annotation, Frame, Sample
+from tsrkit.core.types import Annotation, Frame, Sample
 
 #: Pure lamp colours (BGR) as a camera roughly images them.
 COLOURS = {"red": (40, 30, 230), "yellow": (20, 200, 240), "green": (170, 220, 30)}

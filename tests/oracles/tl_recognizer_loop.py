@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from tsrkit.types import Candidate, Frame
+from tsrkit.core.types import Candidate, Frame
 from tsrkit_plugins.detectors.tl_recognizer.tl_recognizer import (
     PASSES,
     enclosed_cores,

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tsrkit.pipeline import Pipeline
-from tsrkit.plugin import Detector
-from tsrkit.types import Candidate, Detection, Frame
+from tsrkit.core.types import Candidate, Detection, Frame
+from tsrkit.plugin.base import Detector
+from tsrkit.plugin.pipeline import Pipeline
 from tsrkit_plugins.trackers import meanshift as ms
 
 

@@ -11,10 +11,10 @@ import pytest
 from click.testing import CliRunner
 
 from tsrkit.cli.main import cli
-from tsrkit.models import ModelError, save_model
-from tsrkit.plugin import Detector
-from tsrkit.registry import get_registry
-from tsrkit.types import Candidate, Frame
+from tsrkit.core.types import Candidate, Frame
+from tsrkit.plugin.base import Detector
+from tsrkit.plugin.models import ModelError, save_model
+from tsrkit.plugin.registry import get_registry
 from tsrkit_plugins.verifiers.cnn.augment import geometry
 from tsrkit_plugins.verifiers.cnn.data import Scene, collect, housing_target, label
 from tsrkit_plugins.verifiers.cnn.windows import TRAIN_MARGIN, Window, crops, cut
@@ -231,7 +231,7 @@ def test_tsrkit_train_cnn_verifier_writes_a_model_the_plugin_reads(tmp_path):
 
 
 def test_adapting_to_a_camera_re_estimates_only_the_normalisation(trained):
-    from tsrkit.models import load_model
+    from tsrkit.plugin.models import load_model
     from tsrkit_plugins.verifiers.cnn.training import adapt
 
     path, _, scenes, _, detector = trained

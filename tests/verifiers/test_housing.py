@@ -5,11 +5,11 @@ import numpy as np
 import pytest
 
 import tsrkit
-from tsrkit.geometry import iou_matrix
-from tsrkit.pipeline import Pipeline
-from tsrkit.registry import get_registry
+from tsrkit.core.geometry import iou_matrix
+from tsrkit.core.types import Candidate, Frame
+from tsrkit.plugin.pipeline import Pipeline
+from tsrkit.plugin.registry import get_registry
 from tsrkit.synth.heads import LAMP_COLOURS, background, render_head
-from tsrkit.types import Candidate, Frame
 from tsrkit_plugins.verifiers.housing.fit import fit_housings
 
 LAYOUTS = [(v, n, lit) for v in (True, False) for n in (3, 4) for lit in range(n)]

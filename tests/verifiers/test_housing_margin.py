@@ -4,9 +4,9 @@ stage's ``margin``."""
 import numpy as np
 import pytest
 
-from tsrkit.registry import get_registry
+from tsrkit.core.types import Annotation, Candidate, Frame, Sample
+from tsrkit.plugin.registry import get_registry
 from tsrkit.synth.heads import LAMP_COLOURS, background, render_head
-from tsrkit.types import Annotation, Candidate, Frame, Sample
 from tsrkit_plugins.verifiers.housing.margin import learn_margin, margin_free_iou, widen
 
 

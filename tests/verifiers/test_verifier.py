@@ -11,11 +11,11 @@ from click.testing import CliRunner
 from skimage.feature import hog
 
 from tsrkit.cli.main import cli
-from tsrkit.models import ModelError, load_model, model_paths
-from tsrkit.registry import get_registry
+from tsrkit.core.types import Annotation, Candidate, Dataset, Frame, Sample
+from tsrkit.plugin.models import ModelError, load_model, model_paths
+from tsrkit.plugin.registry import get_registry
+from tsrkit.runner.training import train
 from tsrkit.synth import SynthOptions, render_frame
-from tsrkit.training import train
-from tsrkit.types import Annotation, Candidate, Dataset, Frame, Sample
 from tsrkit_plugins.verifiers import features as F
 from tsrkit_plugins.verifiers.mining import centre_labels, no_light_frames
 
@@ -313,7 +313,7 @@ def test_untrusted_types_in_the_estimator_bytes_are_refused():
     import skops.io as sio
     from sklearn.preprocessing import FunctionTransformer
 
-    from tsrkit.models import Model
+    from tsrkit.plugin.models import Model
     from tsrkit_plugins.shared.persistence import ARRAY, load_estimator
 
     blob = np.frombuffer(sio.dumps(FunctionTransformer(func=print)), np.uint8)
@@ -322,7 +322,7 @@ def test_untrusted_types_in_the_estimator_bytes_are_refused():
 
 
 def test_fit_needs_a_detector_and_both_classes():
-    from tsrkit.errors import TsrkitError
+    from tsrkit.core.errors import TsrkitError
 
     with pytest.raises(TsrkitError, match="detector"):
         make().fit(tiny_dataset(1))

@@ -6,12 +6,12 @@ import numpy as np
 import pytest
 from test_verifier import FAST, tiny_dataset
 
-from tsrkit.models import load_model
-from tsrkit.params import ParamError
-from tsrkit.plugin import Detector
-from tsrkit.registry import get_registry
-from tsrkit.training import train
-from tsrkit.types import Candidate, Frame
+from tsrkit.core.types import Candidate, Frame
+from tsrkit.plugin.base import Detector
+from tsrkit.plugin.models import load_model
+from tsrkit.plugin.params import ParamError
+from tsrkit.plugin.registry import get_registry
+from tsrkit.runner.training import train
 from tsrkit_plugins.verifiers.augment import Augmentation, camera_look, resized
 from tsrkit_plugins.verifiers.mining import labelled_candidates
 
@@ -96,7 +96,7 @@ class Brightest(Detector):
 
 
 def test_mining_labels_each_resized_view_by_its_own_boxes():
-    from tsrkit.types import Annotation, Sample
+    from tsrkit.core.types import Annotation, Sample
 
     image = square_frame().image
     sample = Sample(

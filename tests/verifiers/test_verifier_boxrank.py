@@ -9,10 +9,10 @@ import pytest
 from scipy.special import logit
 from test_verifier import FAST, lamp_scene, make, tiny_dataset
 
-from tsrkit.models import ModelError, load_model
-from tsrkit.registry import get_registry
-from tsrkit.training import train
-from tsrkit.types import Candidate, Frame
+from tsrkit.core.types import Candidate, Frame
+from tsrkit.plugin.models import ModelError, load_model
+from tsrkit.plugin.registry import get_registry
+from tsrkit.runner.training import train
 from tsrkit_plugins.shared.forest import Forest
 from tsrkit_plugins.shared.persistence import BOX_ARRAY, load_estimator
 from tsrkit_plugins.verifiers import features as F

@@ -14,8 +14,8 @@ import pytest
 from oracles import verifier_features_oracle as oracle
 from oracles.frames import annotated_frames
 
-from tsrkit.registry import get_registry
-from tsrkit.types import Candidate, Frame
+from tsrkit.core.types import Candidate, Frame
+from tsrkit.plugin.registry import get_registry
 from tsrkit_plugins.verifiers.features import candidate_features, remap_points, row_percentile
 
 

@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 from threadpoolctl import threadpool_limits
 
+from tsrkit.core.types import Candidate
 from tsrkit.datasets import open_dataset
-from tsrkit.models import ModelError
-from tsrkit.registry import get_registry
+from tsrkit.plugin.models import ModelError
+from tsrkit.plugin.registry import get_registry
 from tsrkit.synth import SynthOptions, render_frame
-from tsrkit.types import Candidate
 from tsrkit_plugins.shared.forest import Forest
 from tsrkit_plugins.verifiers.features import candidate_features
 

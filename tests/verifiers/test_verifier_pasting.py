@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 from test_verifier import FAST, make, tiny_dataset
 
-from tsrkit.errors import TsrkitError
-from tsrkit.models import load_model
-from tsrkit.registry import get_registry
-from tsrkit.training import train
-from tsrkit.types import Annotation, Candidate, Sample
+from tsrkit.core.errors import TsrkitError
+from tsrkit.core.types import Annotation, Candidate, Sample
+from tsrkit.plugin.models import load_model
+from tsrkit.plugin.registry import get_registry
+from tsrkit.runner.training import train
 from tsrkit_plugins.verifiers.mining import centre_labels
 from tsrkit_plugins.verifiers.pasting import (
     CROP_SET,

@@ -8,7 +8,7 @@ The command line registers this module as an internal plugin when it needs every
 import importlib
 
 from tsrkit.cli.verbs import VERBS
-from tsrkit.hookspecs import hookimpl
+from tsrkit.plugin.hookspecs import hookimpl
 
 __all__ = ["register_commands"]
 

@@ -1,6 +1,6 @@
 """Options shared by the verbs that run plugins (selection, ``--param``, ``--config``) and a
 float option type that refuses NaN. Building the chosen plugins is
-:func:`tsrkit.selection.build`."""
+:func:`tsrkit.plugin.selection.build`."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import math
 import click
 
 from tsrkit.cli.completion import plugin_names, preset_or_file
-from tsrkit.selection import DEFAULT_DETECTOR
+from tsrkit.plugin.selection import DEFAULT_DETECTOR
 
 __all__ = ["FiniteFloatRange", "plugin_options", "split_name"]
 

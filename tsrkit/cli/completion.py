@@ -39,7 +39,8 @@ def plugin_names(kind: str) -> Complete:
     """Complete the installed plugins of ``kind`` (detector, classifier, format, writer...)."""
 
     def names() -> list[str]:
-        from tsrkit.registry import get_registry
+        # only when the shell asks for completions: start-up stays fast
+        from tsrkit.plugin.registry import get_registry
 
         return [info.name for info in get_registry().plugins(kind)]
 
@@ -62,8 +63,9 @@ def trainable_names(ctx, param, incomplete: str) -> list[CompletionItem]:
     """Complete the trainable plugins (``tsrkit train PLUGIN``)."""
 
     def names() -> list[str]:
-        from tsrkit.plugin import is_trainable
-        from tsrkit.registry import get_registry
+        # only when the shell asks for completions: start-up stays fast
+        from tsrkit.plugin.base import is_trainable
+        from tsrkit.plugin.registry import get_registry
 
         return [i.name for i in get_registry().plugins() if is_trainable(i.cls)]
 
@@ -74,6 +76,7 @@ def dataset_names(ctx, param, incomplete: str) -> list[CompletionItem]:
     """Complete registered dataset names and ``sample``; paths are completed by the shell."""
 
     def names() -> list[str]:
+        # only when the shell asks for completions: start-up stays fast
         from tsrkit.datasets import load_registry
 
         return ["sample", *load_registry()]
@@ -84,7 +87,8 @@ def dataset_names(ctx, param, incomplete: str) -> list[CompletionItem]:
 
 def preset_or_file(ctx, param, incomplete: str) -> list[CompletionItem]:
     """Complete preset names for ``--config``, else let the shell complete a file."""
-    from tsrkit.presets import preset_names
+    # only when the shell asks for completions: start-up stays fast
+    from tsrkit.plugin.presets import preset_names
 
     found = _items(preset_names, incomplete)
     return found or [CompletionItem(incomplete, type="file")]
@@ -92,6 +96,7 @@ def preset_or_file(ctx, param, incomplete: str) -> list[CompletionItem]:
 
 def preset_names_only(ctx, param, incomplete: str) -> list[CompletionItem]:
     """Complete preset names (``tsrkit presets --show``)."""
-    from tsrkit.presets import preset_names
+    # only when the shell asks for completions: start-up stays fast
+    from tsrkit.plugin.presets import preset_names
 
     return _items(preset_names, incomplete)

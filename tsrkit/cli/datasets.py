@@ -10,10 +10,13 @@ import click
 from rich.console import Console
 from rich.table import Table
 
-from tsrkit.atomic import json_text
 from tsrkit.cli.completion import dataset_names, plugin_names
 from tsrkit.cli.drive import drive_command
 from tsrkit.cli.synth import synth_command
+from tsrkit.core.atomic import json_text
+from tsrkit.core.errors import TsrkitError
+from tsrkit.core.outputs import reading, refuse_input, refuse_special
+from tsrkit.core.types import Dataset
 from tsrkit.datasets import (
     DatasetError,
     load_registry,
@@ -22,11 +25,9 @@ from tsrkit.datasets import (
     verify_manifest,
     write_dataset,
 )
+from tsrkit.datasets.concat import dataset_inputs
 from tsrkit.datasets.registry import GENERATED_SAMPLE
-from tsrkit.errors import TsrkitError
-from tsrkit.outlock import locked_file
-from tsrkit.outputs import dataset_inputs, reading, refuse_input, refuse_special
-from tsrkit.types import Dataset
+from tsrkit.runner.outlock import locked_file
 
 __all__ = [
     "convert_command",
@@ -220,7 +221,7 @@ def state_changes(before: Dataset, after: Dataset) -> list[str]:
 
     Examples
     --------
-    >>> from tsrkit.types import Annotation, Sample
+    >>> from tsrkit.core.types import Annotation, Sample
     >>> def one(state):
     ...     return Dataset("d", (Sample("a.png", (Annotation((0, 0, 1, 1), state),)),))
     >>> state_changes(one("green"), one("unknown"))

@@ -15,22 +15,22 @@ import click
 import cv2
 from rich.console import Console
 
-from tsrkit.agreement import Agreement
-from tsrkit.atomic import atomic_open, json_line
 from tsrkit.cli.common import plugin_options
 from tsrkit.cli.errors import UserError
-from tsrkit.draw import draw_detections
-from tsrkit.errors import TsrkitError
-from tsrkit.follow import Follower
-from tsrkit.inputs import IMAGE_EXTENSIONS, VIDEO_EXTENSIONS, check_range
-from tsrkit.outlock import locked_file
-from tsrkit.outputs import reading, refuse_input, refuse_special, writing
-from tsrkit.records import FrameRecord
-from tsrkit.report import ProgressBar
-from tsrkit.selection import build
-from tsrkit.streams import Runner, run_pipeline
-from tsrkit.types import Frame, Skipped
-from tsrkit.workers import check_workers
+from tsrkit.core.atomic import atomic_open, json_line
+from tsrkit.core.errors import TsrkitError
+from tsrkit.core.outputs import reading, refuse_input, refuse_special, writing
+from tsrkit.core.records import FrameRecord
+from tsrkit.core.types import Frame, Skipped
+from tsrkit.plugin.selection import build
+from tsrkit.reporting.draw import draw_detections
+from tsrkit.reporting.report import ProgressBar
+from tsrkit.runner.agreement import Agreement
+from tsrkit.runner.follow import Follower
+from tsrkit.runner.inputs import IMAGE_EXTENSIONS, VIDEO_EXTENSIONS, check_range
+from tsrkit.runner.outlock import locked_file
+from tsrkit.runner.streams import Runner, run_pipeline
+from tsrkit.runner.workers import check_workers
 
 __all__ = [
     "Resumed",
@@ -99,11 +99,12 @@ def run_detect(
 
     A frame on which a plugin crashes is reported as skipped and the run goes on; a
     :class:`TsrkitError` from a plugin (a setup problem such as a mismatched model) stops it.
-    ``workers`` > 1 runs the pipeline in worker processes (:func:`tsrkit.streams.run_pipeline`);
+    ``workers`` > 1 runs the pipeline in worker processes
+    (:func:`tsrkit.runner.streams.run_pipeline`);
     overlays (``draw``) need the frames here, so they need one worker. ``progress`` shows a
     progress bar (frames done, frames/s) on stderr. ``agree`` > 1 keeps only the detections
     whose light is found on that many consecutive video frames
-    (:class:`tsrkit.agreement.Agreement`; still images keep every detection).
+    (:class:`tsrkit.runner.agreement.Agreement`; still images keep every detection).
     ``resumed``: the frames an aborted run already wrote, which are not run again (and are
     counted in the totals).
 
@@ -177,6 +178,7 @@ def printable(text: str) -> str:
 
 def default_inputs() -> list[str]:
     """The bundled synthetic sample's images (generated on first use)."""
+    # cv2 and NumPy of the renderer: only when no input is given
     from tsrkit.synth import sample_path
 
     return [str(sample_path().parent / "images")]

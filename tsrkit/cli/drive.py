@@ -9,7 +9,7 @@ from pathlib import Path
 import click
 
 from tsrkit.cli.common import FiniteFloatRange
-from tsrkit.errors import TsrkitError
+from tsrkit.core.errors import TsrkitError
 from tsrkit.synth.drive import MOVEMENTS
 
 __all__ = ["drive_command"]
@@ -44,7 +44,8 @@ def drive_command(out: Path, route: str, width: int, height: int, fps: float, se
       tsrkit track city/drive.mp4 --gps city/gps.csv --map city/map.osm --out runs/city
       tsrkit datasets drive --out town/ --route through,left,right --width 640 --height 480
     """
-    from tsrkit.outlock import locked
+    # pyproj and the renderer: only when the verb runs
+    from tsrkit.runner.outlock import locked
     from tsrkit.synth.drive import DriveOptions, render_drive
 
     moves = tuple(m.strip() for m in route.split(",") if m.strip())

@@ -21,8 +21,8 @@ import click
 
 from tsrkit.cli.errors import UserError, describe_os_error
 from tsrkit.cli.verbs import VERBS
-from tsrkit.errors import TsrkitError, TsrkitWarning
-from tsrkit.hookspecs import ENTRY_POINT_GROUP
+from tsrkit.core.errors import TsrkitError, TsrkitWarning
+from tsrkit.plugin.hookspecs import ENTRY_POINT_GROUP
 
 __all__ = ["TsrkitGroup", "cli", "main"]
 
@@ -112,6 +112,7 @@ def cli(ctx: click.Context) -> None:
       tsrkit plugins
     """
     if ctx.invoked_subcommand is None:
+        # when needed: ``tsrkit --help`` loads no verb and no plugin
         from tsrkit.cli.benchmark import run_default
 
         ctx.invoke(run_default)
@@ -132,8 +133,9 @@ BUILTIN_VERBS = "tsrkit-commands"
 def _add_commands() -> None:
     """Every verb registered through ``register_commands``: the built-in ones (the CLI
     registers :mod:`tsrkit.cli.commands` as an internal plugin) and the plugins'; runs once."""
+    # when needed: ``tsrkit --help`` loads no verb and no plugin
     from tsrkit.cli import commands
-    from tsrkit.registry import PluginFailure, get_registry
+    from tsrkit.plugin.registry import PluginFailure, get_registry
 
     if getattr(cli, "_hooks_done", False):
         return

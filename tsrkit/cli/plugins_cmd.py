@@ -7,8 +7,8 @@ from rich.console import Console
 from rich.table import Table
 
 import tsrkit
-from tsrkit.atomic import json_text
-from tsrkit.registry import KINDS
+from tsrkit.core.atomic import json_text
+from tsrkit.plugin.registry import KINDS
 
 __all__ = ["plugins_command"]
 

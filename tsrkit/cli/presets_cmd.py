@@ -7,7 +7,7 @@ from rich.console import Console
 from rich.table import Table
 
 from tsrkit.cli.completion import preset_names_only
-from tsrkit.presets import describe, preset_names, preset_path
+from tsrkit.plugin.presets import describe, preset_names, preset_path
 
 __all__ = ["presets_command"]
 

@@ -35,9 +35,10 @@ def report_command(run_dir, writers) -> None:
       tsrkit report runs/drive                 # a track run: report.html
       tsrkit report runs/kr --writer markdown --writer html
     """
+    # when the verb runs: ``tsrkit --help`` stays fast
     from tsrkit.eval.guard import Failure
-    from tsrkit.registry import get_registry
-    from tsrkit.runfolder import load_run, read_comparison
+    from tsrkit.plugin.registry import get_registry
+    from tsrkit.reporting.runfolder import load_run, read_comparison
 
     folder = Path(run_dir)
     chosen = [get_registry().create("writer", name) for name in writers]

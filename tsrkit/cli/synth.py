@@ -8,9 +8,9 @@ from pathlib import Path
 import click
 from rich.console import Console
 
-from tsrkit.errors import TsrkitError
-from tsrkit.outlock import locked_file
-from tsrkit.outputs import refuse_special
+from tsrkit.core.errors import TsrkitError
+from tsrkit.core.outputs import refuse_special
+from tsrkit.runner.outlock import locked_file
 from tsrkit.synth import LIGHTINGS, generate
 
 __all__ = ["synth_command"]
@@ -72,7 +72,8 @@ def synth_command(
       tsrkit datasets synth --out clip/ --frames 60 --video clip.mp4
     """
     conditions = tuple(c.strip() for c in lighting.split(",") if c.strip())
-    from tsrkit.report import ProgressBar
+    # when the verb runs: ``tsrkit --help`` stays fast
+    from tsrkit.reporting.report import ProgressBar
 
     if video is not None:
         refuse_special(video, "--video")
@@ -94,6 +95,7 @@ def synth_command(
         f"({', '.join(f'{k} {v}' for k, v in sorted(states.items()))}) to {out}"
     )
     if video is not None:
+        # when the verb runs: ``tsrkit --help`` stays fast
         from tsrkit.synth.video import write_video
 
         click.echo(f"video: {write_video(dataset, video)}")

@@ -4,7 +4,9 @@ traversal (3.4.4-3.4.5), evaluated against ground truth when given (5.4)."""
 
 from __future__ import annotations
 
+import contextlib
 import json
+import time
 from datetime import UTC, datetime
 from pathlib import Path
 
@@ -12,13 +14,13 @@ import click
 from rich.console import Console
 from rich.table import Table
 
-from tsrkit.atomic import atomic_open, json_line
 from tsrkit.cli.common import FiniteFloatRange, plugin_options
 from tsrkit.cli.errors import UserError
-from tsrkit.files import not_regular
+from tsrkit.core.atomic import atomic_open, json_line
+from tsrkit.core.files import not_regular
+from tsrkit.core.outputs import reading, refuse_input
 from tsrkit.geo.gps import EARLIEST, LATEST
-from tsrkit.outlock import locked
-from tsrkit.outputs import reading, refuse_input
+from tsrkit.runner.outlock import locked
 
 __all__ = ["track_command"]
 
@@ -173,6 +175,7 @@ def track_command(
       tsrkit track drive.mp4 --gps gps.csv --map map.osm -d conspicuity -c ab-hist \\
           -p h_peak=0.8 --vicinity 50 --truth truth.jsonl --out runs/drive
     """
+    # pyproj, SciPy and the plugins: only when the verb runs
     from tsrkit.geo import read_signals, read_track, traversals
 
     if video is None:
@@ -194,6 +197,7 @@ def track_command(
         raise UserError(f"{gps}: one GPS fix only; a track needs at least two GPS fixes")
     console = Console()
     if video is not None:
+        # pyproj, SciPy and the plugins: only when the verb runs
         from tsrkit.spatiotemporal.run import TrackSettings
 
         settings = TrackSettings(vicinity, upstream, downstream, top, slack, flow_margin, roi_top)
@@ -240,14 +244,12 @@ def _track_video(
     video, track, signals, settings, plugins, start_utc, truth, quiet, out, console
 ) -> None:
     """The video mode of ``tsrkit track`` (see :func:`tsrkit.spatiotemporal.track_video`)."""
-    import contextlib
-    import time
-
-    from tsrkit.report import ProgressBar, versions
-    from tsrkit.selection import build
+    # pyproj, SciPy and the plugins: only when the verb runs
+    from tsrkit.plugin.selection import build
+    from tsrkit.reporting.report import ProgressBar, versions
+    from tsrkit.reporting.runfolder import write_track_run
     from tsrkit.spatiotemporal.evaluate import evaluate_traversal, read_truth, temporal_section
     from tsrkit.spatiotemporal.ranges import frame_profile, frame_traversals
-    from tsrkit.spatiotemporal.results import write_track_run
     from tsrkit.spatiotemporal.run import identity, track_video, video_facts
 
     selection = build(*plugins)
@@ -358,7 +360,8 @@ def no_signals(signals, osm) -> None:
 
 
 def _print_traversals(console, records, evaluations, frames, clip_frames, elapsed) -> None:
-    from tsrkit.spatiotemporal.results import ACCURACY_NOTE, summary_rows
+    # the report's tables: only when the verb runs (``tsrkit --help`` stays fast)
+    from tsrkit.reporting.track import ACCURACY_NOTE, summary_rows
 
     table = Table(
         title=f"{len(records)} traversals; {clip_frames} of {frames} frames decoded "

@@ -9,13 +9,14 @@ from rich.console import Console
 
 from tsrkit.cli.common import split_name
 from tsrkit.cli.completion import dataset_names, plugin_names, trainable_names
-from tsrkit.errors import TsrkitError
-from tsrkit.models import model_paths
-from tsrkit.outlock import locked_file
-from tsrkit.outputs import dataset_inputs, reading, refuse_input, refuse_special
-from tsrkit.params import parse_assignments
-from tsrkit.registry import get_registry
-from tsrkit.training import train
+from tsrkit.core.errors import TsrkitError
+from tsrkit.core.outputs import reading, refuse_input, refuse_special
+from tsrkit.datasets.concat import dataset_inputs
+from tsrkit.plugin.models import model_paths
+from tsrkit.plugin.params import parse_assignments
+from tsrkit.plugin.registry import get_registry
+from tsrkit.runner.outlock import locked_file
+from tsrkit.runner.training import train
 
 __all__ = ["train_command"]
 
@@ -87,6 +88,7 @@ def train_command(
       tsrkit train verifier --dataset roboflow_traffic_light_kr:valid -d lab-frst \\
           -p detector.top=15 --out models/verifier
     """
+    # when the verb runs: ``tsrkit --help`` stays fast
     from tsrkit.datasets import open_datasets
 
     assignments = parse_assignments(params)

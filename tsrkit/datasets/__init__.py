@@ -1,4 +1,5 @@
-"""Dataset registry, opening datasets by name or path, format detection and checksums.
+"""Datasets: the registry (``datasets.yaml``), opening by name or path with format detection,
+checksums, several sets as one, and the renderer of the bundled sample (:mod:`.scenes`).
 
 >>> from tsrkit.datasets import open_dataset
 >>> ds = open_dataset("roboflow_traffic_light_kr")          # doctest: +SKIP

@@ -11,13 +11,14 @@
 from __future__ import annotations
 
 import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 
-from tsrkit.errors import TsrkitError
-from tsrkit.types import Dataset
+from tsrkit.core.errors import TsrkitError
+from tsrkit.core.types import Dataset
+from tsrkit.datasets.registry import load_registry
 
-__all__ = ["concat_datasets", "open_datasets", "parse_reference"]
+__all__ = ["concat_datasets", "dataset_inputs", "open_datasets", "parse_reference"]
 
 
 def parse_reference(ref: str, split: str | None = None) -> tuple[str, str | None]:
@@ -103,3 +104,15 @@ def _agreed(infos: Sequence[Mapping]) -> dict:
     """The key/value pairs every mapping of ``infos`` has alike."""
     first, *rest = infos
     return {k: v for k, v in first.items() if all(k in i and i[k] == v for i in rest)}
+
+
+def dataset_inputs(refs: Iterable[str], dataset) -> list[str]:
+    """What a run on ``dataset`` reads: the annotation file or folder of each reference
+    (a registered name, ``NAME:SPLIT``, or a path) and every sample's image."""
+    registry = load_registry()
+    files = []
+    for ref in refs:
+        name, _ = parse_reference(ref, None)
+        entry = registry.get(name)
+        files.append(str(entry.annotation_path()) if entry is not None else name)
+    return [*files, *(s.source for s in dataset.samples if s.source)]

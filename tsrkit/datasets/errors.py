@@ -9,8 +9,8 @@ import os
 from pathlib import Path
 from typing import Any
 
-from tsrkit.errors import TsrkitError
-from tsrkit.files import InputFileError, loads_json, loads_yaml, read_bytes
+from tsrkit.core.errors import TsrkitError
+from tsrkit.core.files import InputFileError, loads_json, loads_yaml, read_bytes
 
 __all__ = ["DatasetError", "read_json", "read_text", "read_yaml"]
 
@@ -48,7 +48,7 @@ def read_text(path: str | os.PathLike, missing: str = "file not found") -> str:
     ------
     DatasetError
         ``missing`` when the file does not exist, the reason when it cannot be read (not a
-        regular file, larger than :data:`tsrkit.files.MAX_TEXT_BYTES`...), and "not valid
+        regular file, larger than :data:`tsrkit.core.files.MAX_TEXT_BYTES`...), and "not valid
         UTF-8" with the line and the offending byte when it does not decode.
 
     Examples
@@ -77,7 +77,7 @@ def read_text(path: str | os.PathLike, missing: str = "file not found") -> str:
 
 
 def read_yaml(path: str | os.PathLike, missing: str = "file not found") -> Any:
-    """Parse a YAML file (:func:`tsrkit.files.loads_yaml`: the C loader when available, bounded
+    """Parse a YAML file (:func:`tsrkit.core.files.loads_yaml`: the C loader when available, bounded
     nesting and aliases, no repeated key).
 
     Raises
@@ -93,7 +93,7 @@ def read_yaml(path: str | os.PathLike, missing: str = "file not found") -> Any:
 
 
 def read_json(path: str | os.PathLike, missing: str = "file not found") -> Any:
-    """Parse a JSON file (:func:`tsrkit.files.loads_json`: nesting bounded).
+    """Parse a JSON file (:func:`tsrkit.core.files.loads_json`: nesting bounded).
 
     Raises
     ------

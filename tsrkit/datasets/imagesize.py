@@ -14,7 +14,7 @@ __all__ = ["image_size"]
 def image_size(path: str | os.PathLike) -> tuple[int, int]:
     """``(width, height)`` of the image at ``path``, read from its header by Pillow, upright:
     swapped when its EXIF orientation turns it by 90 degrees (as
-    :func:`tsrkit.images.read_image` does).
+    :func:`tsrkit.core.images.read_image` does).
 
     Raises
     ------

@@ -13,13 +13,13 @@ import warnings
 from collections.abc import Mapping
 from pathlib import Path
 
+from tsrkit.core.errors import TsrkitError, TsrkitWarning
+from tsrkit.core.files import InputFileError, not_regular, read_json
+from tsrkit.core.types import Annotation, Dataset
 from tsrkit.datasets.errors import DatasetError
 from tsrkit.datasets.registry import DatasetEntry, load_registry
 from tsrkit.datasets.states import check_mapping, to_state
-from tsrkit.errors import TsrkitError, TsrkitWarning
-from tsrkit.files import InputFileError, not_regular, read_json
-from tsrkit.registry import get_registry
-from tsrkit.types import Annotation, Dataset
+from tsrkit.plugin.registry import get_registry
 
 __all__ = ["SAMPLE", "detect_format", "open_dataset", "read_dataset", "relabel", "write_dataset"]
 
@@ -230,6 +230,6 @@ def _registry_entry(ref: str | os.PathLike) -> DatasetEntry | None:
 
 
 def _sample_path() -> Path:
-    from tsrkit.synth import scenes as synth
+    from tsrkit.datasets import scenes as synth  # cv2 and NumPy load only when the sample is made
 
     return Path(synth.sample_path())

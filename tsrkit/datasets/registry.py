@@ -70,7 +70,7 @@ class DatasetEntry:
         use by :func:`tsrkit.synth.sample_path`.
         """
         if self.root == GENERATED_SAMPLE:
-            from tsrkit.synth import scenes as synth
+            from tsrkit.datasets import scenes as synth  # cv2, NumPy: only for the sample
 
             return Path(synth.sample_path()).parent
         root = Path(self.root).expanduser()
@@ -93,7 +93,7 @@ class DatasetEntry:
         return (root / self.path).resolve() if self.path != "." else root
 
     def to_info(self) -> dict[str, Any]:
-        """The facts a :class:`tsrkit.types.Dataset` carries in ``info``."""
+        """The facts a :class:`tsrkit.core.types.Dataset` carries in ``info``."""
         info = {
             "name": self.name,
             "format": self.format,

@@ -1,4 +1,4 @@
-"""Mapping raw dataset labels onto :data:`tsrkit.types.STATES`.
+"""Mapping raw dataset labels onto :data:`tsrkit.core.types.STATES`.
 
 Readers keep the raw label in ``Annotation.attributes["label"]`` and set ``state`` with
 :func:`to_state`. A registry entry (``states:`` in ``datasets.yaml``) or a caller may give an
@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
-from tsrkit.types import STATES
+from tsrkit.core.types import STATES
 
 __all__ = ["PREFIXES", "check_mapping", "to_state"]
 

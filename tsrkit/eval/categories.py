@@ -12,8 +12,8 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar
 
-from tsrkit.eval.perframe import FrameScore, FrameScoreMetric, summarise
-from tsrkit.eval.results import MetricResult, Plot, Table, fmt
+from tsrkit.core.results import MetricResult, Plot, Table, fmt
+from tsrkit.eval.perframe import FrameScore, summarise
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure as MplFigure
@@ -24,7 +24,6 @@ __all__ = [
     "PRECISION_BOUNDS",
     "RADIUS_BIN_STARTS",
     "CategoriesResult",
-    "LightingBySize",
     "bubble_size",
     "category_table",
     "counts_table",
@@ -211,6 +210,7 @@ def draw_bubbles(figure: MplFigure, rows: Sequence[Mapping[str, Any]]) -> None:
     precision (right) bubbles, circle area proportional to the share of the category's frames,
     bluer towards (FPR 0, recall 1) and redder away from it, with ``N = frames`` in grey.
     """
+    # matplotlib: only when a plot is drawn
     from matplotlib import colormaps
     from matplotlib.cm import ScalarMappable
     from matplotlib.colors import Normalize
@@ -318,18 +318,3 @@ class CategoriesResult(MetricResult):
                 (max(5, 0.6 * len(rows) + 2), 3.5),
             ),
         ]
-
-
-class LightingBySize(FrameScoreMetric):
-    """``categories``: the Table 5-2 rows (lighting x max target radius) with Figure 5-1 bubbles."""
-
-    name = "categories"
-    summary = "frame counts by lighting and max target radius, recall and precision columns"
-    section = "Zheng 2016, 5.2.1, Table 5-2, Figure 5-1"
-
-    result_type = CategoriesResult
-
-    def compute(self) -> CategoriesResult:
-        return CategoriesResult(
-            {"categories": category_table(self.scores) if self.settings.detection else []}
-        )

@@ -14,12 +14,10 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar
 
-from tsrkit.eval.results import Figure, MetricResult, Plot
-from tsrkit.eval.settings import EvalSettings
-from tsrkit.geometry import xyxy_to_xywh
-from tsrkit.plugin import Metric
-from tsrkit.records import FrameRecord
-from tsrkit.types import Sample
+from tsrkit.core.geometry import xyxy_to_xywh
+from tsrkit.core.records import FrameRecord
+from tsrkit.core.results import Figure, MetricResult, Plot
+from tsrkit.core.types import Sample
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure as MplFigure
@@ -27,7 +25,6 @@ if TYPE_CHECKING:
 __all__ = [
     "ABOUT",
     "CATEGORY",
-    "CocoAP",
     "CocoResult",
     "coco_ap",
     "coco_dataset",
@@ -113,6 +110,7 @@ def coco_ap(ground_truth: Mapping[str, Any], results: list[dict[str, Any]]) -> d
     curve is COCOeval's interpolated precision at IoU 0.5 on its 101 recall points); the APs are
     0 when there are no detections and None when there is no ground-truth box.
     """
+    # pycocotools: only when COCO AP is computed
     from pycocotools.coco import COCO
     from pycocotools.cocoeval import COCOeval
 
@@ -184,37 +182,3 @@ class CocoResult(MetricResult):
                 (4.0, 4.0),
             )
         ]
-
-
-class CocoAP(Metric):
-    """``iou50.ap``, ``iou50.ap_50_95`` and ``iou50.pr_curve``: pycocotools on the evaluated box."""
-
-    name = "coco-ap"
-    summary = "class-agnostic COCO AP at IoU 0.5 and 0.5:0.95 (pycocotools)"
-    section = "COCO detection evaluation (cocodataset.org/#detection-eval)"
-
-    def reset(self, settings: EvalSettings) -> None:
-        self.settings = settings
-        self.images: list[dict] = []
-        self.annotations: list[dict] = []
-        self.results: list[dict] = []
-
-    def update(self, sample: Sample, record: FrameRecord) -> None:
-        image, anns, dets = coco_frame(sample, record, len(self.annotations) + 1, self.settings.box)
-        self.images.append(image)
-        self.annotations += anns
-        self.results += dets
-
-    result_type = CocoResult
-
-    def compute(self) -> CocoResult:
-        if not self.settings.detection:
-            return CocoResult({})
-        ap = coco_ap(
-            coco_dataset(self.images, self.annotations, self.settings.dataset), self.results
-        )
-        if not self.settings.exhaustive:
-            ap = {"ap50": None, "ap": None, "curve": None}
-        return CocoResult(
-            {"iou50": {"ap": ap["ap50"], "ap_50_95": ap["ap"], "pr_curve": ap["curve"]}}
-        )

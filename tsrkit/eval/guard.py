@@ -19,11 +19,11 @@ from collections.abc import Callable, Mapping, Set
 from dataclasses import dataclass
 from typing import Any
 
-from tsrkit.eval.results import Figure, MetricResult, Plot, Table
+from tsrkit.core.records import FrameRecord
+from tsrkit.core.results import Figure, MetricResult, Plot, Table
+from tsrkit.core.types import Sample
 from tsrkit.eval.settings import EvalSettings
-from tsrkit.plugin import Metric, Plugin
-from tsrkit.records import FrameRecord
-from tsrkit.types import Sample
+from tsrkit.plugin.base import Metric, Plugin
 
 __all__ = [
     "MESSAGE_CHARS",

@@ -2,15 +2,15 @@
 
 ``centre_hits`` implements Zheng 2016, 5.2.1 (a candidate is a true positive when its centre lies
 in the minimum enclosing circle of a ground-truth box of the same frame); ``greedy_match`` with
-:func:`tsrkit.geometry.iou_matrix` implements the overlap test of Lee 3.6.2 (PASCAL,
-``tau < area(o & g) / area(o | g)``). Box geometry lives in :mod:`tsrkit.geometry`.
+:func:`tsrkit.core.geometry.iou_matrix` implements the overlap test of Lee 3.6.2 (PASCAL,
+``tau < area(o & g) / area(o | g)``). Box geometry lives in :mod:`tsrkit.core.geometry`.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from tsrkit.geometry import enclosing_circles
+from tsrkit.core.geometry import enclosing_circles
 
 __all__ = ["centre_hits", "greedy_match"]
 

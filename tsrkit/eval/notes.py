@@ -1,18 +1,14 @@
-"""``notes``: how many frames each plugin note was given for (e.g. a model's fallback)."""
+"""``notes``: the result counting the frames each plugin note was given for (e.g. a model's
+fallback); the metric that fills it is the plugin ``tsrkit_plugins.metrics.frame_notes``."""
 
 from __future__ import annotations
 
-from collections import Counter
 from dataclasses import dataclass
 from typing import ClassVar
 
-from tsrkit.eval.results import MetricResult, Table
-from tsrkit.eval.settings import EvalSettings
-from tsrkit.plugin import Metric
-from tsrkit.records import FrameRecord
-from tsrkit.types import Sample
+from tsrkit.core.results import MetricResult, Table
 
-__all__ = ["FrameNotes", "FrameNotesResult"]
+__all__ = ["FrameNotesResult"]
 
 
 @dataclass(frozen=True)
@@ -23,28 +19,3 @@ class FrameNotesResult(MetricResult):
 
     def tables(self) -> list[Table]:
         return []
-
-
-class FrameNotes(Metric):
-    """``frame_notes``: the number of frames of each note the plugins wrote into the records;
-    absent from the report when no plugin wrote any."""
-
-    name = "frame-notes"
-    summary = "frames counted per plugin note (fallbacks and other per-frame remarks)"
-    section = "tsrkit"
-
-    def reset(self, settings: EvalSettings) -> None:
-        self.counts: Counter[str] = Counter()
-        self.frames = 0
-
-    def update(self, sample: Sample, record: FrameRecord) -> None:
-        self.frames += 1
-        self.counts.update(set(record.notes))
-
-    result_type = FrameNotesResult
-
-    def compute(self) -> FrameNotesResult:
-        if not self.counts:
-            return FrameNotesResult({})
-        counts = dict(sorted(self.counts.items()))
-        return FrameNotesResult({"frame_notes": {"frames": self.frames, "counts": counts}})

@@ -14,17 +14,12 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from tsrkit.core.geometry import box_areas, intersection_matrix, iou_matrix
+from tsrkit.core.results import MetricResult, Table, fmt
 from tsrkit.eval.matching import greedy_match
-from tsrkit.eval.results import MetricResult, Table, fmt
-from tsrkit.eval.settings import NOT_DETECTION, EvalSettings
-from tsrkit.geometry import box_areas, intersection_matrix, iou_matrix
-from tsrkit.plugin import Metric
-from tsrkit.records import FrameRecord
-from tsrkit.types import Sample
 
 __all__ = [
     "COLUMNS",
-    "OverlapPR",
     "OverlapResult",
     "OverlapScore",
     "match_by_iou",
@@ -125,39 +120,3 @@ class OverlapResult(MetricResult):
                 "averaged over the matched pairs.",
             )
         ]
-
-
-class OverlapPR(Metric):
-    """``iou50`` and ``iou``: Lee 3.6.2's overlap precision and recall at IoU 0.5 and ``--iou``.
-
-    Reads the evaluated box of each detection (``lens_bbox`` or ``bbox``, ``--eval-box``).
-    """
-
-    name = "iou-overlap"
-    summary = "precision, recall and area precision / recall of IoU matching at 0.5 and --iou"
-    section = "Lee 2017, 3.6.2"
-
-    def reset(self, settings: EvalSettings) -> None:
-        self.settings = settings
-        self.at50: list[OverlapScore] = []
-        self.at_threshold: list[OverlapScore] = []
-
-    def update(self, sample: Sample, record: FrameRecord) -> None:
-        boxes = [d.box(self.settings.box) for d in record.detections]
-        scores = [d.score for d in record.detections]
-        truth = [a.bbox for a in sample.annotations]
-        self.at50.append(score_overlap(boxes, scores, truth, 0.5))
-        self.at_threshold.append(score_overlap(boxes, scores, truth, self.settings.iou_threshold))
-
-    result_type = OverlapResult
-
-    def compute(self) -> OverlapResult:
-        if not self.settings.detection:
-            return OverlapResult({"iou50": NOT_DETECTION, "iou": NOT_DETECTION})
-        out = {
-            "iou50": summarise_overlap(self.at50, 0.5),
-            "iou": summarise_overlap(self.at_threshold, self.settings.iou_threshold),
-        }
-        for section in out.values():
-            section["precision"] = self.settings.false_positive_figure(section["precision"])
-        return OverlapResult(out)

@@ -1,4 +1,5 @@
-"""Zheng 2016, 5.2.1: per-frame recall and precision, and the metric of the ``per_frame`` section.
+"""Zheng 2016, 5.2.1: per-frame recall and precision, and the ``per_frame`` section's result (the
+metric that fills it is the plugin ``tsrkit_plugins.metrics.per_frame``).
 
 A candidate is a true positive when its centre lies in the minimum enclosing circle of any
 ground-truth box of the same frame. Reading chosen for the per-frame figures (the prose: "how many
@@ -16,24 +17,20 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import ClassVar
 
 import numpy as np
 
+from tsrkit.core.records import FrameRecord
+from tsrkit.core.results import Figure, MetricResult
+from tsrkit.core.types import Sample
 from tsrkit.eval.matching import centre_hits
-from tsrkit.eval.results import Figure, MetricResult
-from tsrkit.eval.settings import NOT_DETECTION, EvalSettings
 from tsrkit.eval.stats import bootstrap_interval
-from tsrkit.plugin import Metric
-from tsrkit.records import FrameRecord
-from tsrkit.types import Sample
 
 __all__ = [
     "FIGURES",
     "FrameScore",
-    "FrameScoreMetric",
     "PerFrameResult",
-    "ZhengPerFrame",
     "frame_score",
     "headline_intervals",
     "max_target_radius",
@@ -188,39 +185,3 @@ class PerFrameResult(MetricResult):
 
 def _pair(interval: Sequence[float] | None) -> tuple[float, float] | None:
     return (interval[0], interval[1]) if interval else None
-
-
-class FrameScoreMetric(Metric):
-    """A metric computed from every frame's :class:`FrameScore` (kept in ``self.scores``)."""
-
-    def reset(self, settings: EvalSettings) -> None:
-        self.settings = settings
-        self.scores: list[FrameScore] = []
-
-    def update(self, sample: Sample, record: FrameRecord) -> None:
-        self.scores.append(frame_score(sample, record))
-
-
-class ZhengPerFrame(FrameScoreMetric):
-    """``per_frame`` and ``intervals``: Zheng 5.2.1's per-frame means with bootstrap intervals.
-
-    A detection's centre (the lens centre) is matched to the ground truth's minimum enclosing
-    circles whichever box is evaluated.
-    """
-
-    name = "per-frame"
-    summary = "per-frame recall, precision and hit-frame fraction (centre in enclosing circle)"
-    section = "Zheng 2016, 5.2.1"
-
-    result_type = PerFrameResult
-
-    def compute(self) -> PerFrameResult:
-        if not self.settings.detection:
-            return PerFrameResult({"per_frame": NOT_DETECTION, "intervals": {}})
-        summary: dict[str, Any] = summarise(self.scores)
-        intervals: dict[str, Any] = headline_intervals(self.scores)
-        for figures in (summary, intervals):
-            figures["precision_mean"] = self.settings.false_positive_figure(
-                figures["precision_mean"]
-            )
-        return PerFrameResult({"per_frame": summary, "intervals": intervals})

@@ -8,7 +8,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
-from tsrkit.eval.results import Figure, MetricResult, Table, fmt
+from tsrkit.core.results import Figure, MetricResult, Table, fmt
 
 __all__ = ["STAGES", "RunFacts", "RunTiming", "SkippedInputs", "description_tables", "run_facts"]
 

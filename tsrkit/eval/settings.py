@@ -8,11 +8,21 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from tsrkit.errors import TsrkitError
+from tsrkit.core.errors import TsrkitError
 
-__all__ = ["BOX_OPTIONS", "NOT_DETECTION", "EvalSettings", "not_exhaustive_note", "resolve_box"]
+if TYPE_CHECKING:
+    from tsrkit.core.types import Dataset
+
+__all__ = [
+    "BOX_OPTIONS",
+    "NOT_DETECTION",
+    "EvalSettings",
+    "eval_settings",
+    "not_exhaustive_note",
+    "resolve_box",
+]
 
 #: Values of the ``box`` option (``--eval-box``).
 BOX_OPTIONS = ("auto", "housing", "lens")
@@ -77,3 +87,17 @@ def not_exhaustive_note(dataset: str) -> str:
 NOT_DETECTION = {
     "note": "classifier alone on the ground-truth boxes: detection metrics do not apply"
 }
+
+
+def eval_settings(
+    dataset: Dataset, detection: bool = True, iou_threshold: float = 0.5, box: str = "auto"
+) -> EvalSettings:
+    """The evaluation settings of ``dataset``: the box (``auto`` follows its registry ``box``
+    convention) and whether it is exhaustively labelled (registry ``exhaustive``)."""
+    return EvalSettings(
+        dataset.name,
+        iou_threshold,
+        resolve_box(box, dataset.info),
+        dataset.info.get("exhaustive", True) is not False,
+        detection,
+    )

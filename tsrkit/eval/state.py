@@ -14,19 +14,14 @@ from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
-from tsrkit.eval.matching import centre_hits, greedy_match
-from tsrkit.eval.results import Figure, MetricResult, Plot, Table, fmt
-from tsrkit.eval.settings import EvalSettings
-from tsrkit.plugin import Metric
-from tsrkit.records import FrameRecord
-from tsrkit.types import STATES, Sample
+from tsrkit.core.results import Figure, MetricResult, Plot, Table, fmt
+from tsrkit.core.types import STATES
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure as MplFigure
 
 __all__ = [
     "RATIO_EDGES",
-    "StateMetric",
     "StateResult",
     "confusion",
     "discriminative_ratio",
@@ -66,7 +61,7 @@ def state_metrics(
     Parameters
     ----------
     truth, predicted : sequences of str
-        Labels of matched pairs: signal states (:data:`tsrkit.types.STATES`, kept in that
+        Labels of matched pairs: signal states (:data:`tsrkit.core.types.STATES`, kept in that
         order) or any other class names, e.g. sign classes (sorted).
     scores : sequence of mappings, optional
         The predictions' ``state_scores`` for the discriminative-ratio figures.
@@ -284,43 +279,3 @@ class StateResult(MetricResult):
                 (5.0, 4.0),
             )
         ]
-
-
-class StateMetric(Metric):
-    """``state``: the states of detections matched to ground truth by Zheng's centre rule.
-
-    Each ground-truth box takes at most one detection (best score first) whose centre lies in
-    its minimum enclosing circle; the pair's true and predicted states enter the figures.
-    """
-
-    name = "state"
-    summary = "state accuracy, per-class figures, confusion, R-Y errors, discriminative ratio"
-    section = "Mascetti 2016, 5.1; Zheng 2016, 5.3"
-
-    def reset(self, settings: EvalSettings) -> None:
-        self.settings = settings
-        self.truth: list[str] = []
-        self.predicted: list[str] = []
-        self.scores: list[Mapping[str, float]] = []
-
-    def update(self, sample: Sample, record: FrameRecord) -> None:
-        dets = record.detections
-        hits = centre_hits([(d.x, d.y) for d in dets], [a.bbox for a in sample.annotations])
-        for i, j in greedy_match([d.score for d in dets], hits.astype(float), 0.5):
-            self.truth.append(sample.annotations[j].state)
-            self.predicted.append(dets[i].state)
-            self.scores.append(dets[i].state_scores)
-
-    result_type = StateResult
-
-    def compute(self) -> StateResult:
-        if all(p == "unknown" for p in self.predicted):
-            return StateResult(
-                {
-                    "state": {
-                        **state_metrics([], []),
-                        "note": "the method predicts no state (every detection is 'unknown')",
-                    }
-                }
-            )
-        return StateResult({"state": state_metrics(self.truth, self.predicted, self.scores)})

@@ -90,6 +90,7 @@ def paired_test(
     if x.shape != y.shape:
         raise ValueError(f"paired values differ in length: {x.size} and {y.size}")
     diff = x - y
+    # SciPy's statistics: only when a comparison is tested
     from scipy.stats import wilcoxon
 
     p_value = 1.0 if not np.any(diff) else float(wilcoxon(x, y, zero_method="wilcox").pvalue)

@@ -11,6 +11,6 @@ Names are imported on first use (PEP 562, declared in ``__init__.pyi``): reading
 does not import the map reader's SciPy graph routines.
 """
 
-from tsrkit._lazy import attach_stub
+import lazy_loader as _lazy
 
-__getattr__, __dir__, __all__ = attach_stub(__name__, __file__)
+__getattr__, __dir__, __all__ = _lazy.attach_stub(__name__, __file__)

@@ -6,8 +6,8 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from tsrkit import files
-from tsrkit.errors import TsrkitError
+from tsrkit.core import files
+from tsrkit.core.errors import TsrkitError
 
 __all__ = ["GeoError", "read_text"]
 
@@ -35,7 +35,7 @@ class GeoError(TsrkitError):
 
 def read_text(path: Path) -> str:
     """The UTF-8 text of ``path`` (a byte order mark dropped), or a :class:`GeoError`: missing,
-    not a regular file, larger than :data:`tsrkit.files.MAX_TEXT_BYTES`, not UTF-8."""
+    not a regular file, larger than :data:`tsrkit.core.files.MAX_TEXT_BYTES`, not UTF-8."""
     try:
         return files.read_text(path)
     except files.InputFileError as exc:
@@ -44,7 +44,7 @@ def read_text(path: Path) -> str:
 
 def check_file(path: Path) -> None:
     """Raise a :class:`GeoError` unless ``path`` is a regular file of at most
-    :data:`tsrkit.files.MAX_TEXT_BYTES` (a FIFO or device would block the reader)."""
+    :data:`tsrkit.core.files.MAX_TEXT_BYTES` (a FIFO or device would block the reader)."""
     try:
         files.file_size(path, files.MAX_TEXT_BYTES)
     except files.InputFileError as exc:

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tsrkit.errors import TsrkitWarning
+from tsrkit.core.errors import TsrkitWarning
 from tsrkit.geo.errors import GeoError, read_text
 from tsrkit.geo.gpx import gpx_rows
 from tsrkit.geo.nmea import nmea_rows

@@ -23,6 +23,7 @@ def pbf_nodes(path: Path) -> list[tuple[int, float, float, dict[str, str], str]]
         pyosmium missing, a missing or malformed file, a signal node without a location.
     """
     try:
+        # osmium is optional (extra "pbf"): only for .osm.pbf maps
         import osmium
         import osmium.filter
     except ImportError:

@@ -1,6 +1,5 @@
-"""Zheng 2016's spatiotemporal framework on video (3.4.4-3.4.5, 5.4): short-range
-initialisation with Farneback optical flow and the colour state machine, long-range tracked
-recognition, and the temporal accuracy of the tracks.
+"""Zheng 2016's spatiotemporal framework on video (3.4.4-3.4.5, 5.4): short-range initialisation
+(optical flow, colour state machine), long-range tracked recognition, temporal accuracy.
 
 ``track_video`` runs it on a video with its GPS log and map (:mod:`tsrkit.geo` finds the
 traversals); ``recognise`` on one clip; ``temporal_accuracy`` scores tracks against ground truth.

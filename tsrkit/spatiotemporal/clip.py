@@ -10,10 +10,10 @@ from dataclasses import dataclass, field
 import cv2
 import numpy as np
 
-from tsrkit.pipeline import Pipeline
+from tsrkit.core.types import Frame
+from tsrkit.plugin.pipeline import Pipeline
 from tsrkit.spatiotemporal.flow import farneback, project, project_with
 from tsrkit.spatiotemporal.points import Point
-from tsrkit.types import Frame
 
 __all__ = ["CONTEXT_PX", "KEPT_FLOWS", "MIN_REGION_PX", "WHOLE_FLOW_POINTS", "Clip"]
 

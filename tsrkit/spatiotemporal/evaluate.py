@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from tsrkit.errors import TsrkitError
+from tsrkit.core.errors import TsrkitError
 from tsrkit.eval.matching import centre_hits
 
 __all__ = [

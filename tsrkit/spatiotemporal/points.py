@@ -7,7 +7,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from tsrkit.types import Detection
+from tsrkit.core.types import Detection
 
 __all__ = ["COLOURS", "Point", "Track", "frame_status"]
 

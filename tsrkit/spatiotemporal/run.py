@@ -21,18 +21,18 @@ from typing import Any
 import cv2
 import numpy as np
 
-from tsrkit.atomic import write_json
-from tsrkit.engine import MAX_CACHE_ENTRY, plugin_identity
-from tsrkit.errors import TsrkitError
-from tsrkit.files import InputFileError, read_json
+from tsrkit.core.atomic import write_json
+from tsrkit.core.errors import TsrkitError
+from tsrkit.core.files import InputFileError, read_json
+from tsrkit.core.types import Skipped
 from tsrkit.geo import Signals, Track
-from tsrkit.inputs import iter_video
-from tsrkit.pipeline import Pipeline
-from tsrkit.selection import Selection
+from tsrkit.plugin.pipeline import Pipeline
+from tsrkit.plugin.selection import Selection
+from tsrkit.runner.engine import MAX_CACHE_ENTRY, plugin_identity
+from tsrkit.runner.inputs import iter_video
 from tsrkit.spatiotemporal.clip import Clip
 from tsrkit.spatiotemporal.passes import TOP_N, recognise
 from tsrkit.spatiotemporal.ranges import DOWNSTREAM_M, UPSTREAM_M, FrameTraversal, frame_traversals
-from tsrkit.types import Skipped
 
 __all__ = [
     "RECORD_VERSION",

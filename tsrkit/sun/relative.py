@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 from pyproj import Geod
 
-from tsrkit.errors import TsrkitError
+from tsrkit.core.errors import TsrkitError
 from tsrkit.geo.gps import Track
 from tsrkit.sun.geometry import sun_position
 

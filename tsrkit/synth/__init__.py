@@ -1,11 +1,12 @@
-"""tsrkit's own synthetic data: road scenes rendered with exact labels.
+"""tsrkit's own synthetic data: road scenes rendered with exact labels, Sun-lit scenes, work
+zones, drives along a GPS path and their video.
 
-``scenes`` renders the deterministic day / dusk / night road scenes with lit traffic lights
-that make the bundled sample (:func:`sample_path`) and ``tsrkit datasets synth``. Other
-renderers (for example Sun-lit scenes or drives along a GPS path) live beside it.
+The day / dusk / night road scenes that make the bundled sample (:func:`sample_path`) and
+``tsrkit datasets synth`` are rendered by :mod:`tsrkit.datasets.scenes` (the datasets room
+opens the sample without this one) and re-exported here; the other renderers live here.
 """
 
-from tsrkit.synth.scenes import (
+from tsrkit.datasets.scenes import (
     LIGHTINGS,
     SAMPLE_FRAMES,
     SAMPLE_SEED,

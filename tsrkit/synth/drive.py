@@ -21,7 +21,7 @@ What is not simulated
 
 Coordinates: metres east (x) and north (y) of the first intersection, projected to latitude and
 longitude with :class:`tsrkit.geo.LocalProjection` about ``(lat0, lon0)``. Image coordinates
-follow the COCO convention of :mod:`tsrkit.synth.scenes` (pixel centres at ``i + 0.5``).
+follow the COCO convention of :mod:`tsrkit.datasets.scenes` (pixel centres at ``i + 0.5``).
 """
 
 from __future__ import annotations
@@ -35,11 +35,11 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from tsrkit.atomic import atomic_open, json_line, write_json
+from tsrkit.core.atomic import atomic_open, json_line, write_json
+from tsrkit.datasets.scenes import LENS_BGR, add_glow
 from tsrkit.geo.projection import LocalProjection
 from tsrkit.spatiotemporal.points import frame_status
 from tsrkit.synth.heads import LAMP_COLOURS, render_head
-from tsrkit.synth.scenes import LENS_BGR, add_glow
 from tsrkit.synth.video import video_writer
 
 __all__ = [

@@ -36,9 +36,9 @@ from datetime import UTC, datetime
 import cv2
 import numpy as np
 
+from tsrkit.core.types import Annotation, Dataset, Sample
 from tsrkit.sun.geometry import sun_position
 from tsrkit.sun.radiance import blackbody_bgr
-from tsrkit.types import Annotation, Dataset, Sample
 
 __all__ = [
     "ALBEDO",

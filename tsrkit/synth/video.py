@@ -12,8 +12,8 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from tsrkit.errors import TsrkitError
-from tsrkit.types import Dataset
+from tsrkit.core.errors import TsrkitError
+from tsrkit.core.types import Dataset
 
 __all__ = ["video_writer", "write_video"]
 

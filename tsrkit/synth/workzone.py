@@ -18,8 +18,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from tsrkit.depth import PANEL_HEIGHT_M
-from tsrkit.types import Annotation, Dataset, Sample
+from tsrkit.core.depth import PANEL_HEIGHT_M
+from tsrkit.core.types import Annotation, Dataset, Sample
 
 __all__ = [
     "ORANGE",

@@ -306,7 +306,7 @@ class LampState(Classifier):
 
         Raises
         ------
-        tsrkit.models.ModelError
+        tsrkit.plugin.models.ModelError
             A missing, corrupt or foreign model, or one of another feature layout or count.
         """
         if self._estimator is None:

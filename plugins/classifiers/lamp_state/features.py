@@ -118,7 +118,7 @@ def hue_histograms(pixels: np.ndarray, part: np.ndarray, parts: int) -> np.ndarr
 
 def pixel_bounds(boxes: np.ndarray, width: int, height: int) -> np.ndarray:
     """Integer pixel bounds (N, 4) of float ``boxes`` inside a ``width`` x ``height`` image,
-    end exclusive (:func:`tsrkit.geometry.clip_box`, for all boxes at once)."""
+    end exclusive (:func:`tsrkit.core.geometry.clip_box`, for all boxes at once)."""
     low = np.maximum(np.floor(boxes[:, :2]), 0)
     high = np.minimum(np.ceil(boxes[:, 2:]), (width, height))
     return np.concatenate([low, high], axis=1).astype(np.int64)

@@ -136,7 +136,7 @@ def scene_crops(scene: Scene, candidates: Sequence[Candidate], index: int) -> Cr
     """The labelled training crops of one scene's candidates (those left out dropped)."""
     light, hit_box = label(scene, candidates)
     keep = np.flatnonzero(light >= 0)
-    kept = [candidates[i] for i in keep]
+    kept = [candidates[int(i)] for i in keep]
     batch, windows = crops(scene.frame.image, kept, TRAIN_MARGIN)
     box = np.full((len(kept), 4), np.nan, np.float32)
     state = np.full(len(kept), -1, np.int8)

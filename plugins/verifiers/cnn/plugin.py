@@ -51,10 +51,10 @@ from tsrkit_plugins.verifiers.unlit import no_light_frames
 DEFAULT_MODEL = Path(__file__).parent.parent / "models" / "cnn_verifier_default"
 #: What a model's card must say of its input for this plugin to read it.
 LAYOUT = {
-    "version": 1,
+    "version": 2,
     "input": [3, INPUT, INPUT],
     "channels": "BGR",
-    "normalisation": "(v / 255 - 0.5) / 0.25",
+    "normalisation": "per crop: v - channel mean, / max(crop std, 4)",
     "window_radii": CONTEXT,
     "states": list(STATE_NAMES),
 }
@@ -313,7 +313,7 @@ class CnnVerifier(Verifier):
         own = np.clip([c.score for c in candidates], 0.0, 1.0)
         score = (1.0 - prior) * np.nan_to_num(out["light"], nan=0.0) + prior * own
         keep = np.flatnonzero(passes(score, self.params["threshold"], self.params["relative"]))
-        boxes = housings(out["box"][keep], [candidates[i].bbox for i in keep], frame)
+        boxes = housings(out["box"][keep], [candidates[int(i)].bbox for i in keep], frame)
         chosen = suppress(boxes, score[keep], self.params["overlap"])
         kept = []
         for k in chosen:

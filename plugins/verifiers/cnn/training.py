@@ -8,9 +8,10 @@ the box on positives with a housing box, cross-entropy of the state on positives
 state. Every epoch sees the positives (at most ``per_camera`` of each camera) and
 ``negative_ratio`` times as many negatives drawn anew, from the second epoch on a share ``hard``
 of them the negatives the network scores highest in a random pool three times as large
-(hard-negative mining); each crop under a fresh camera augmentation (:mod:`.augment`). With a validation set (a
-camera the training never sees) the epoch whose validation average precision of the light is
-best is kept, and training stops after ``patience`` epochs without a better one.
+(hard-negative mining); each crop under a fresh camera augmentation (:mod:`.augment`). With a
+validation set (a camera the training never sees) the epoch whose validation average precision
+of the light is best is kept, and training stops after ``patience`` epochs without a better
+one.
 
 The exported model outputs probabilities: ``light`` (N), ``box`` (N, 4), ``state`` (N, 5).
 Before it is returned, ONNX Runtime runs it on validation (or training) crops and its outputs
@@ -89,7 +90,7 @@ def network(width: int) -> Any:
             nn.Conv2d(a, b, 3, padding=1, bias=False), nn.BatchNorm2d(b), nn.ReLU()
         )
 
-    class Net(nn.Module):  # type: ignore[misc, name-defined]
+    class Net(nn.Module):  # type: ignore[name-defined]
         def __init__(self) -> None:
             super().__init__()
             c = width
@@ -289,7 +290,7 @@ def export(model: Any, check: np.ndarray) -> tuple[bytes, float]:
     """
     torch = _torch()
 
-    class Probabilities(torch.nn.Module):  # type: ignore[misc, name-defined]
+    class Probabilities(torch.nn.Module):  # type: ignore[name-defined]
         def __init__(self, inner: Any) -> None:
             super().__init__()
             self.inner = inner
