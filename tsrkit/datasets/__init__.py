@@ -15,10 +15,10 @@ from tsrkit.datasets.opening import (
     open_dataset,
     read_dataset,
     relabel,
-    write_dataset,
 )
 from tsrkit.datasets.registry import DatasetEntry, data_dir, load_registry, registry_path
 from tsrkit.datasets.states import to_state
+from tsrkit.datasets.writing import write_dataset
 
 __all__ = [
     "SAMPLE",

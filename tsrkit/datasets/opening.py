@@ -21,7 +21,7 @@ from tsrkit.datasets.registry import DatasetEntry, load_registry
 from tsrkit.datasets.states import check_mapping, to_state
 from tsrkit.plugin.registry import get_registry
 
-__all__ = ["SAMPLE", "detect_format", "open_dataset", "read_dataset", "relabel", "write_dataset"]
+__all__ = ["SAMPLE", "detect_format", "open_dataset", "read_dataset", "relabel"]
 
 SAMPLE = "sample"
 
@@ -202,18 +202,6 @@ def relabel(dataset: Dataset, states: Mapping[str, str]) -> Dataset:
         for s in dataset.samples
     )
     return dataclasses.replace(dataset, samples=samples)
-
-
-def write_dataset(dataset: Dataset, format: str, out: str | os.PathLike) -> Path:
-    """Write ``dataset`` with the format plugin ``format`` at ``out`` (file or folder)."""
-    writer = get_registry().create("format", format)
-    if not writer.writable:
-        writable = ", ".join(
-            i.name for i in get_registry().plugins("format") if getattr(i.cls, "writable", False)
-        )
-        raise TsrkitError(f"format '{format}' has no writer (writable: {writable})")
-    writer.write(dataset, Path(out))
-    return Path(out)
 
 
 def _registry_entry(ref: str | os.PathLike) -> DatasetEntry | None:

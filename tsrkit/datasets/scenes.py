@@ -52,7 +52,7 @@ import numpy as np
 from tsrkit.core.atomic import json_text
 from tsrkit.core.errors import TsrkitError
 from tsrkit.core.types import Annotation, Dataset, Sample
-from tsrkit.datasets.opening import write_dataset
+from tsrkit.datasets.writing import write_dataset
 
 __all__ = [
     "ANNOTATION_FILES",
