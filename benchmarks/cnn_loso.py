@@ -407,6 +407,46 @@ def adapted_figures(
     return fold_figures(where, params, family, seen, taiwan, synthetic, lamp)
 
 
+def tables(folder: Path, rule: str) -> str:
+    """Markdown: each fold's figures at ``rule`` (``tT_rR_pP``), and the forest preset's on the
+    same candidates (``baseline.json``) beside them."""
+    folds = json.loads((folder / "folds.json").read_text())
+    baseline_path = folder / "baseline.json"
+    forest = json.loads(baseline_path.read_text()) if baseline_path.exists() else {}
+
+    def f(v):
+        return "-" if v is None else f"{v:.2f}"
+
+    head = (
+        "| fold | verifier | hit | precision | recall | recall IoU 0.5 | Taiwan false / keyframe "
+        "(no-light keyframes) | synthetic false / frame | state acc / red / amber |"
+    )
+    lines = [head, "|" + "---|" * 9]
+    for key, figures in folds.items():
+        row = figures["rules"][rule]
+        state = f"{f(figures.get('state_cnn'))} / {f(figures.get('red_recall_cnn'))} / " + f(
+            figures.get("yellow_recall_cnn")
+        )
+        lines.append(
+            f"| {key} | cnn {rule} | {f(row['hit'])} | {f(row['precision'])} | "
+            f"{f(row['recall'])} | {f(row['recall_iou50'])} | "
+            f"{f(row['taiwan_false_per_keyframe'])} ({f(row['taiwan_false_per_empty_keyframe'])})"
+            f" | {f(row['synthetic_false_per_frame'])} | {state} |"
+        )
+        if key in forest:
+            b = forest[key]
+            lamp = f"{f(b.get('state_lamp'))} / {f(b.get('red_recall_lamp'))} / " + f(
+                b.get("yellow_recall_lamp")
+            )
+            lines.append(
+                f"| {key} | forest preset | {f(b['hit'])} | {f(b['precision'])} | "
+                f"{f(b['recall'])} | {f(b['recall_iou50'])} | "
+                f"{f(b['taiwan_false_per_keyframe'])} ({f(b['taiwan_false_per_empty_keyframe'])})"
+                f" | {f(b['synthetic_false_per_frame'])} | {lamp} |"
+            )
+    return "\n".join(lines)
+
+
 def commit() -> str:
     try:
         return subprocess.run(
@@ -438,12 +478,16 @@ def main() -> None:
     parser.add_argument(
         "--evaluate", action="store_true", help="evaluate the folds' saved models (no training)"
     )
+    parser.add_argument("--tables", metavar="RULE", help="print OUT's tables at RULE (tT_rR_pP)")
     parser.add_argument(
         "--baseline",
         action="store_true",
         help="also evaluate the forest verifier preset (shipped model)",
     )
     args = parser.parse_args()
+    if args.tables:
+        print(tables(args.out, args.tables))
+        return
     harness.announce()
     args.out.mkdir(parents=True, exist_ok=True)
     chosen = tsrkit.select(config=args.config)
