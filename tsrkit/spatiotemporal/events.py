@@ -44,6 +44,7 @@ __all__ = [
     "crossing_time",
     "derive_events",
     "state_at",
+    "until_crossing",
     "write_rows",
 ]
 
@@ -123,6 +124,19 @@ class Dilemma:
         return {(True, True): "option", (True, False): "can_stop", (False, True): "can_clear"}.get(
             (stop, clear), "dilemma"
         )
+
+
+def until_crossing(intervals: Sequence[Interval], motion: Motion) -> list[Interval]:
+    """``intervals`` cut where the car passes the stop position (the approach: the signal
+    governs the car until then); all of them when it does not pass it."""
+    crossed = crossing_time(motion)
+    if crossed is None:
+        return list(intervals)
+    return [
+        Interval(i.kind, i.time, min(i.end, crossed), i.confidence)
+        for i in intervals
+        if i.time < crossed or i.time == intervals[0].time
+    ]
 
 
 def state_at(intervals: Sequence[Interval], t: float) -> Interval | None:

@@ -3,13 +3,15 @@ state timeline (:mod:`tsrkit.spatiotemporal.timeline`, Lee 2017 5.3.4) and the d
 (:mod:`tsrkit.spatiotemporal.events`) from it and the GPS kinematics
 (:mod:`tsrkit.spatiotemporal.kinematics`), written as ``timelines.csv`` and ``events.csv``.
 
-``timelines.csv``: ``traversal`` (the record's index in ``traversals.jsonl``), ``kind`` (red,
-yellow, green, red_yellow or unknown), ``time`` / ``end`` (UTC epoch seconds), ``video_start``
-/ ``video_end`` (seconds into the video) and ``confidence``. ``events.csv``: ``traversal``,
-``kind`` (amber_onset, red_onset, stop, go, red_crossing), ``time`` (UTC), ``video_s``, the car's
-``speed`` (m/s), ``distance`` (m, to the stop position, positive before it) and
-``time_to_stop`` (s, at the current speed) at that moment, the timeline's ``state`` then, the
-dilemma-zone class at amber onset (``zone``) and, for a red-light crossing, its ``evidence``.
+``timelines.csv`` (the approach: until the car passes the stop position): ``traversal``
+(the record's index in ``traversals.jsonl``), ``kind`` (red, yellow, green, red_yellow or
+unknown), ``time`` / ``end`` (UTC epoch seconds), ``video_start`` / ``video_end`` (seconds into
+the video) and ``confidence``. ``events.csv``: ``traversal``, ``kind`` (amber_onset, red_onset,
+stop, go, red_crossing), ``time`` (UTC), ``video_s``, the car's ``speed`` (m/s), ``distance``
+(m, to the stop position, positive before it) and ``time_to_stop`` (s, at the current speed) at
+that moment, the timeline's ``state`` then, the dilemma-zone class at amber onset (``zone``),
+for a red-light crossing its ``evidence``, where the stop position came from (``stop_source``:
+``osm`` or ``offset``) and the ids of the fused heads (``heads``).
 """
 
 from __future__ import annotations
@@ -30,6 +32,7 @@ from tsrkit.spatiotemporal.events import (
     Dilemma,
     crossing_time,
     derive_events,
+    until_crossing,
     write_rows,
 )
 from tsrkit.spatiotemporal.kinematics import (
@@ -40,7 +43,7 @@ from tsrkit.spatiotemporal.kinematics import (
 )
 from tsrkit.spatiotemporal.timeline import controlling_tracks, fused_states, state_intervals
 
-__all__ = ["StudySettings", "frame_width", "study_traversal", "write_study"]
+__all__ = ["StudySettings", "frame_size", "study_traversal", "write_study"]
 
 #: Fixes this many seconds beyond a traversal's entry and exit feed its kinematics.
 FIX_MARGIN_S = 20.0
@@ -52,16 +55,20 @@ class StudySettings:
     "unknown" threshold of Lee 5.3.4, and the dilemma-zone constants."""
 
     stop_offset: float = STOP_OFFSET_M
-    lowpass_s: float = 0.3
+    lowpass_s: float = 0.5
     unknown: float = 0.3
     dilemma: Dilemma = field(default_factory=Dilemma)
 
 
-def frame_width(video: str | os.PathLike) -> int:
-    """The video's frame width in pixels (what a track's bearing is a share of)."""
+def frame_size(video: str | os.PathLike) -> tuple[int, int]:
+    """The video's frame width and height in pixels (a track's bearing is a share of the
+    width)."""
     capture = cv2.VideoCapture(str(video), cv2.CAP_FFMPEG)
     try:
-        return int(capture.get(cv2.CAP_PROP_FRAME_WIDTH) or 0)
+        return (
+            int(capture.get(cv2.CAP_PROP_FRAME_WIDTH) or 0),
+            int(capture.get(cv2.CAP_PROP_FRAME_HEIGHT) or 0),
+        )
     finally:
         capture.release()
 
@@ -71,11 +78,13 @@ def study_traversal(
     track: Track,
     signals: Signals,
     stops: np.ndarray,
-    width: int,
+    size: tuple[int, int],
     settings: StudySettings = StudySettings(),
 ) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
     """The timeline rows and event rows of one traversal record of ``tsrkit track``
-    (``stops``: ``(lat, lon)`` rows of the map's stop-line nodes)."""
+    (``stops``: ``(lat, lon)`` rows of the map's stop-line nodes; ``size``: the frame's width
+    and height). The heads are the record's ``heads`` (followed over the clip,
+    :mod:`tsrkit.spatiotemporal.headpass`), else its ``tracks``."""
     number, fps, start = record["traversal"], float(record["fps"]), float(record["start_utc"])
     first, last = int(record["first_frame"]), int(record["last_frame"])
     node = record["intersection"]
@@ -93,9 +102,9 @@ def study_traversal(
     motion = approach_motion(t, approach.distance(x, y), start + frames / fps)
     crossed = crossing_time(motion)
     until = last if crossed is None else int(np.floor((crossed - start) * fps))
-    heads = controlling_tracks(record["tracks"], width, until)
+    heads = controlling_tracks(record.get("heads") or record["tracks"], size, until)
     states, votes = fused_states(heads, first, last, fps, settings.lowpass_s, settings.unknown)
-    intervals = state_intervals(states, votes, first, fps, start)
+    intervals = until_crossing(state_intervals(states, votes, first, fps, start), motion)
     timeline = [
         {
             "traversal": number,
@@ -126,10 +135,10 @@ def write_study(
     """Write ``timelines.csv`` and ``events.csv`` of the traversal records into ``out``
     (atomically); returns the counts of intervals and events."""
     stops = stop_nodes(signals.source)
-    width = frame_width(video)
+    size = frame_size(video)
     timelines, events = [], []
     for record in records:
-        rows, found = study_traversal(record, track, signals, stops, width, settings)
+        rows, found = study_traversal(record, track, signals, stops, size, settings)
         timelines += rows
         events += found
     write_rows(out / "timelines.csv", TIMELINE_COLUMNS, timelines)

@@ -4,7 +4,8 @@ track`` (Zheng 2016, 3.4.4-3.4.5) fused as Lee 2017 fuses the lights of one lane
 Controlling heads. The camera looks along the car's heading, so a track's image column gives
 its bearing from the approach heading, and its row says it hangs above the road. The heads
 controlling the car's approach face it for the whole approach (the longest, steadiest tracks:
-Zheng's stability score, 3.4.4) and lie ahead of it (near the image's centre column); heads of
+Zheng's stability score, 3.4.4), lie ahead of it (near the image's centre column) and hang
+above the camera (above the centre row of a level camera); heads of
 the cross street come into view at the side near the junction, lit in the other phase. The head
 of highest ``stability * (1 - |bearing share|)`` over the frames before the car passes the stop
 position is chosen, and so is every other track whose states agree with it on at least
@@ -15,9 +16,10 @@ classification confidence (a DOF candidate, which carries the state of the frame
 projected from, with :data:`DOF_WEIGHT` of it), averaged over the heads seen in that frame:
 where they agree this is the consensus, where not the most confident head wins, as Lee's rule.
 A low-pass filter (here a centred moving average over ``lowpass_s``: the run is offline, so the
-filter need not lag) smooths the votes; a frame whose highest smoothed vote is below
-``unknown`` is published as ``unknown`` (Lee's threshold ``t``; he gives no value). A frame no
-head is seen in votes nothing.
+filter need not lag) smooths the votes, averaging over the frames of the window where a head was
+seen (a missed detection neither votes nor dilutes the others); a frame whose highest smoothed
+vote is below ``unknown`` is published as ``unknown`` (Lee's threshold ``t``; he gives no
+value), and so is a frame with no head seen within the window.
 """
 
 from __future__ import annotations
@@ -49,15 +51,18 @@ def _points(track: Mapping[str, Any], until: int) -> dict[int, Mapping[str, Any]
 
 
 def controlling_tracks(
-    tracks: Sequence[Mapping[str, Any]], width: int, until: int
+    tracks: Sequence[Mapping[str, Any]], size: tuple[int, int], until: int
 ) -> list[Mapping[str, Any]]:
-    """The tracks of the heads controlling the approach, best first (module notes); ``until``
-    is the last frame before the car passes the stop position."""
+    """The tracks of the heads controlling the approach, best first (module notes); ``size``
+    is the frame's width and height, ``until`` the last frame before the car passes the stop
+    position. A track whose median row lies below the centre row (the horizon of a level
+    camera) is no head."""
+    width, height = size
     scored = []
     for track in tracks:
         points = _points(track, until)
         detected = [p for p in points.values() if p["origin"] == "detected"]
-        if not detected:
+        if not detected or float(np.median([p["y"] for p in detected])) > height / 2:
             continue
         bearing = float(np.median([abs(p["x"] - width / 2) for p in detected])) / (width / 2)
         stability = sum(p["confidence"] for p in detected)
@@ -81,7 +86,7 @@ def fused_states(
     first: int,
     last: int,
     fps: float,
-    lowpass_s: float = 0.3,
+    lowpass_s: float = 0.5,
     unknown: float = 0.3,
 ) -> tuple[list[str], np.ndarray]:
     """Per frame ``first..last`` the published state and its smoothed vote (module notes)."""
@@ -97,10 +102,11 @@ def fused_states(
                 seen[k] += 1
     votes /= np.maximum(seen, 1)[:, None]
     width = max(1, int(round(lowpass_s * fps)) | 1)
-    kernel = np.ones(width) / width
-    padded = np.pad(votes, ((width // 2, width // 2), (0, 0)), mode="edge")
-    smooth = np.column_stack(
-        [np.convolve(padded[:, j], kernel, mode="valid") for j in range(len(VOTED))]
+    kernel = np.ones(width)
+    observed = np.convolve((seen > 0).astype(float), kernel, mode="same")
+    smooth = (
+        np.column_stack([np.convolve(votes[:, j], kernel, mode="same") for j in range(len(VOTED))])
+        / np.maximum(observed, 1)[:, None]
     )
     top = smooth.max(axis=1)
     states = [VOTED[int(j)] if v >= unknown else "unknown" for j, v in zip(smooth.argmax(1), top)]

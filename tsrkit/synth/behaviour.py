@@ -5,7 +5,8 @@ what ``tsrkit track`` should find in ``timelines.csv`` and ``events.csv``
 A traversal here is one visit of a signalised intersection, numbered in route order as
 ``drive.json``'s ``traversals``; its window holds the frames within :data:`TRUTH_WINDOW_M` of
 the intersection's centre around the closest frame (the vicinity of Zheng 2016, 3.4.2, with
-that threshold). The controlling signal is the approach's own phase
+that threshold), its timeline ends where the car passes the stop position. The controlling
+signal is the approach's own phase
 (:func:`tsrkit.synth.drive.light_state`); the stop position is the route's stop (1 m before the
 near side's mast line, :data:`tsrkit.synth.drive.HEAD_PAST` + 1 m before the centre).
 """
@@ -24,6 +25,7 @@ from tsrkit.spatiotemporal.events import (
     Interval,
     Motion,
     derive_events,
+    until_crossing,
     write_rows,
 )
 from tsrkit.synth.drive import Drive, Node, drive_profile, light_state, summary
@@ -81,19 +83,6 @@ def truth_rows(
         first, last = _window(
             np.hypot(drive.x - cx, drive.y - cy), visit["closest_frame"], window_m
         )
-        intervals = true_timeline(drive, node, float(times[first]), float(times[last]))
-        for interval in intervals:
-            timelines.append(
-                {
-                    "traversal": number,
-                    "kind": interval.kind,
-                    "time": round(start + interval.time, 3),
-                    "end": round(start + interval.end, 3),
-                    "video_start": round(interval.time, 3),
-                    "video_end": round(interval.end, 3),
-                    "confidence": 1.0,
-                }
-            )
         stop = drive.route.stops[visit["node"]]
         window = slice(first, last + 1)
         motion = Motion(
@@ -101,7 +90,22 @@ def truth_rows(
             (stop - s[window]) if math.isfinite(stop) else np.full(last + 1 - first, np.inf),
             drive.speed[window],
         )
-        utc = [Interval(i.kind, start + i.time, start + i.end) for i in intervals]
+        intervals = true_timeline(drive, node, float(times[first]), float(times[last]))
+        utc = until_crossing(
+            [Interval(i.kind, start + i.time, start + i.end) for i in intervals], motion
+        )
+        for interval in utc:
+            timelines.append(
+                {
+                    "traversal": number,
+                    "kind": interval.kind,
+                    "time": round(interval.time, 3),
+                    "end": round(interval.end, 3),
+                    "video_start": round(interval.time - start, 3),
+                    "video_end": round(interval.end - start, 3),
+                    "confidence": 1.0,
+                }
+            )
         events += derive_events(number, utc, motion, start)
     return timelines, events
 
