@@ -33,6 +33,7 @@ import numpy as np
 from tsrkit.atomic import atomic_open
 
 __all__ = [
+    "CROSS_M",
     "EVENT_COLUMNS",
     "EVENT_KINDS",
     "STATES",
@@ -53,6 +54,8 @@ STATES = ("red", "yellow", "green", "red_yellow", "unknown")
 EVENT_KINDS = ("amber_onset", "red_onset", "stop", "go", "red_crossing")
 #: Below this speed (m/s) the car is at rest (``stop`` / ``go``).
 STOP_SPEED = 0.1
+#: The car has passed the stop position once it is this far (m) beyond it.
+CROSS_M = 2.0
 
 TIMELINE_COLUMNS = (
     "traversal",
@@ -149,15 +152,21 @@ def state_at(intervals: Sequence[Interval], t: float) -> Interval | None:
 
 
 def crossing_time(motion: Motion) -> float | None:
-    """When the distance to the stop position first reaches zero (linear between samples), or
-    None when the car does not pass it."""
-    d = motion.distance
-    after = np.flatnonzero((d[1:] <= 0) & (d[:-1] > 0))
-    if not len(after):
+    """When the car passes the stop position, or None when it does not get
+    :data:`CROSS_M` beyond it. A car that comes to rest at (or, by position noise, just past)
+    the stop position crosses when it pulls away, not when it halted there; else the moment
+    the distance reaches zero (linear between samples)."""
+    d, speed = motion.distance, motion.speed
+    beyond = np.flatnonzero(d <= -CROSS_M)
+    if not len(beyond):
         return None
-    k = int(after[0])
-    share = d[k] / (d[k] - d[k + 1])
-    return float(motion.time[k] + share * (motion.time[k + 1] - motion.time[k]))
+    k = int(beyond[0])
+    while k > 0 and d[k - 1] <= 0 and speed[k - 1] >= STOP_SPEED:
+        k -= 1
+    if k == 0 or d[k - 1] <= 0:  # at rest past the line, or past it from the start
+        return float(motion.time[k])
+    share = d[k - 1] / (d[k - 1] - d[k])
+    return float(motion.time[k - 1] + share * (motion.time[k] - motion.time[k - 1]))
 
 
 def _at(motion: Motion, t: float) -> tuple[float, float]:
