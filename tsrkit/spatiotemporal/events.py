@@ -36,6 +36,7 @@ __all__ = [
     "CROSS_M",
     "EVENT_COLUMNS",
     "EVENT_KINDS",
+    "RED_MARGIN_S",
     "STATES",
     "STOP_SPEED",
     "TIMELINE_COLUMNS",
@@ -56,6 +57,8 @@ EVENT_KINDS = ("amber_onset", "red_onset", "stop", "go", "red_crossing")
 STOP_SPEED = 0.1
 #: The car has passed the stop position once it is this far (m) beyond it.
 CROSS_M = 2.0
+#: Least time (s) a red crossing must lie inside the red interval, at either end.
+RED_MARGIN_S = 0.2
 
 TIMELINE_COLUMNS = (
     "traversal",
@@ -205,6 +208,7 @@ def derive_events(
     motion: Motion,
     video_start: float,
     dilemma: Dilemma = Dilemma(),
+    position_m: float = 0.0,
 ) -> list[dict[str, Any]]:
     """The events of one approach, in time order (module notes).
 
@@ -212,8 +216,11 @@ def derive_events(
     follows a yellow one, both before the car passes the stop position; ``stop`` the first
     sample below :data:`STOP_SPEED` before it and ``go`` the first sample above it after a
     stop; ``red_crossing`` the moment the car passes the stop position while the timeline
-    shows red, with the interval that says so as evidence. ``video_start`` is the UTC time of
-    the video's first frame (for ``video_s``).
+    shows red, with the interval that says so as evidence. The crossing must lie inside the
+    red interval by ``max(RED_MARGIN_S, position_m / speed)`` at both ends, so that an error
+    of ``position_m`` metres in the car's position cannot turn a crossing on amber or green
+    into a red one (0 for exact kinematics: any crossing on red). ``video_start`` is the UTC
+    time of the video's first frame (for ``video_s``).
     """
     crossed = crossing_time(motion)
     until = crossed if crossed is not None else float(motion.time[-1])
@@ -243,12 +250,15 @@ def derive_events(
         if kind == "go" and not any(e["kind"] == "stop" for e in events):
             continue
         events.append(_event(traversal, kind, t, video_start, motion, state_at(intervals, t)))
-    if crossed is not None:
-        shown = state_at(intervals, crossed)
-        if shown is not None and shown.kind == "red":
+    shown = state_at(intervals, crossed) if crossed is not None else None
+    if crossed is not None and shown is not None and shown.kind == "red":
+        speed = max(_at(motion, crossed)[0], STOP_SPEED)
+        margin = max(RED_MARGIN_S, position_m / speed) if position_m else 0.0
+        if shown.time + margin <= crossed <= shown.end - margin:
             evidence = (
-                f"red since {crossed - shown.time:.2f} s before the stop position "
-                f"(interval {shown.time:.2f}-{shown.end:.2f}, confidence {shown.confidence:.2f})"
+                f"red since {crossed - shown.time:.2f} s before the stop position, "
+                f"{shown.end - crossed:.2f} s more (interval confidence {shown.confidence:.2f}, "
+                f"margin {margin:.2f} s)"
             )
             events.append(
                 _event(traversal, "red_crossing", crossed, video_start, motion, shown, "", evidence)

@@ -45,6 +45,9 @@ from tsrkit.spatiotemporal.timeline import controlling_tracks, fused_states, sta
 
 __all__ = ["StudySettings", "frame_size", "study_traversal", "write_study"]
 
+#: The error (m) of a smoothed GPS position the red-crossing margin allows for (about twice the
+#: spread of a consumer receiver's fix after the local fit).
+POSITION_M = 2.0
 #: Fixes this many seconds beyond a traversal's entry and exit feed its kinematics.
 FIX_MARGIN_S = 20.0
 
@@ -52,11 +55,13 @@ FIX_MARGIN_S = 20.0
 @dataclass(frozen=True)
 class StudySettings:
     """Stop offset (m, where the map marks no stop line), the low-pass window (s) and the
-    "unknown" threshold of Lee 5.3.4, and the dilemma-zone constants."""
+    "unknown" threshold of Lee 5.3.4, the position error the red-crossing margin allows for
+    (:func:`~tsrkit.spatiotemporal.events.derive_events`) and the dilemma-zone constants."""
 
     stop_offset: float = STOP_OFFSET_M
     lowpass_s: float = 0.5
     unknown: float = 0.3
+    position_m: float = POSITION_M
     dilemma: Dilemma = field(default_factory=Dilemma)
 
 
@@ -104,7 +109,7 @@ def study_traversal(
     until = last if crossed is None else int(np.floor((crossed - start) * fps))
     heads = controlling_tracks(record.get("heads") or record["tracks"], size, until)
     states, votes = fused_states(heads, first, last, fps, settings.lowpass_s, settings.unknown)
-    intervals = until_crossing(state_intervals(states, votes, first, fps, start), motion)
+    intervals = state_intervals(states, votes, first, fps, start)
     timeline = [
         {
             "traversal": number,
@@ -115,9 +120,9 @@ def study_traversal(
             "video_end": round(i.end - start, 3),
             "confidence": i.confidence,
         }
-        for i in intervals
+        for i in until_crossing(intervals, motion)
     ]
-    events = derive_events(number, intervals, motion, start, settings.dilemma)
+    events = derive_events(number, intervals, motion, start, settings.dilemma, settings.position_m)
     for event in events:
         event["stop_source"] = approach.source
         event["heads"] = ";".join(str(h["id"]) for h in heads)

@@ -91,10 +91,8 @@ def truth_rows(
             drive.speed[window],
         )
         intervals = true_timeline(drive, node, float(times[first]), float(times[last]))
-        utc = until_crossing(
-            [Interval(i.kind, start + i.time, start + i.end) for i in intervals], motion
-        )
-        for interval in utc:
+        utc = [Interval(i.kind, start + i.time, start + i.end) for i in intervals]
+        for interval in until_crossing(utc, motion):
             timelines.append(
                 {
                     "traversal": number,
