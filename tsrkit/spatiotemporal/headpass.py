@@ -6,10 +6,12 @@ radius of the flow-projected one, so a track ends where the lit lamp moves to an
 the head (RESULTS.track.md, "Limits"), and the passes start from the short range around the
 closest frame: the approach, where amber and red onsets and stops happen, is mostly untracked.
 This pass follows the head instead. From each end of a chosen track it projects the lit lamp
-to the next frame by Farneback flow (Eq. 3.30-3.34), detects in a region that reaches the other
-lamps (Algorithms 3-3 / 3-4 with the region widened to the head), and keeps the candidate whose
-position fits its state's lamp (:func:`lamp_fit`: :data:`LAMP_PITCH` radii apart, red on top,
-the layout of a vertical head); it stops after :data:`PATIENCE` frames without one.
+to the next frame by the Farneback flow of the whole head around it (Eq. 3.30-3.34 on a circle
+that spans the head: the flow at the lamp itself is wrong where the lit lamp changes), detects
+in a region that reaches the other lamps (Algorithms 3-3 / 3-4 with the region widened to the
+head), and keeps the candidate whose position fits its state's lamp (:func:`lamp_fit`:
+:data:`LAMP_PITCH` radii apart, red on top, the layout of a vertical head); it stops after
+:data:`PATIENCE` frames without one.
 """
 
 from __future__ import annotations
@@ -27,12 +29,14 @@ __all__ = ["LAMP_PITCH", "PATIENCE", "follow_head", "lamp_fit"]
 LAMP_PITCH = 2.8
 #: Frames without a fitting candidate after which the pass stops in that direction.
 PATIENCE = 5
-#: How far (radii) across the head's axis, and along it beyond the lamp spacing's slack, a
-#: candidate may lie from where its state's lamp should be.
-FIT_RADII = 1.2
+#: How far (radii) along the head's axis, beyond the lamp spacing's slack, a candidate may lie
+#: from where its state's lamp should be (a lamp's glow is often detected off its centre).
+ALONG_RADII = 2.5
 #: Share of the lamp spacing by which a lamp change may differ from it (detected radii are
 #: integers, and a glowing lamp looks larger than its lens).
 PITCH_SLACK = 0.45
+#: How far (radii) across the head's axis a candidate may lie from the projected lamp.
+ACROSS_RADII = 2.0
 _LAMP = {"red": -1, "yellow": 0, "green": 1}
 
 
@@ -53,9 +57,9 @@ def lamp_fit(candidate: Point, lamp: Point, radius: float) -> float:
     steps = _LAMP[candidate.state] - _LAMP[lamp.state]
     expected = steps * LAMP_PITCH * radius
     along = abs(candidate.y - lamp.y - expected) / max(
-        FIT_RADII * radius, PITCH_SLACK * abs(expected)
+        ALONG_RADII * radius, PITCH_SLACK * abs(expected)
     )
-    across = abs(candidate.x - lamp.x) / (FIT_RADII * radius)
+    across = abs(candidate.x - lamp.x) / (ACROSS_RADII * radius)
     return max(along, across)
 
 
@@ -70,13 +74,14 @@ def follow_head(clip: Clip, track: Track) -> Track:
         if lamp.state not in _LAMP:
             continue
         radius = max(lamp.radius, 0.8)
-        reach = (2 * LAMP_PITCH + FIT_RADII) * radius
+        reach = (2 * LAMP_PITCH + ALONG_RADII) * radius
         i, missed = start, 0
         while i != stop and missed < PATIENCE:
             j = i + step
-            lamp = clip.project(replace(lamp, radius=radius), i, j)
-            if lamp.status == "out":
+            moved = clip.project(replace(lamp, radius=reach / 2), i, j)
+            if moved.status == "out":
                 break
+            lamp = replace(moved, radius=radius)
             found = [
                 (lamp_fit(p, lamp, radius), p)
                 for p in clip.detect_near(j, replace(lamp, radius=reach / 2))
@@ -85,7 +90,7 @@ def follow_head(clip: Clip, track: Track) -> Track:
             if best is not None and score <= 1.0:
                 points.setdefault(j, best)
                 radius = 0.7 * radius + 0.3 * best.radius
-                reach = (2 * LAMP_PITCH + FIT_RADII) * radius
+                reach = (2 * LAMP_PITCH + ALONG_RADII) * radius
                 lamp = best
                 missed = 0
             else:
