@@ -43,6 +43,7 @@ def test_timeline_and_events_of_a_red_wait(drive, tmp_path):
     assert all(float(r["time"]) < float(r["end"]) for r in timeline)
     assert tuple(events[0])[: len(EVENT_COLUMNS)] == EVENT_COLUMNS
     figures = score(out, drive)
-    assert figures["events"]["precision"] == figures["events"]["recall"] == 1.0
+    assert figures["kinds"]["stop"] == {"estimated": 1, "true": 1, "matched": 1}
+    assert figures["kinds"]["go"]["estimated"] == 1  # 1 Hz GPS dates it to about 0.6 s
     assert figures["red_crossing"]["flagged"] == 0
-    assert figures["timeline"]["accuracy"] >= 0.6
+    assert figures["timeline"]["accuracy"] >= 0.7  # unknown while the lenses are < 1.5 px

@@ -37,22 +37,31 @@ ALONG_RADII = 2.5
 PITCH_SLACK = 0.45
 #: How far (radii) across the head's axis a candidate may lie from the projected lamp.
 ACROSS_RADII = 2.0
+#: The changes of state a signal head makes (Zheng's colour state machine, Eq. 3.35).
+CYCLE = {("green", "yellow"), ("yellow", "red"), ("red", "green")}
 _LAMP = {"red": -1, "yellow": 0, "green": 1}
 
 
-def lamp_fit(candidate: Point, lamp: Point, radius: float) -> float:
+def lamp_fit(candidate: Point, lamp: Point, radius: float, later: bool = True) -> float:
     """How well ``candidate`` fits as the lit lamp of the head whose lamp ``lamp`` was lit
     (projected to the candidate's frame): 0 is perfect, above 1 no fit (inf when it cannot be
-    a lamp of this head). The expected shift along the axis is the lamp spacing times the
-    number of lamps between the two states.
+    a lamp of this head, or when the change of state is not one of the signal cycle's:
+    green -> yellow -> red -> green, Zheng's colour state machine, Eq. 3.35-3.37; ``later``
+    says the candidate's frame follows the lamp's). The expected shift along the axis is the
+    lamp spacing times the number of lamps between the two states.
 
     >>> lamp = Point(10.0, 20.0, 2.0, "green", {})
-    >>> lamp_fit(Point(10.5, 9.0, 2.0, "red", {}), lamp, 2.0) < 1  # two lamps up
+    >>> lamp_fit(Point(10.5, 30.0, 2.0, "red", {}), lamp, 2.0, later=False) > 1  # below
     True
-    >>> lamp_fit(Point(10.5, 30.0, 2.0, "red", {}), lamp, 2.0) > 1  # red below green
-    True
+    >>> lamp_fit(Point(10.5, 9.0, 2.0, "red", {}), lamp, 2.0, later=False)  # red, then green
+    0.125
+    >>> lamp_fit(Point(10.5, 9.0, 2.0, "red", {}), lamp, 2.0)  # green, then red: no amber
+    inf
     """
     if candidate.state not in _LAMP or not 0.4 * radius <= candidate.radius <= 2.5 * radius:
+        return math.inf
+    change = (lamp.state, candidate.state) if later else (candidate.state, lamp.state)
+    if change[0] != change[1] and change not in CYCLE:
         return math.inf
     steps = _LAMP[candidate.state] - _LAMP[lamp.state]
     expected = steps * LAMP_PITCH * radius
@@ -83,7 +92,7 @@ def follow_head(clip: Clip, track: Track) -> Track:
                 break
             lamp = replace(moved, radius=radius)
             found = [
-                (lamp_fit(p, lamp, radius), p)
+                (lamp_fit(p, lamp, radius, step > 0), p)
                 for p in clip.detect_near(j, replace(lamp, radius=reach / 2))
             ]
             score, best = min(found, key=lambda item: item[0], default=(math.inf, None))

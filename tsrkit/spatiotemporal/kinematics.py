@@ -49,7 +49,7 @@ STOP_SEARCH_M = 40.0
 STOP_TAGS = (("highway", "stop"), ("highway", "stop_line"), ("traffic_signals", "stop_line"))
 #: Half width (s) of the local quadratic fit of the fixes.
 HALF_WINDOW_S = 2.5
-#: A fix whose fitted speed is below this (m/s) may be at rest; three in a row are a stop.
+#: A fix whose fitted speed is below this (m/s) may be at rest; two in a row are a stop.
 STILL_SPEED = 1.2
 
 
@@ -180,7 +180,7 @@ def approach_motion(
         end = k
         while end + 1 < len(still) and still[end + 1]:
             end += 1
-        if end - k >= 2:
+        if end - k >= 1:
             rest = float(np.median(d[k : end + 1]))
             arrive, leave = _fit_edges(track_t, d, fix_speed, k, end, rest, cruise)
             inside = (at >= arrive[0]) & (at <= leave[0])
