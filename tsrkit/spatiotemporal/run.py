@@ -30,6 +30,7 @@ from tsrkit.inputs import iter_video
 from tsrkit.pipeline import Pipeline
 from tsrkit.selection import Selection
 from tsrkit.spatiotemporal.clip import Clip
+from tsrkit.spatiotemporal.egomotion import image_motion
 from tsrkit.spatiotemporal.headpass import follow_head
 from tsrkit.spatiotemporal.passes import TOP_N, recognise
 from tsrkit.spatiotemporal.ranges import DOWNSTREAM_M, UPSTREAM_M, FrameTraversal, frame_traversals
@@ -125,7 +126,8 @@ def traversal_record(
     """Run the passes on the clip and describe the traversal, its tracks and, as ``heads``,
     the tracks of the heads controlling the approach followed over the whole clip
     (:func:`~tsrkit.spatiotemporal.timeline.controlling_tracks` until the anchor frame, then
-    :mod:`tsrkit.spatiotemporal.headpass`)."""
+    :mod:`tsrkit.spatiotemporal.headpass`), and per frame the camera's image motion
+    (:func:`~tsrkit.spatiotemporal.egomotion.image_motion`, which dates stops)."""
     start = time.perf_counter()
     tracks, made = recognise(clip, found.upstream, found.downstream, settings.top, settings.slack)
     height, width = clip.images[clip.first].shape[:2]
@@ -142,6 +144,7 @@ def traversal_record(
         "tracks_first_pass": made,
         "tracks": described,
         "heads": [t.to_json() for t in heads],
+        "image_motion": {str(k): round(v, 3) for k, v in image_motion(clip.images).items()},
         "calls": dict(clip.calls),
         "seconds": round(time.perf_counter() - start, 3),
     }

@@ -1,7 +1,8 @@
 """From the traversals of ``tsrkit track`` to answers: per traversal the controlling signal's
 state timeline (:mod:`tsrkit.spatiotemporal.timeline`, Lee 2017 5.3.4) and the driving events
 (:mod:`tsrkit.spatiotemporal.events`) from it and the GPS kinematics
-(:mod:`tsrkit.spatiotemporal.kinematics`), written as ``timelines.csv`` and ``events.csv``.
+(:mod:`tsrkit.spatiotemporal.kinematics`; stops dated by the video's image motion,
+:mod:`tsrkit.spatiotemporal.egomotion`), written as ``timelines.csv`` and ``events.csv``.
 
 ``timelines.csv`` (the approach: until the car passes the stop position): ``traversal``
 (the record's index in ``traversals.jsonl``), ``kind`` (red, yellow, green, red_yellow or
@@ -26,6 +27,7 @@ import cv2
 import numpy as np
 
 from tsrkit.geo import LocalProjection, Signals, Track
+from tsrkit.spatiotemporal.egomotion import dated_rest
 from tsrkit.spatiotemporal.events import (
     EVENT_COLUMNS,
     TIMELINE_COLUMNS,
@@ -105,6 +107,9 @@ def study_traversal(
     )
     frames = np.arange(first, last + 1)
     motion = approach_motion(t, approach.distance(x, y), start + frames / fps)
+    measure = {int(k): float(v) for k, v in (record.get("image_motion") or {}).items()}
+    if measure:
+        motion = dated_rest(motion, frames.tolist(), measure, fps)
     crossed = crossing_time(motion)
     until = last if crossed is None else int(np.floor((crossed - start) * fps))
     heads = controlling_tracks(record.get("heads") or record["tracks"], size, until)
