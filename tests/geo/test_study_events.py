@@ -7,6 +7,7 @@ from itertools import pairwise
 import numpy as np
 import pytest
 
+from tsrkit.spatiotemporal.egomotion import dated_rest, rest_edges
 from tsrkit.spatiotemporal.events import Dilemma, Interval, Motion, derive_events, until_crossing
 from tsrkit.spatiotemporal.kinematics import approach_motion, approach_of
 from tsrkit.spatiotemporal.scoring import match_events, pair_traversals, timeline_scores
@@ -140,3 +141,14 @@ def test_scoring_pairs_traversals_and_matches_events(mixed):
     late = [{**e, "time": e["time"] + 0.6} for e in moved]
     assert match_events(late, events, pairs) == []
     assert timeline_scores(shifted, timelines, pairs)["accuracy"] == 1.0
+
+
+def test_the_video_dates_the_ends_of_a_stop():
+    frames = list(range(40))
+    moving = [5.0] * 12 + [0.6, 0.8, 0.5, 1.2] * 4 + [0.7, 0.6] + [4.0] * 10
+    # the GPS says 10..28; the image stops changing at frame 12 and changes again at 30
+    assert rest_edges(frames, moving, 10, 28, 5) == (12, 29)
+    t = np.arange(40) / 10.0
+    speed = np.where((np.arange(40) >= 10) & (np.arange(40) <= 28), 0.0, 3.0)
+    dated = dated_rest(Motion(t, np.zeros(40), speed), frames, dict(zip(frames, moving)), 10)
+    assert np.flatnonzero(dated.speed == 0).tolist() == list(range(12, 30))
