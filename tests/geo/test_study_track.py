@@ -2,6 +2,7 @@
 short rendered drive (the car waits at a red, then goes on green), scored against its truth."""
 
 import csv
+import json
 
 import pytest
 from click.testing import CliRunner
@@ -47,3 +48,27 @@ def test_timeline_and_events_of_a_red_wait(drive, tmp_path):
     assert figures["kinds"]["go"]["estimated"] == 1  # 1 Hz GPS dates it to about 0.6 s
     assert figures["red_crossing"]["flagged"] == 0
     assert figures["timeline"]["accuracy"] >= 0.7  # unknown while the lenses are < 1.5 px
+
+
+def test_study_runs_a_manifest_resumes_and_combines(drive, tmp_path):
+    manifest = tmp_path / "drives.csv"
+    manifest.write_text(
+        f"name,video,gps,map\nred_wait,{drive / 'drive.mp4'},{drive / 'gps.csv'},"
+        f"{drive / 'map.osm'}\n"
+    )
+    out = tmp_path / "study"
+    args = ["study", str(manifest), "--out", str(out), "--vicinity", "60", "-q", *PLUGINS]
+    first = CliRunner().invoke(cli, args)
+    assert first.exit_code == 0, first.output
+    again = CliRunner().invoke(cli, args)
+    assert again.exit_code == 0 and "red_wait: finished before, skipped" in again.output
+    events = rows(out / "events.csv")
+    assert events and all(e["drive"] == "red_wait" for e in events)
+    assert rows(out / "timelines.csv")[0]["drive"] == "red_wait"
+    geojson = json.loads((out / "traversals.geojson").read_text())
+    assert geojson["features"][0]["properties"]["stop"] == 1
+    bad = tmp_path / "bad.csv"
+    bad.write_text("video,gps\nnone.mp4,none.csv\n")
+    result = CliRunner().invoke(cli, ["study", str(bad), "--out", str(tmp_path / "x")])
+    assert result.exit_code != 0 and "drive 1: no map" in result.output
+    assert "Traceback" not in result.output

@@ -45,8 +45,10 @@ from tsrkit.spatiotemporal.kinematics import (
 )
 from tsrkit.spatiotemporal.timeline import controlling_tracks, fused_states, state_intervals
 
-__all__ = ["StudySettings", "frame_size", "study_traversal", "write_study"]
+__all__ = ["STUDY_EVENT_COLUMNS", "StudySettings", "frame_size", "study_traversal", "write_study"]
 
+#: The columns of ``events.csv``.
+STUDY_EVENT_COLUMNS = (*EVENT_COLUMNS, "stop_source", "heads")
 #: The error (m) of a smoothed GPS position the red-crossing margin allows for (about twice the
 #: spread of a consumer receiver's fix after the local fit).
 POSITION_M = 2.0
@@ -152,5 +154,5 @@ def write_study(
         timelines += rows
         events += found
     write_rows(out / "timelines.csv", TIMELINE_COLUMNS, timelines)
-    write_rows(out / "events.csv", (*EVENT_COLUMNS, "stop_source", "heads"), events)
+    write_rows(out / "events.csv", STUDY_EVENT_COLUMNS, events)
     return len(timelines), len(events)
