@@ -98,17 +98,18 @@ def approach_of(
     stops: np.ndarray,
     offset: float = STOP_OFFSET_M,
 ) -> Approach:
-    """The approach of the fixes ``(x, y)`` at times ``t`` (local metres) to ``centre``: the
+    """The approach of the fixes ``(x, y)`` at times ``t`` (local metres, at least two) to
+    ``centre``: the
     heading is the principal direction of the fixes before ``anchor`` and more than 14 m from
     the centre (oriented along the motion); the stop position is the stop node (rows of
     ``stops``, local metres) before the centre and nearest the path, else ``offset`` metres
     before the centre."""
     before = (t <= anchor) & (np.hypot(x - centre[0], y - centre[1]) > 14.0)
     if before.sum() < 2:
-        before = t <= anchor
+        before = t <= anchor if (t <= anchor).sum() >= 2 else np.ones(len(t), bool)
     px, py = x[before], y[before]
     points = np.column_stack([px - px.mean(), py - py.mean()])
-    heading = np.linalg.svd(points, full_matrices=False)[2][0] if len(px) > 1 else np.array((0, 1))
+    heading = np.linalg.svd(points, full_matrices=False)[2][0]
     if heading @ np.array((px[-1] - px[0], py[-1] - py[0])) < 0:
         heading = -heading
     lateral = np.array((-heading[1], heading[0]))

@@ -32,6 +32,7 @@ from tsrkit.spatiotemporal.events import (
     EVENT_COLUMNS,
     TIMELINE_COLUMNS,
     Dilemma,
+    Motion,
     crossing_time,
     derive_events,
     until_crossing,
@@ -103,12 +104,17 @@ def study_traversal(
     )
     x, y = projection(track.lat[near], track.lon[near])
     t = track.time[near]
-    stop_xy = np.column_stack(projection(stops[:, 0], stops[:, 1])) if len(stops) else stops
-    approach = approach_of(
-        x, y, t, np.zeros(2), float(record["anchor"]), stop_xy, settings.stop_offset
-    )
     frames = np.arange(first, last + 1)
-    motion = approach_motion(t, approach.distance(x, y), start + frames / fps)
+    if len(t) >= 2:
+        stop_xy = np.column_stack(projection(stops[:, 0], stops[:, 1])) if len(stops) else stops
+        approach = approach_of(
+            x, y, t, np.zeros(2), float(record["anchor"]), stop_xy, settings.stop_offset
+        )
+        motion = approach_motion(t, approach.distance(x, y), start + frames / fps)
+        source = approach.source
+    else:  # no fixes around the traversal: no kinematics, no event but from the timeline
+        unknown = np.full(len(frames), np.nan)
+        motion, source = Motion(start + frames / fps, unknown, unknown), "none"
     measure = {int(k): float(v) for k, v in (record.get("image_motion") or {}).items()}
     if measure:
         motion = dated_rest(motion, frames.tolist(), measure, fps)
@@ -131,7 +137,7 @@ def study_traversal(
     ]
     events = derive_events(number, intervals, motion, start, settings.dilemma, settings.position_m)
     for event in events:
-        event["stop_source"] = approach.source
+        event["stop_source"] = source
         event["heads"] = ";".join(str(h["id"]) for h in heads)
     return timeline, events
 
