@@ -25,7 +25,7 @@ ROAD_SHARE = 0.3
 #: Vertical shifts (pixels, either way) tried between two frames.
 SHIFT_PX = 2
 #: A frame moves when its measure exceeds the rest level by this factor.
-REST_FACTOR = 2.5
+REST_FACTOR = 1.6
 
 
 def image_motion(images: Mapping[int, np.ndarray]) -> dict[int, float]:
@@ -51,22 +51,28 @@ def rest_edges(
     frames: Sequence[int], values: Sequence[float], arrive: int, leave: int, search: int
 ) -> tuple[int, int]:
     """The first and last frames at rest of a stop that the GPS places at ``arrive..leave``:
-    the rest level is the median measure inside it, and each end moves, within ``search``
-    frames, to where the measure crosses :data:`REST_FACTOR` times that level. Ends that the
-    measures cannot date stay as given."""
+    the rest level is the median measure inside it, a frame moves when its measure and its
+    neighbour's (the one further from the stop) both exceed :data:`REST_FACTOR` times that level
+    (a lone spike is a compression artefact), and each end moves, within ``search`` frames, to
+    the frame next to the nearest moving one. Ends that the measures cannot date stay as
+    given."""
     measure = dict(zip(frames, values))
     inside = [measure[f] for f in range(arrive, leave + 1) if f in measure]
     if len(inside) < 3:
         return arrive, leave
     level = REST_FACTOR * float(np.median(inside))
+
+    def moving(f: int, g: int) -> bool:
+        return measure.get(f, 0.0) > level and measure.get(g, 0.0) > level
+
     first = arrive
-    for f in range(arrive + search, arrive - search - 1, -1):  # the last moving frame before
-        if f in measure and measure[f] > level and f < leave:
+    for f in range(min(arrive + search, leave - 1), arrive - search - 1, -1):
+        if moving(f, f - 1):  # the last moving frame before the rest
             first = f + 1
             break
     last = leave
-    for f in range(leave - search, leave + search + 1):  # the first moving frame after
-        if f in measure and measure[f] > level and f > first:
+    for f in range(max(leave - search, first + 1), leave + search + 1):
+        if moving(f, f + 1):  # the first moving frame after it
             last = f - 1
             break
     return first, last
@@ -76,7 +82,7 @@ def dated_rest(
     motion: Motion, frames: Sequence[int], measure: Mapping[int, float], fps: float
 ) -> Motion:
     """``motion`` (sampled at ``frames``) with each stop's ends moved to where the video dates
-    them (:func:`rest_edges`, searching a second either way): at rest in between, and at
+    them (:func:`rest_edges`, searching two seconds either way): at rest in between, and at
     least :data:`~tsrkit.spatiotemporal.events.STOP_SPEED` where the video shows motion."""
     speed = motion.speed.copy()
     rest = speed < STOP_SPEED
@@ -90,7 +96,7 @@ def dated_rest(
         end = k
         while end + 1 < len(rest) and rest[end + 1]:
             end += 1
-        first, last = rest_edges(frames, values, frames[k], frames[end], int(round(fps)))
+        first, last = rest_edges(frames, values, frames[k], frames[end], int(round(2 * fps)))
         lo, hi = (
             frames.index(first) if first in frames else k,
             frames.index(last) if last in frames else end,
