@@ -10,7 +10,9 @@ to the next frame by the Farneback flow of the whole head around it (Eq. 3.30-3.
 that spans the head: the flow at the lamp itself is wrong where the lit lamp changes), detects
 in a region that reaches the other lamps (Algorithms 3-3 / 3-4 with the region widened to the
 head), and keeps the candidate whose position fits its state's lamp (:func:`lamp_fit`:
-:data:`LAMP_PITCH` radii apart, red on top, the layout of a vertical head); it stops after
+:data:`LAMP_PITCH` radii apart, red on top, the layout of a vertical head; after a change
+of lamp the pass follows the new lamp from where the head's layout puts it, since the first
+detection of a lamp switching on is often its glow off the lens); it stops after
 :data:`PATIENCE` frames without one.
 """
 
@@ -72,13 +74,24 @@ def lamp_fit(candidate: Point, lamp: Point, radius: float, later: bool = True) -
     return max(along, across)
 
 
+def _steady(points: dict[int, Point], frames: list[int]) -> int:
+    """Of ``frames``, the one whose point lies nearest the median position of their points
+    (a track's first or last point is often a stray one)."""
+    x = sorted(points[f].x for f in frames)[len(frames) // 2]
+    y = sorted(points[f].y for f in frames)[len(frames) // 2]
+    return min(frames, key=lambda f: math.hypot(points[f].x - x, points[f].y - y))
+
+
 def follow_head(clip: Clip, track: Track) -> Track:
-    """A copy of ``track`` extended over the clip in both directions (module notes)."""
+    """A copy of ``track`` extended over the clip in both directions (module notes), from the
+    steadiest of its first and of its last five points."""
     points = dict(track.points)
     frames = sorted(points)
-    for start, step, stop in (
-        ((frames[0], -1, clip.first), (frames[-1], 1, clip.last)) if frames else ()
-    ):
+    ends = (
+        (_steady(points, frames[:5]), -1, clip.first),
+        (_steady(points, frames[-5:]), 1, clip.last),
+    )
+    for start, step, stop in ends if frames else ():
         lamp = points[start]
         if lamp.state not in _LAMP:
             continue
@@ -98,6 +111,9 @@ def follow_head(clip: Clip, track: Track) -> Track:
             score, best = min(found, key=lambda item: item[0], default=(math.inf, None))
             if best is not None and score <= 1.0:
                 points.setdefault(j, best)
+                if best.state != lamp.state:  # the lit lamp moved: where the head puts it
+                    steps = _LAMP[best.state] - _LAMP[lamp.state]
+                    best = replace(best, y=lamp.y + steps * LAMP_PITCH * radius)
                 radius = 0.7 * radius + 0.3 * best.radius
                 reach = (2 * LAMP_PITCH + ALONG_RADII) * radius
                 lamp = best
