@@ -36,6 +36,7 @@ __all__ = [
     "CROSS_M",
     "EVENT_COLUMNS",
     "EVENT_KINDS",
+    "GAP_S",
     "RED_MARGIN_S",
     "STATES",
     "STOP_SPEED",
@@ -57,6 +58,8 @@ EVENT_KINDS = ("amber_onset", "red_onset", "stop", "go", "red_crossing")
 STOP_SPEED = 0.1
 #: The car has passed the stop position once it is this far (m) beyond it.
 CROSS_M = 2.0
+#: An "unknown" interval this short (s) between two states does not hide a change between them.
+GAP_S = 0.5
 #: Least time (s) a red crossing must lie inside the red interval, at either end.
 RED_MARGIN_S = 0.2
 
@@ -213,8 +216,9 @@ def derive_events(
     """The events of one approach, in time order (module notes).
 
     ``amber_onset`` is a yellow interval that follows a green one, ``red_onset`` a red one that
-    follows a yellow one, both before the car passes the stop position; ``stop`` the first
-    sample below :data:`STOP_SPEED` before it and ``go`` the first sample above it after a
+    follows a yellow one (across an ``unknown`` of at most :data:`GAP_S`), both before the car
+    passes the stop position; ``stop`` the first sample below :data:`STOP_SPEED` before it and
+    ``go`` the first sample above it after a
     stop; ``red_crossing`` the moment the car passes the stop position while the timeline
     shows red, with the interval that says so as evidence. The crossing must lie inside the
     red interval by ``max(RED_MARGIN_S, position_m / speed)`` at both ends, so that an error
@@ -226,7 +230,14 @@ def derive_events(
     until = crossed if crossed is not None else float(motion.time[-1])
     events = []
     for k in range(1, len(intervals)):
-        before, interval = intervals[k - 1], intervals[k]
+        interval, b = intervals[k], k - 1
+        while (
+            b > 0
+            and intervals[b].kind == "unknown"
+            and intervals[b].end - intervals[b].time <= GAP_S
+        ):
+            b -= 1  # a blink of "unknown" between two states
+        before = intervals[b]
         if not interval.time < until:
             continue
         if interval.kind == "yellow" and before.kind == "green":
