@@ -139,7 +139,8 @@ def _write_jsonl(path: Path, records) -> None:
     "-o",
     type=click.Path(file_okay=False),
     default=None,
-    help="Folder for traversals.jsonl (and, with VIDEO, report.json / .md, plots/, cache/).",
+    help="Folder for traversals.jsonl (and, with VIDEO, timelines.csv, events.csv, "
+    "report.json / .md, plots/, cache/).",
 )
 def track_command(
     video,

@@ -218,9 +218,9 @@ def derive_events(
     ``amber_onset`` is a yellow interval that follows a green one, ``red_onset`` a red one that
     follows a yellow one (across an ``unknown`` of at most :data:`GAP_S`), both before the car
     passes the stop position; ``stop`` the first sample below :data:`STOP_SPEED` before it and
-    ``go`` the first sample above it after a
-    stop; ``red_crossing`` the moment the car passes the stop position while the timeline
-    shows red, with the interval that says so as evidence. The crossing must lie inside the
+    ``go`` the first sample above it after a stop; ``red_crossing`` the moment the car passes
+    the stop position while the timeline shows red, with the interval that says so as
+    evidence. The crossing must lie inside the
     red interval by ``max(RED_MARGIN_S, position_m / speed)`` at both ends, so that an error
     of ``position_m`` metres in the car's position cannot turn a crossing on amber or green
     into a red one (0 for exact kinematics: any crossing on red). ``video_start`` is the UTC

@@ -8,11 +8,13 @@ What is simulated
     cruises, slows for turns and stops at the stop line for a red (or a yellow it can stop
     for). Every signalised intersection has two vertical three-lens heads per approach on a mast
     arm 12 m past the junction centre, 5.5 m high; the two phases (north-south and east-west)
-    cycle green, yellow, red on a known schedule with a per-intersection offset. Heads facing
-    the camera show their lit lens (``heads.render_head``); others show a dark housing. A box
-    truck overtakes in the next lane on every leg and occludes heads (depth-tested). The camera
-    adds pitch vibration, optical blur and sensor noise; the video is MPEG-4. The GPS log (CSV,
-    1 Hz) carries Gaussian position noise.
+    cycle green, yellow, red (and an optional all-red clearance) on a known schedule with a
+    per-intersection offset; on a chosen share of visits the driver ignores the signal and runs
+    the amber or red (``run_share``). Heads facing the camera show their lit lens
+    (``heads.render_head``); others show a dark housing. A box truck overtakes in the next lane
+    on every leg and occludes heads (depth-tested). The camera adds pitch vibration, optical
+    blur and sensor noise; the video is MPEG-4. The GPS log (CSV, 1 Hz) carries Gaussian
+    position noise.
 
 What is not simulated
     Lens distortion, rolling shutter, lighting other than day, heads seen at an angle (shown
