@@ -141,7 +141,8 @@ def _write_jsonl(path: Path, records) -> None:
     "-o",
     type=click.Path(file_okay=False),
     default=None,
-    help="Folder for traversals.jsonl (and, with VIDEO, report.json / .md, plots/, cache/).",
+    help="Folder for traversals.jsonl (and, with VIDEO, timelines.csv, events.csv, "
+    "report.json / .md, plots/, cache/).",
 )
 def track_command(
     video,
@@ -251,6 +252,7 @@ def _track_video(
     from tsrkit.spatiotemporal.evaluate import evaluate_traversal, read_truth, temporal_section
     from tsrkit.spatiotemporal.ranges import frame_profile, frame_traversals
     from tsrkit.spatiotemporal.run import identity, track_video, video_facts
+    from tsrkit.spatiotemporal.study import write_study
 
     selection = build(*plugins)
     truth_frames = read_truth(truth) if truth else None
@@ -315,11 +317,12 @@ def _track_video(
                 report["temporal"] = temporal_section(evaluations)
             profile = frame_profile(track, signals, start, fps, count)
             written = write_track_run(out, report, records, profile, settings.vicinity).report
+            write_study(out, records, track, signals, video)
     _print_traversals(console, records, evaluations, count, total, elapsed)
     if out is not None:
         for note in written.get("notes", []):
             console.print(f"note: {note}", markup=False)
-        shown = ", ".join(["traversals.jsonl", *written["files"]])
+        shown = ", ".join(["traversals.jsonl", "timelines.csv", "events.csv", *written["files"]])
         console.print(f"-> {out}: {shown}, plots/", markup=False)
 
 

@@ -59,6 +59,14 @@ VERBS = {
         "RUN_DIR/compare.html (a compare folder) from the files the run left, without "
         "recomputing.",
     ),
+    "study": Verb(
+        "tsrkit.cli.study",
+        "study_command",
+        "Run `tsrkit track VIDEO --gps LOG --map MAP` on every drive of MANIFEST (CSV or YAML: "
+        "video, gps, map, optional name and start_utc) into OUT/drives/NAME/, skipping drives "
+        "finished before (a killed study resumes), then write the combined timelines.csv and "
+        "events.csv (a `drive` column first) and traversals.geojson into OUT.",
+    ),
     "track": Verb(
         "tsrkit.cli.track",
         "track_command",

@@ -31,8 +31,11 @@ from tsrkit.plugin.selection import Selection
 from tsrkit.runner.engine import MAX_CACHE_ENTRY, plugin_identity
 from tsrkit.runner.inputs import iter_video
 from tsrkit.spatiotemporal.clip import Clip
+from tsrkit.spatiotemporal.egomotion import image_motion
+from tsrkit.spatiotemporal.headpass import follow_head
 from tsrkit.spatiotemporal.passes import TOP_N, recognise
 from tsrkit.spatiotemporal.ranges import DOWNSTREAM_M, UPSTREAM_M, FrameTraversal, frame_traversals
+from tsrkit.spatiotemporal.timeline import controlling_tracks
 
 __all__ = [
     "RECORD_VERSION",
@@ -46,7 +49,7 @@ __all__ = [
 ]
 
 #: Bumped when a traversal's record changes meaning; part of the cache key.
-RECORD_VERSION = 2
+RECORD_VERSION = 3
 
 
 class VideoError(TsrkitError):
@@ -120,9 +123,17 @@ def identity(selection: Selection, settings: TrackSettings) -> str:
 def traversal_record(
     number: int, found: FrameTraversal, signals: Signals, clip: Clip, settings: TrackSettings
 ) -> dict[str, Any]:
-    """Run the passes on the clip and describe the traversal and its tracks."""
+    """Run the passes on the clip and describe the traversal, its tracks and, as ``heads``,
+    the tracks of the heads controlling the approach followed over the whole clip
+    (:func:`~tsrkit.spatiotemporal.timeline.controlling_tracks` until the anchor frame, then
+    :mod:`tsrkit.spatiotemporal.headpass`), and per frame the camera's image motion
+    (:func:`~tsrkit.spatiotemporal.egomotion.image_motion`, which dates stops)."""
     start = time.perf_counter()
     tracks, made = recognise(clip, found.upstream, found.downstream, settings.top, settings.slack)
+    height, width = clip.images[clip.first].shape[:2]
+    described = [t.to_json() for t in tracks]
+    chosen = {t["id"] for t in controlling_tracks(described, (width, height), found.anchor)}
+    heads = [follow_head(clip, t) for t in tracks if t.id in chosen]
     return {
         "traversal": number,
         **found.traversal.to_json(signals),
@@ -131,7 +142,9 @@ def traversal_record(
         "anchor_frame": found.anchor,
         "short_range": [found.upstream, found.downstream],
         "tracks_first_pass": made,
-        "tracks": [t.to_json() for t in tracks],
+        "tracks": described,
+        "heads": [t.to_json() for t in heads],
+        "image_motion": {str(k): round(v, 3) for k, v in image_motion(clip.images).items()},
         "calls": dict(clip.calls),
         "seconds": round(time.perf_counter() - start, 3),
     }

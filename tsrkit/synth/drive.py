@@ -8,11 +8,13 @@ What is simulated
     cruises, slows for turns and stops at the stop line for a red (or a yellow it can stop
     for). Every signalised intersection has two vertical three-lens heads per approach on a mast
     arm 12 m past the junction centre, 5.5 m high; the two phases (north-south and east-west)
-    cycle green, yellow, red on a known schedule with a per-intersection offset. Heads facing
-    the camera show their lit lens (``heads.render_head``); others show a dark housing. A box
-    truck overtakes in the next lane on every leg and occludes heads (depth-tested). The camera
-    adds pitch vibration, optical blur and sensor noise; the video is MPEG-4. The GPS log (CSV,
-    1 Hz) carries Gaussian position noise.
+    cycle green, yellow, red (and an optional all-red clearance) on a known schedule with a
+    per-intersection offset; on a chosen share of visits the driver ignores the signal and runs
+    the amber or red (``run_share``). Heads facing the camera show their lit lens
+    (``heads.render_head``); others show a dark housing. A box truck overtakes in the next lane
+    on every leg and occludes heads (depth-tested). The camera adds pitch vibration, optical
+    blur and sensor noise; the video is MPEG-4. The GPS log (CSV, 1 Hz) carries Gaussian
+    position noise.
 
 What is not simulated
     Lens distortion, rolling shutter, lighting other than day, heads seen at an angle (shown
@@ -76,6 +78,7 @@ __all__ = [
     "ground_colour",
     "junctions",
     "light_state",
+    "mark_runners",
     "osm_extract",
     "plan_drive",
     "plan_nodes",
@@ -114,6 +117,14 @@ class DriveOptions:
         ``signal_fraction`` of them signalised: the long drives of the benchmarks.
     light_offset : float or None
         Seconds into the signal cycle at time 0 for every intersection; None draws one each.
+    green_s, yellow_s, all_red_s : float
+        The signal timings: each phase shows green, then yellow (amber), then red; both phases
+        show red for ``all_red_s`` after each yellow (the all-red clearance interval; 0 keeps
+        the two-phase cycle ``2 * (green_s + yellow_s)``).
+    run_share : float
+        Share of the signalised traversals where the driver ignores the signal and keeps going
+        (through an amber or a red, whatever it shows); drawn from its own random stream, so
+        0 (the default) leaves every drive as it was.
     """
 
     width: int = 480
@@ -128,6 +139,8 @@ class DriveOptions:
     cruise: float = 12.0
     green_s: float = 10.0
     yellow_s: float = 3.0
+    all_red_s: float = 0.0
+    run_share: float = 0.0
     light_offset: float | None = None
     gps_noise_m: float = 1.0
     noise: float = 3.0
@@ -145,6 +158,10 @@ class DriveOptions:
         bad = [m for m in self.route if m not in MOVEMENTS]
         if bad or not (self.route or self.random_nodes):
             raise ValueError(f"route must be movements from {MOVEMENTS}; got {self.route!r}")
+        if min(self.green_s, self.yellow_s) <= 0 or self.all_red_s < 0:
+            raise ValueError("green_s and yellow_s must be > 0 and all_red_s >= 0")
+        if not 0 <= self.run_share <= 1:
+            raise ValueError(f"run_share must be in 0..1; got {self.run_share}")
         if self.block < 60:
             raise ValueError("block must be at least 60 m (signals merge within 50 m)")
 
@@ -153,10 +170,16 @@ class DriveOptions:
         """Focal length in pixels: a horizontal field of view of about 58 degrees."""
         return 0.9 * self.width
 
+    @property
+    def cycle(self) -> float:
+        """The signal cycle (s): two phases of green, yellow and all-red."""
+        return 2 * (self.green_s + self.yellow_s + self.all_red_s)
+
 
 @dataclass(frozen=True)
 class Node:
-    """A route intersection: grid indices, the direction driven in and out, the movement."""
+    """A route intersection: grid indices, the direction driven in and out, the movement;
+    ``runs`` when the driver ignores its signal on this visit."""
 
     i: int
     j: int
@@ -165,6 +188,7 @@ class Node:
     movement: str
     signalised: bool
     offset: float
+    runs: bool = False
 
 
 @dataclass
@@ -197,7 +221,7 @@ def plan_nodes(options: DriveOptions, rng: np.random.Generator) -> list[Node]:
         signals = (rng.random(len(moves)) < options.signal_fraction).tolist()
     else:
         moves, signals = list(options.route), [True] * len(options.route)
-    cycle = 2 * (options.green_s + options.yellow_s)
+    cycle = options.cycle
     nodes, i, j, heading = [], 0, 0, "N"
     seen: dict[tuple[int, int], tuple[bool, float]] = {}  # a revisit meets the same junction
     for move, signalised in zip(moves, signals):
@@ -212,6 +236,19 @@ def plan_nodes(options: DriveOptions, rng: np.random.Generator) -> list[Node]:
         di, dj = DIRECTIONS[out]
         i, j, heading = i + di, j + dj, out
     return nodes
+
+
+def mark_runners(options: DriveOptions, nodes: list[Node], seed: int) -> list[Node]:
+    """``nodes`` with ``runs`` set on about ``options.run_share`` of the signalised visits,
+    drawn from a stream of their own (the route's draws stay as they were)."""
+    if not options.run_share:
+        return nodes
+    rng = np.random.default_rng((seed, 3 << 20))
+    draws = rng.random(len(nodes))
+    return [
+        replace(node, runs=bool(node.signalised and draw < options.run_share))
+        for node, draw in zip(nodes, draws)
+    ]
 
 
 def _right(direction: str) -> np.ndarray:
@@ -273,17 +310,19 @@ def _segment(p: np.ndarray, q: np.ndarray) -> np.ndarray:
 
 def light_state(options: DriveOptions, node: Node, approach: str, t: float) -> str:
     """The state shown to traffic driving in direction ``approach`` at ``t`` seconds: the
-    north-south phase is green, yellow, then red while the east-west one is green and yellow."""
-    g, y = options.green_s, options.yellow_s
-    phase = (t + node.offset) % (2 * (g + y))
+    north-south phase is green, yellow, then red while the east-west one is green and yellow
+    (both red during the all-red intervals)."""
+    g, y, cycle = options.green_s, options.yellow_s, options.cycle
+    phase = (t + node.offset) % cycle
     if approach in "EW":
-        phase = (phase + g + y) % (2 * (g + y))
+        phase = (phase + cycle / 2) % cycle
     return "green" if phase < g else "yellow" if phase < g + y else "red"
 
 
 def drive_profile(options: DriveOptions, route: Route) -> tuple[np.ndarray, np.ndarray]:
     """Arc length and speed of the car at every frame: start at cruise speed, slow for turns,
-    stop for a red or for a yellow it can stop for at 3.5 m/s^2, pull away at 2 m/s^2."""
+    stop for a red or for a yellow it can stop for at 3.5 m/s^2 (unless the node ``runs``),
+    pull away at 2 m/s^2."""
     dt = 1.0 / options.fps
     s, v, t = 0.0, float(route.limit[0]), 0.0
     positions, speeds = [], []
@@ -296,6 +335,8 @@ def drive_profile(options: DriveOptions, route: Route) -> tuple[np.ndarray, np.n
             gap = stop - s
             if not 0 < gap < 60 or not math.isfinite(stop):
                 continue
+            if node.runs:
+                break
             state = light_state(options, node, node.into, t)
             if state == "red" or (state == "yellow" and v * v / (2 * gap) < 3.5):
                 allowed = min(allowed, math.sqrt(max(0.0, 6.0 * (gap - 0.5))))
@@ -680,7 +721,7 @@ def junctions(nodes: list[Node]) -> dict[Node, int]:
 def plan_drive(options: DriveOptions, seed: int = 0) -> Drive:
     """The route, the car's pose at every frame and the trucks (no rendering)."""
     rng = np.random.default_rng(seed)
-    nodes = plan_nodes(options, rng)
+    nodes = mark_runners(options, plan_nodes(options, rng), seed)
     route = build_route(options, nodes)
     s, speed = drive_profile(options, route)
     x, y = np.interp(s, route.s, route.x), np.interp(s, route.s, route.y)
@@ -845,8 +886,10 @@ def render_drive(
     out: str | os.PathLike, options: DriveOptions = DriveOptions(), seed: int = 0
 ) -> Path:
     """Write ``drive.mp4``, ``gps.csv``, ``map.osm``, ``truth.jsonl`` (per frame: time, pose
-    and lit lenses with state, centre, radius, box, in-frame status and unoccluded share) and
-    ``drive.json`` (:func:`summary`) into the folder ``out``; returns the folder.
+    and lit lenses with state, centre, radius, box, in-frame status and unoccluded share),
+    ``drive.json`` (:func:`summary`) and the true timelines and events of each traversal,
+    ``truth_timelines.csv`` and ``truth_events.csv`` (:mod:`tsrkit.synth.behaviour`), into the
+    folder ``out``; returns the folder.
 
     Deterministic by ``seed`` (the pixels up to the MPEG-4 encoder).
     """
@@ -874,4 +917,7 @@ def render_drive(
     with atomic_open(folder / "map.osm") as fh:
         fh.write(osm_extract(drive))
     write_json(folder / "drive.json", summary(drive), indent=1)
+    from tsrkit.synth.behaviour import write_truth  # it reads this module's drives
+
+    write_truth(drive, folder)
     return folder
