@@ -190,6 +190,7 @@ class Seen:
     grown: list | None = None
     load: object = None
     out: dict | None = None
+    kept: list | None = None
 
     def frame(self) -> Frame:
         """A frame of this size without pixels (what ``decide`` reads)."""
@@ -385,6 +386,38 @@ def fold_figures(model_path, params, family, seen, taiwan, synthetic, lamp) -> d
     return figures
 
 
+#: Cascade rules swept (threshold, prior) after the forest preset's verifier.
+CASCADE = tuple((t, p) for t in (0.1, 0.2, 0.3, 0.4, 0.5, 0.6) for p in (0.0, 0.3, 0.5))
+
+
+def forest_kept(forest, groups) -> None:
+    """What the forest preset's verifier keeps of every seen frame's candidates (on the
+    frame), stored as the frame's candidates of a cascade."""
+    for group in groups:
+        for s in group:
+            s.kept = forest.verify(s.load(), s.found) if s.found else []
+
+
+def cascade_figures(model_path, family, seen, taiwan, synthetic, lamp) -> dict:
+    """The fold's network confirming what the forest preset kept: figures at every rule of
+    :data:`CASCADE` (the housing the forest's stage fitted is kept)."""
+    network = tsrkit.verifier("cnn-verifier", model=str(model_path))
+    views = {}
+    for name, group in (("seen", seen), ("taiwan", taiwan), ("synthetic", synthetic)):
+        views[name] = [replace(s, found=s.kept, out=None) for s in group]
+        for v in views[name]:
+            v.out = network.outputs(v.load(), v.found) if v.found else None
+    sweep = {}
+    for t, p in CASCADE:
+        rule = tsrkit.verifier(
+            "cnn-verifier", model=str(model_path), threshold=t, prior=p, housing="stage"
+        )
+        row = evaluate(rule, views["seen"], family, lamp if (t, p) == (0.3, 0.0) else None)
+        row.update(false_lights(rule, views["taiwan"], views["synthetic"]))
+        sweep[f"t{t:g}_p{p:g}"] = row
+    return sweep
+
+
 def adapted_figures(
     model, crops: CropSet, path: Path, params, family, seen, taiwan, synthetic, lamp
 ) -> dict:
@@ -478,6 +511,9 @@ def main() -> None:
     parser.add_argument(
         "--evaluate", action="store_true", help="evaluate the folds' saved models (no training)"
     )
+    parser.add_argument(
+        "--cascade", action="store_true", help="the folds' networks after the forest verifier"
+    )
     parser.add_argument("--tables", metavar="RULE", help="print OUT's tables at RULE (tT_rR_pP)")
     parser.add_argument(
         "--baseline",
@@ -524,7 +560,7 @@ def main() -> None:
     lamp = tsrkit.classifier("lamp-state")
     results: dict = {}
     folds = [f for f in FAMILIES if not args.only or f.key in args.only]
-    if args.ship or args.baseline:
+    if args.ship or args.baseline or args.cascade:
         folds = []
     for family in folds:
         train = CropSet.concat(
@@ -573,6 +609,23 @@ def main() -> None:
         print(family.key, json.dumps(figures), file=sys.stderr)
         name = "folds_evaluated.json" if args.evaluate else "folds.json"
         (args.out / name).write_text(json.dumps(results, indent=1))
+    if args.cascade:
+        forest = tsrkit.select(config="recommended-forest").verifier
+        forest_kept(forest, [*seen.values(), taiwan, test_unlit])
+        cascades = {}
+        for family in FAMILIES:
+            if args.only and family.key not in args.only:
+                continue
+            cascades[family.key] = cascade_figures(
+                args.out / f"model_{family.key}",
+                family,
+                seen[family.key],
+                taiwan,
+                test_unlit,
+                lamp,
+            )
+            print("cascade", family.key, json.dumps(cascades[family.key]), file=sys.stderr)
+            (args.out / "cascade.json").write_text(json.dumps(cascades, indent=1))
     if args.baseline:
         baseline = tsrkit.select(config="recommended-forest").verifier
         rows = {}

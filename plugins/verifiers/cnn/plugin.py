@@ -51,10 +51,10 @@ from tsrkit_plugins.verifiers.unlit import no_light_frames
 DEFAULT_MODEL = Path(__file__).parent.parent / "models" / "cnn_verifier_default"
 #: What a model's card must say of its input for this plugin to read it.
 LAYOUT = {
-    "version": 2,
+    "version": 1,
     "input": [3, INPUT, INPUT],
     "channels": "BGR",
-    "normalisation": "per crop: v - channel mean, / max(crop std, 4)",
+    "normalisation": "(v / 255 - 0.5) / 0.25",
     "window_radii": CONTEXT,
     "states": list(STATE_NAMES),
 }
@@ -156,6 +156,22 @@ class CnnVerifier(Verifier):
             max=1.0,
             help="of kept candidates whose housing boxes overlap by more than this IoU, "
             "only the most probable stays (1: keep all)",
+        ),
+        Param(
+            "after",
+            "verifier",
+            "",
+            help="a verifier run on the candidates first (e.g. 'verifier': the forest "
+            "verifier with its housing stage), whose kept candidates the network then confirms "
+            "(their score is what prior blends in); '' for none",
+        ),
+        Param(
+            "housing",
+            "str",
+            "network",
+            choices=("network", "stage"),
+            help="the housing box a kept candidate reports: the network's, or the one the "
+            "'after' stage fitted where it fitted one (the network's elsewhere)",
         ),
         Param(
             "states",
@@ -298,6 +314,9 @@ class CnnVerifier(Verifier):
         return {"light": np.asarray(light, float), "box": frame_boxes, "state": np.asarray(state)}
 
     def verify(self, frame: Frame, candidates: Sequence[Candidate]) -> list[Candidate]:
+        part = self.params["after"]
+        if part is not None and candidates:
+            candidates = part.plugin.verify(frame, candidates)
         if not candidates:
             return []
         return self.decide(frame, candidates, self.outputs(frame, candidates))
@@ -314,6 +333,11 @@ class CnnVerifier(Verifier):
         score = (1.0 - prior) * np.nan_to_num(out["light"], nan=0.0) + prior * own
         keep = np.flatnonzero(passes(score, self.params["threshold"], self.params["relative"]))
         boxes = housings(out["box"][keep], [candidates[int(i)].bbox for i in keep], frame)
+        if self.params["housing"] == "stage":
+            for row, i in enumerate(keep):
+                fitted = candidates[int(i)].housing
+                if fitted is not None:
+                    boxes[row] = fitted
         chosen = suppress(boxes, score[keep], self.params["overlap"])
         kept = []
         for k in chosen:
