@@ -5,7 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from benchmark_fakes import OracleDetector, hand_dataset, make
+from click.testing import CliRunner
 
+from tsrkit.cli.main import cli
 from tsrkit.core.errors import TsrkitError
 from tsrkit.eval.lighting import ZHENG_CONDITIONS, ZHENG_RULE, frame_condition, zheng_condition
 from tsrkit.reporting.benchmarking import benchmark
@@ -71,3 +73,10 @@ def test_benchmark_lighting_zheng_names_zheng_conditions_and_states_the_rule():
     assert not any("lighting categories" in n for n in default.get("notes", []))
     with pytest.raises(TsrkitError, match="lighting must be one of"):
         benchmark(data, make(OracleDetector), cache=False, lighting="lux")
+
+
+def test_cli_refuses_an_unknown_lighting_scheme_in_one_line():
+    for verb in ("benchmark", "compare"):
+        result = CliRunner().invoke(cli, [verb, "--lighting", "lux"])
+        assert result.exit_code == 2
+        assert "'lux' is not one of 'mascetti', 'zheng'" in result.output
