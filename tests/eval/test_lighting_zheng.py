@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 from benchmark_fakes import OracleDetector, hand_dataset, make
@@ -9,8 +11,9 @@ from click.testing import CliRunner
 
 from tsrkit.cli.main import cli
 from tsrkit.core.errors import TsrkitError
+from tsrkit.core.types import Dataset
 from tsrkit.eval.lighting import ZHENG_CONDITIONS, ZHENG_RULE, frame_condition, zheng_condition
-from tsrkit.reporting.benchmarking import benchmark
+from tsrkit.reporting.benchmarking import benchmark, with_sun_elevation
 
 
 def frame(sky_bgr, ground_bgr, height=30, width=20):
@@ -80,3 +83,18 @@ def test_cli_refuses_an_unknown_lighting_scheme_in_one_line():
         result = CliRunner().invoke(cli, [verb, "--lighting", "lux"])
         assert result.exit_code == 2
         assert "'lux' is not one of 'mascetti', 'zheng'" in result.output
+
+
+def test_time_and_position_decide_the_period_in_a_benchmark():
+    data = hand_dataset(2)
+    noon, night = "2024-06-21T12:00:00Z", "2024-06-21T00:00:00Z"
+    samples = tuple(
+        dataclasses.replace(s, metadata={**s.metadata, "utc": utc, "lat": 0.0, "lon": 0.0})
+        for s, utc in zip(data.samples, (noon, night), strict=True)
+    )
+    report = benchmark(
+        Dataset("timed", samples), make(OracleDetector), cache=False, lighting="zheng"
+    )
+    # frame 0 is black (mean V 0), frame 1 a flat grey: the Sun, not the pixels, says day
+    assert {row["lighting"] for row in report["categories"]} == {"cloudy", "dark_unlit"}
+    assert with_sun_elevation(samples)[0].metadata["sun_elevation"] > 60

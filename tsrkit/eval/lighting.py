@@ -6,8 +6,9 @@ five conditions.
 categories (by default) and the TL-recognizer detector both use it.
 
 ``zheng_condition`` names Zheng 2016's five conditions (Figure 4-2: sunny, cloudy, dawn/dusk,
-dark lit, dark unlit) from the solar elevation when the caller knows it (time and position,
-:func:`tsrkit.sun.geometry.sun_position`), else from image statistics alone; ``ZHENG_RULE``
+dark lit, dark unlit) from the solar elevation when the caller knows it (a sample's ``utc``,
+``lat`` and ``lon``: :func:`tsrkit.sun.relative.sun_elevation`, which the benchmark applies),
+else from image statistics alone; ``ZHENG_RULE``
 states the thresholds. ``frame_condition`` picks the scheme (``--lighting mascetti|zheng``).
 """
 
@@ -154,7 +155,7 @@ def zheng_condition(image_bgr: np.ndarray, sun_elevation: float | None = None) -
     image_bgr : ndarray of shape (H, W, 3), uint8
     sun_elevation : float, optional
         Solar elevation in degrees at the frame's time and position
-        (:func:`tsrkit.sun.geometry.sun_position`); None when unknown.
+        (:func:`tsrkit.sun.relative.sun_elevation`); None when unknown.
 
     Returns
     -------

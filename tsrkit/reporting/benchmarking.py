@@ -14,6 +14,7 @@ them after the metrics are computed.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import functools
 import json
 import os
@@ -28,7 +29,7 @@ import numpy as np
 
 from tsrkit.core.outputs import refuse_input
 from tsrkit.core.records import FrameRecord
-from tsrkit.core.types import Dataset
+from tsrkit.core.types import Dataset, Sample
 from tsrkit.eval.guard import Failure, GuardedMetrics
 from tsrkit.eval.runfacts import run_facts
 from tsrkit.eval.settings import EvalSettings, eval_settings, lighting_note, not_exhaustive_note
@@ -238,7 +239,8 @@ def run_benchmark(
         refuse_foreign_report(Path(out))
     lock = locked(out) if out is not None else contextlib.nullcontext()
     with lock, ProgressBar(len(dataset), progress, label) as bar:
-        records = bar.track(run_records(dataset.samples, job, workers, engine, scheduler))
+        samples = with_sun_elevation(dataset.samples) if lighting == "zheng" else dataset.samples
+        records = bar.track(run_records(samples, job, workers, engine, scheduler))
         return evaluate(
             dataset,
             records,
@@ -248,6 +250,24 @@ def run_benchmark(
             writers=writers,
             run_info={"workers": workers, "engine": engine},
         )
+
+
+def with_sun_elevation(samples: Sequence[Sample]) -> list[Sample]:
+    """The samples, each with ``sun_elevation`` in its metadata when its time and position are
+    known (``utc``, ``lat``, ``lon``: :func:`tsrkit.sun.relative.sun_elevation`) and it has none
+    yet, for Zheng's lighting conditions (:func:`tsrkit.eval.lighting.zheng_condition`)."""
+    # only runs with --lighting zheng pay for the solar geometry's imports (pyproj)
+    from tsrkit.sun.relative import sun_elevation
+
+    out = []
+    for sample in samples:
+        elevation = None if "sun_elevation" in sample.metadata else sun_elevation(sample.metadata)
+        if elevation is not None:
+            sample = dataclasses.replace(
+                sample, metadata={**sample.metadata, "sun_elevation": elevation}
+            )
+        out.append(sample)
+    return out
 
 
 def benchmark(
