@@ -4,6 +4,15 @@ The white top-hat (image minus its morphological opening) of the grayscale frame
 small bright spots; Zheng's localization (3.2.2, ``localization.py``) then extracts candidates
 from it exactly as from a conspicuity map. The top-hat has no radius map, so each component's
 DRMShift window keeps the radius of the disk with the component's area.
+
+Structuring element. Zheng (5.2.2) gives no size; de Charette & Nashashibi, whom he follows,
+used 11x11. The opening removes bright spots narrower than the element, so the top-hat keeps
+only lenses up to about ``se_size`` across: 11 px loses Zheng's largest lenses (radius 9, 19 px
+across), 21 px keeps them. Measured (``tsrkit benchmark -d gray-tophat -p se_size=N``, per-frame
+recall / precision / hit, Zheng 5.2.1): bundled sample (lens radius 1.5-9) 0.220 / 0.103 / 0.417
+at 11 against 0.405 / 0.224 / 0.604 at 21; ``roboflow_cinta_v2_id`` 0.366 / 0.239 / 0.393 against
+0.396 / 0.278 / 0.423; ``roboflow_traffic_light_kr`` 0 at both. So the default is 21 px
+(``benchmarks/PAPERS.md``).
 """
 
 from __future__ import annotations
@@ -43,7 +52,7 @@ class GrayTophat(Detector):
             21,
             min=3,
             max=201,
-            section="5.2.2 (size not given; ours)",
+            section="5.2.2 (size not given; de Charette's 11 measured worse: module docstring)",
             help="structuring-element diameter in pixels; wider than the largest lens",
         ),
         ROI_PARAM,

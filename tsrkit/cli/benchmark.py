@@ -18,6 +18,7 @@ from tsrkit.cli.completion import dataset_names, plugin_list, plugin_names, pres
 from tsrkit.cli.errors import UserError
 from tsrkit.core.outputs import reading
 from tsrkit.datasets.concat import dataset_inputs
+from tsrkit.eval.lighting import LIGHTING_SCHEMES
 from tsrkit.eval.settings import BOX_OPTIONS
 from tsrkit.plugin.selection import build, build_compare
 from tsrkit.reporting.report import print_table
@@ -74,7 +75,7 @@ def dataset_options(func):
 
 def run_options(func):
     """``--workers``, ``--engine``, ``--scheduler``, ``--out``, ``--no-cache``, ``--iou``,
-    ``--quiet``, ``--eval-box``, ``--writer``, ``--no-plots``."""
+    ``--quiet``, ``--eval-box``, ``--writer``, ``--no-plots``, ``--lighting``."""
     options = [
         click.option(
             "--workers",
@@ -132,6 +133,15 @@ def run_options(func):
             is_flag=True,
             help="Write no plot files (skips the plots writer; report.html still embeds them).",
         ),
+        click.option(
+            "--lighting",
+            type=click.Choice(LIGHTING_SCHEMES),
+            default=LIGHTING_SCHEMES[0],
+            show_default=True,
+            help="Lighting categories of the lighting x size table: Mascetti's four mean-V "
+            "classes (Table 4) or Zheng's five conditions (Figure 4-2: sunny, cloudy, "
+            "dawn_dusk, dark_lit, dark_unlit).",
+        ),
     ]
     for option in reversed(options):
         func = option(func)
@@ -162,7 +172,16 @@ def check_engine(engine: str, scheduler: str | None) -> None:
 
 
 def _run_kwargs(
-    workers, engine, scheduler, no_cache, iou_threshold, quiet, eval_box, writers, no_plots
+    workers,
+    engine,
+    scheduler,
+    no_cache,
+    iou_threshold,
+    quiet,
+    eval_box,
+    writers,
+    no_plots,
+    lighting,
 ) -> dict:
     if no_plots:
         writers = [name for name in writers or default_writers() if name != "plots"]
@@ -175,6 +194,7 @@ def _run_kwargs(
         "progress": not quiet,
         "box": eval_box,
         "writers": list(writers) or None,
+        "lighting": lighting,
     }
 
 
@@ -220,6 +240,7 @@ def benchmark_command(
     eval_box,
     writers,
     no_plots,
+    lighting,
 ) -> None:
     """Run a detector (and classifier) over a dataset and write an evaluated report.
 
@@ -268,6 +289,7 @@ def benchmark_command(
                 eval_box,
                 writers,
                 no_plots,
+                lighting,
             ),
         )
     print_table([report])
@@ -362,6 +384,7 @@ def compare_command(
     eval_box,
     writers,
     no_plots,
+    lighting,
     configs,
     html,
 ) -> None:
@@ -397,7 +420,16 @@ def compare_command(
         raise click.UsageError(f"--configs names whole pipelines; {given[0]} goes with it")
     start_pool_early(workers, engine)
     run = _run_kwargs(
-        workers, engine, scheduler, no_cache, iou_threshold, quiet, eval_box, writers, no_plots
+        workers,
+        engine,
+        scheduler,
+        no_cache,
+        iou_threshold,
+        quiet,
+        eval_box,
+        writers,
+        no_plots,
+        lighting,
     )
     if configs is not None:
         compare_configs(dataset_ref, format_name, images, split, configs, params, out, run)

@@ -63,14 +63,16 @@ def _write_jsonl(path: Path, records) -> None:
     "gps",
     required=True,
     type=click.Path(dir_okay=False),
-    help="GPS log (CSV time,lat,lon or 'dd-Mon-yyyy hh:mm:ss lat lon' lines).",
+    help="GPS log: CSV with a time,lat,lon header, 'dd-Mon-yyyy hh:mm:ss lat lon' lines, GPX "
+    "(.gpx) or NMEA 0183 (.nmea: RMC and GGA sentences); by extension, else by content.",
 )
 @click.option(
     "--map",
     "osm",
     required=True,
     type=click.Path(dir_okay=False),
-    help="OpenStreetMap extract (.osm or .osm.gz).",
+    help="Signal map: OpenStreetMap XML (.osm, .osm.gz), an .osm.pbf extract (needs "
+    "pyosmium) or GeoJSON signal points (.geojson, .json); by extension.",
 )
 @click.option(
     "--vicinity",

@@ -1,6 +1,7 @@
 """Zheng 2016, Table 5-2 and Figure 5-1: frames grouped by lighting and by max target radius.
 
-Each ground-truth frame falls into one lighting condition (labelled, or Mascetti 3.2's mean V)
+Each ground-truth frame falls into one lighting condition (labelled, else Mascetti 3.2's mean V
+or, with ``--lighting zheng``, Zheng's Figure 4-2 conditions: :mod:`tsrkit.eval.lighting`)
 and one maximum target radius; a row counts its frames by recall label and precision bound.
 """
 

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from tsrkit.core.errors import TsrkitError
+from tsrkit.eval.lighting import LIGHTING_SCHEMES, ZHENG_RULE
 
 if TYPE_CHECKING:
     from tsrkit.core.types import Dataset
@@ -20,6 +21,7 @@ __all__ = [
     "NOT_DETECTION",
     "EvalSettings",
     "eval_settings",
+    "lighting_note",
     "not_exhaustive_note",
     "resolve_box",
 ]
@@ -44,6 +46,8 @@ class EvalSettings:
         False when the dataset does not box every light: false positives are not meaningful.
     detection : bool
         False for a classifier alone on the ground-truth boxes (detection metrics do not apply).
+    lighting : {"mascetti", "zheng"}
+        The lighting categories' scheme (:func:`tsrkit.eval.lighting.frame_condition`).
     """
 
     dataset: str = ""
@@ -51,6 +55,7 @@ class EvalSettings:
     box: str = "lens"
     exhaustive: bool = True
     detection: bool = True
+    lighting: str = "mascetti"
 
     def false_positive_figure(self, value: float | None) -> float | None:
         """``value`` on an exhaustively labelled dataset, else None (not meaningful)."""
@@ -83,6 +88,12 @@ def not_exhaustive_note(dataset: str) -> str:
     )
 
 
+def lighting_note(settings: EvalSettings) -> list[str]:
+    """The report's note stating the lighting rule: none for the default (Mascetti's Table 4,
+    so reference reports stay as they were), the rule for Zheng's conditions."""
+    return ["lighting categories: " + ZHENG_RULE] if settings.lighting == "zheng" else []
+
+
 #: What replaces a detection section in a classifier-only (crop) report.
 NOT_DETECTION = {
     "note": "classifier alone on the ground-truth boxes: detection metrics do not apply"
@@ -90,14 +101,24 @@ NOT_DETECTION = {
 
 
 def eval_settings(
-    dataset: Dataset, detection: bool = True, iou_threshold: float = 0.5, box: str = "auto"
+    dataset: Dataset,
+    detection: bool = True,
+    iou_threshold: float = 0.5,
+    box: str = "auto",
+    lighting: str = "mascetti",
 ) -> EvalSettings:
     """The evaluation settings of ``dataset``: the box (``auto`` follows its registry ``box``
-    convention) and whether it is exhaustively labelled (registry ``exhaustive``)."""
+    convention), whether it is exhaustively labelled (registry ``exhaustive``) and the
+    lighting scheme."""
+    if lighting not in LIGHTING_SCHEMES:
+        raise TsrkitError(
+            f"lighting must be one of {', '.join(LIGHTING_SCHEMES)}; got '{lighting}'"
+        )
     return EvalSettings(
         dataset.name,
         iou_threshold,
         resolve_box(box, dataset.info),
         dataset.info.get("exhaustive", True) is not False,
         detection,
+        lighting,
     )

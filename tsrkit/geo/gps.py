@@ -18,7 +18,7 @@ from tsrkit.geo.errors import GeoError, read_text
 from tsrkit.geo.gpx import gpx_rows
 from tsrkit.geo.nmea import nmea_rows
 
-__all__ = ["MAX_SPEED", "MIN_JUMP_M", "Rows", "Track", "log_format", "read_track"]
+__all__ = ["LOG_FORMATS", "MAX_SPEED", "MIN_JUMP_M", "Rows", "Track", "log_format", "read_track"]
 
 #: The fastest a logged vehicle moves between two fixes, m/s (324 km/h, past any road vehicle):
 #: a faster step is a receiver glitch or a jump between two logs, never a drive.
@@ -90,6 +90,8 @@ Rows = list[tuple[int | str, float, float, float]]
 EARLIEST, LATEST = 0.0, 253402300799.0
 
 #: Log formats by file extension; other extensions are told apart by their first character.
+#: Every format :func:`log_format` answers (``tsrkit track --gps`` names each in its help).
+LOG_FORMATS = ("csv", "gpx", "nmea", "whitespace")
 _BY_SUFFIX = {".csv": "csv", ".gpx": "gpx", ".nmea": "nmea", ".nma": "nmea", ".nme": "nmea"}
 
 

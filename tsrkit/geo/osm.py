@@ -26,7 +26,7 @@ from tsrkit.geo.geojson import geojson_nodes
 from tsrkit.geo.osm_pbf import SIGNAL_TAGS, pbf_nodes
 from tsrkit.geo.projection import LocalProjection
 
-__all__ = ["MERGE_M", "Signals", "map_format", "read_signals"]
+__all__ = ["MAP_FORMATS", "MERGE_M", "Signals", "map_format", "read_signals"]
 
 #: Signal nodes closer than this (metres) belong to one intersection.
 MERGE_M = 50.0
@@ -82,6 +82,10 @@ def _xml_nodes(path: Path) -> list[tuple[int, float, float, dict[str, str], str]
             ) from None
         nodes.append((ident, lat, lon, tags, f"node {ident}"))
     return nodes
+
+
+#: Every format :func:`map_format` answers (``tsrkit track --map`` names each in its help).
+MAP_FORMATS = ("xml", "pbf", "geojson")
 
 
 def map_format(path: Path) -> str:

@@ -14,6 +14,7 @@ them after the metrics are computed.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import functools
 import json
 import os
@@ -28,10 +29,10 @@ import numpy as np
 
 from tsrkit.core.outputs import refuse_input
 from tsrkit.core.records import FrameRecord
-from tsrkit.core.types import Dataset
+from tsrkit.core.types import Dataset, Sample
 from tsrkit.eval.guard import Failure, GuardedMetrics
 from tsrkit.eval.runfacts import run_facts
-from tsrkit.eval.settings import EvalSettings, eval_settings, not_exhaustive_note
+from tsrkit.eval.settings import EvalSettings, eval_settings, lighting_note, not_exhaustive_note
 from tsrkit.plugin.base import Classifier, Detector, Verifier
 from tsrkit.plugin.registry import get_registry
 from tsrkit.reporting.report import REPORT_KEYS, ProgressBar, RunResult, build_report, ordered
@@ -138,6 +139,7 @@ def evaluate(
         "frames_cached": cached,
     }
     notes = [] if settings.exhaustive else [not_exhaustive_note(dataset.name)]
+    notes += lighting_note(settings)
     counted = sections.get("frame_notes", {}).get("counts", {})
     notes += [f"{n} of {len(kept)} frames: {text}" for text, n in counted.items()]
     if resized:
@@ -211,29 +213,34 @@ def run_benchmark(
     iou_threshold: float = 0.5,
     box: str = "auto",
     writers: Sequence[str] | None = None,
+    lighting: str = "mascetti",
 ) -> RunResult:
     """:func:`benchmark`, returning the whole :class:`~tsrkit.reporting.report.RunResult` (records
     too)."""
     if detector is None and classifier is None:
         raise BenchmarkError("a benchmark needs a detector, a classifier, or both")
-    settings = eval_settings(dataset, detector is not None, iou_threshold, box)
+    settings = eval_settings(dataset, detector is not None, iou_threshold, box, lighting)
     plugins = {"detector": plugin_identity(detector), "classifier": plugin_identity(classifier)}
     if verifier is not None:
         plugins["verifier"] = plugin_identity(verifier)
     folder = (Path(cache_dir) if cache_dir else default_cache_dir(out)) if cache else None
+    # the default scheme keeps the cache keys (and every cached record) of earlier runs
+    scheme = "" if lighting == "mascetti" else f" lighting={lighting}"
     job = Job(
         detector,
         classifier,
-        json.dumps(plugins, sort_keys=True),
+        json.dumps(plugins, sort_keys=True) + scheme,
         str(folder) if folder else None,
         verifier,
+        lighting,
     )
     label = (detector or classifier).name  # type: ignore[union-attr]
     if out is not None:
         refuse_foreign_report(Path(out))
     lock = locked(out) if out is not None else contextlib.nullcontext()
     with lock, ProgressBar(len(dataset), progress, label) as bar:
-        records = bar.track(run_records(dataset.samples, job, workers, engine, scheduler))
+        samples = with_sun_elevation(dataset.samples) if lighting == "zheng" else dataset.samples
+        records = bar.track(run_records(samples, job, workers, engine, scheduler))
         return evaluate(
             dataset,
             records,
@@ -243,6 +250,24 @@ def run_benchmark(
             writers=writers,
             run_info={"workers": workers, "engine": engine},
         )
+
+
+def with_sun_elevation(samples: Sequence[Sample]) -> list[Sample]:
+    """The samples, each with ``sun_elevation`` in its metadata when its time and position are
+    known (``utc``, ``lat``, ``lon``: :func:`tsrkit.sun.relative.sun_elevation`) and it has none
+    yet, for Zheng's lighting conditions (:func:`tsrkit.eval.lighting.zheng_condition`)."""
+    # only runs with --lighting zheng pay for the solar geometry's imports (pyproj)
+    from tsrkit.sun.relative import sun_elevation
+
+    out = []
+    for sample in samples:
+        elevation = None if "sun_elevation" in sample.metadata else sun_elevation(sample.metadata)
+        if elevation is not None:
+            sample = dataclasses.replace(
+                sample, metadata={**sample.metadata, "sun_elevation": elevation}
+            )
+        out.append(sample)
+    return out
 
 
 def benchmark(
@@ -282,5 +307,9 @@ def benchmark(
         ``report.json`` says which in ``evaluated_box``.
     writers : sequence of str, optional
         Report writers by name (default: the registered default writers).
+    lighting : {"mascetti", "zheng"}
+        Lighting categories of the lighting x size table (Zheng 5.2.1, Table 5-2): Mascetti
+        3.2's mean-V classes (default) or Zheng's Figure 4-2 conditions
+        (:func:`tsrkit.eval.lighting.zheng_condition`; the report's notes state the rule).
     """
     return run_benchmark(dataset, detector, classifier, **options).report

@@ -33,7 +33,7 @@ from tsrkit.core.files import InputFileError, read_json
 from tsrkit.core.images import ImageReadError
 from tsrkit.core.records import FrameRecord
 from tsrkit.core.types import Candidate, Frame, Sample
-from tsrkit.eval.lighting import light_condition
+from tsrkit.eval.lighting import frame_condition
 from tsrkit.plugin.base import Classifier, Detector, Plugin, Verifier
 from tsrkit.plugin.pipeline import FrameResult, Pipeline
 from tsrkit.plugin.registry import PluginNotFound, get_registry
@@ -78,6 +78,7 @@ class Job:
     identity: str
     cache_dir: str | None
     verifier: Verifier | None = None
+    lighting: str = "mascetti"
 
 
 def plugin_identity(plugin: Plugin | None) -> dict[str, Any] | None:
@@ -159,7 +160,9 @@ def compute_record(index: int, sample: Sample, job: Job) -> FrameRecord:
         frame = sample.load()
     except ImageReadError as exc:
         return FrameRecord(sample.source, index, skipped=str(exc))
-    lighting = sample.metadata.get("lighting") or light_condition(frame.image)
+    lighting = sample.metadata.get("lighting") or frame_condition(
+        frame.image, job.lighting, sample.metadata.get("sun_elevation")
+    )
     try:
         if job.detector is not None:
             result = Pipeline(job.detector, job.classifier, verifier=job.verifier).process(frame)

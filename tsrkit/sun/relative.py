@@ -33,6 +33,7 @@ __all__ = [
     "bearing",
     "frame_facts",
     "relative_azimuth",
+    "sun_elevation",
     "sun_view",
     "track_facts",
     "utc_seconds",
@@ -134,6 +135,30 @@ def sun_view(facts: Mapping[str, Any]) -> SunView | None:
         return None
     azimuth, elevation = sun_position(utc_seconds(facts["utc"]), lat, lon)
     return SunView(float(relative_azimuth(azimuth, heading)), float(azimuth), float(elevation))
+
+
+def sun_elevation(facts: Mapping[str, Any]) -> float | None:
+    """The Sun's elevation in degrees at one frame's time and position (keys ``utc``, ``lat``,
+    ``lon`` of :data:`KEYS`; no heading needed), or None when one is missing. Zheng's lighting
+    conditions read it (:func:`tsrkit.eval.lighting.zheng_condition`).
+
+    Raises
+    ------
+    SunMetadataError
+        When a fact is present but malformed.
+
+    Examples
+    --------
+    >>> round(sun_elevation({"utc": "2024-06-21T12:00:00Z", "lat": 0.0, "lon": 0.0}))
+    67
+    >>> sun_elevation({"lat": 0.0, "lon": 0.0}) is None
+    True
+    """
+    lat = _angle(facts, "lat", -90.0, 90.0)
+    lon = _angle(facts, "lon", -180.0, 180.0)
+    if facts.get("utc") is None or lat is None or lon is None:
+        return None
+    return float(sun_position(utc_seconds(facts["utc"]), lat, lon)[1])
 
 
 def track_facts(track: Track, utc: float, span_s: float = 1.0) -> dict[str, float]:
