@@ -63,7 +63,7 @@ def test_lights_are_followed_between_key_frames_and_new_ones_wait_for_the_next()
     whole = [shape for shape in detector.searched if shape == (120, 160)]
     assert len(whole) == 3 and follower.calls["key"] == 3  # frames 0, 4, 8
     assert follower.calls["followed"] == 9
-    assert follower.calls["regions"] == 9  # one crop on each followed frame
+    assert follower.calls["regions"] == 18  # a window around each disc on each followed frame
 
 
 def test_another_video_or_a_jump_back_starts_with_a_key_frame():
