@@ -104,20 +104,6 @@ def test_a_follower_refuses_a_tracker_and_bad_settings():
         Follower(Pipeline(RedDiscs()), key_every=0)
 
 
-def test_a_light_missed_for_a_frame_is_still_followed_until_the_next_key_frame():
-    """A disc hidden on frame 1 is not reported there, and is found again on frame 2 where its
-    last step carries it, without a key frame."""
-    images = drive(4)
-    hidden = images[1].image.copy()
-    cv2.circle(hidden, (32, 31), 6, (0, 0, 0), -1)
-    images[1] = Frame(hidden, "drive.mp4", 1)
-    follower = Follower(Pipeline(RedDiscs()), key_every=4)
-    followed = [centres(follower.process(f)) for f in images]
-    assert followed[1] == [(102, 41)]
-    assert followed[2] == [(34, 32), (104, 42)]
-    assert follower.calls["key"] == 1
-
-
 def test_overlapping_windows_are_searched_as_one():
     assert windows([(0, 0, 10, 10), (30, 0, 40, 10), (10, 5, 20, 20)]) == [
         (0, 0, 20, 20),

@@ -224,9 +224,9 @@ def default_inputs() -> list[str]:
     default=1,
     show_default=True,
     help="Videos: the whole pipeline on every K-th kept frame only; in between, the same "
-    "detector and verifier in a window around each light found (one missed for a frame is "
-    "still searched until the next key frame; a light appearing meanwhile is found at most "
-    "K-1 frames late). 1: the whole pipeline on every frame.",
+    "detector and verifier in a window around each light of the frame before (a light "
+    "appearing meanwhile is found at most K-1 frames late). 1: the whole pipeline on every "
+    "frame.",
 )
 @click.option(
     "--agree",

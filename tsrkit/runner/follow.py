@@ -10,10 +10,10 @@ detector and the housing fit need around a lens (:func:`region`); windows that o
 searched as one (:func:`windows`). The detector sees each window as a window of the frame
 (``metadata["window"]``, :data:`WINDOW`), so a rule about the frame's rows (the union's band
 above the horizon) holds as on the whole frame. Each detection is matched to the nearest light
-within reach, closest pairs first. A light not found on a frame is not reported there but is
-still followed, along its last step, until the next key frame (a lens hidden or blurred for one
-frame comes back); a light that appears between key frames is found at the next key frame, at
-most ``key_every - 1`` frames late.
+within reach, closest pairs first. A light not found on a frame is dropped (following it on,
+along its last step, until the next key frame found no more lights and more false ones:
+``benchmarks/RESULTS.video.md``); a light that appears between key frames is found at the next
+key frame, at most ``key_every - 1`` frames late.
 
 Each key frame starts afresh (no light carried into it), so a run of frames after a key frame
 depends on that run alone: a video cut into chunks of a multiple of ``key_every`` frames gives
@@ -66,11 +66,6 @@ class Light:
         """Where the light's last step carries it on the next frame."""
         return self.x + self.dx, self.y + self.dy
 
-    def carried(self) -> Light:
-        """The light not found on the next frame, assumed where its last step carries it."""
-        x, y = self.predicted()
-        return replace(self, x=x, y=y)
-
     def moved_to(self, candidate: Candidate) -> Light:
         """The light found at ``candidate`` on the next frame."""
         moved = light_of(candidate)
@@ -105,7 +100,10 @@ def shifted(candidate: Candidate, dx: float, dy: float) -> Candidate:
     return replace(c, x=c.x + dx, y=c.y + dy, bbox=move(c.bbox), housing=move(c.housing))
 
 
-def windows(boxes: list[tuple[int, int, int, int]]) -> list[tuple[int, int, int, int]]:
+Box = tuple[int, int, int, int]
+
+
+def windows(boxes: list[Box]) -> list[Box]:
     """``boxes`` with every group of boxes that overlap (or touch) replaced by the box holding
     the group, in sorted order.
 
@@ -115,7 +113,8 @@ def windows(boxes: list[tuple[int, int, int, int]]) -> list[tuple[int, int, int,
     merged = sorted(boxes)
     changed = True
     while changed:
-        changed, out = False, []
+        changed = False
+        out: list[Box] = []
         for box in merged:
             for k, o in enumerate(out):
                 if box[0] <= o[2] and o[0] <= box[2] and box[1] <= o[3] and o[1] <= box[3]:
@@ -192,11 +191,10 @@ class Follower:
                 and k not in found.values()
             ):
                 found[j] = k
-        self._lights = [
-            light.moved_to(result.detections[found[j]].candidate) if j in found else light.carried()
-            for j, light in enumerate(self._lights)
-        ]
         detections = tuple(result.detections[k] for _, k in sorted(found.items()))
+        self._lights = [
+            self._lights[j].moved_to(d.candidate) for j, d in zip(sorted(found), detections)
+        ]
         ms = (time.perf_counter() - start) * 1000.0
         return replace(result, ms=ms, detections=detections)
 
