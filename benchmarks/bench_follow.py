@@ -66,7 +66,7 @@ def run(frames: list[Frame], follower: Follower) -> tuple[list, float]:
     return results, cpu
 
 
-def gradable(light: dict) -> bool:
+def is_gradable(light: dict) -> bool:
     """Whether ``light`` (one of ``truth.jsonl``'s) counts for recall (see the module notes)."""
     return (
         light["status"] == "in"
@@ -84,7 +84,7 @@ def ceiling(runs: list[tuple[list, list[dict]]], k: int) -> float:
         hit = []
         for result, record in zip(results, truth, strict=True):
             centres = [[d.candidate.x, d.candidate.y] for d in result.detections]
-            lights = [light for light in record["lights"] if gradable(light)]
+            lights = [light for light in record["lights"] if is_gradable(light)]
             boxes = [light["bbox"] for light in lights]
             found = centre_hits(centres, boxes).any(axis=0) if centres and boxes else []
             hit.append({light["id"]: bool(f) for light, f in zip(lights, found)})
@@ -104,7 +104,7 @@ def score(results, truth: list[dict]) -> dict[str, float]:
         boxes = [light["bbox"] for light in lights]
         matrix = centre_hits(centres, boxes) if centres and boxes else None
         for j, light in enumerate(lights):
-            if not gradable(light):
+            if not is_gradable(light):
                 continue
             gradable += 1
             hitting = [i for i in range(len(centres)) if matrix is not None and matrix[i, j]]
