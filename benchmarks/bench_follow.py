@@ -76,9 +76,10 @@ def is_gradable(light: dict) -> bool:
 
 
 def ceiling(runs: list[tuple[list, list[dict]]], k: int) -> float:
-    """The best light recall following can reach at key frames every ``k``, from every-frame
-    ``(results, truth)`` of each drive: a gradable light counts on frame t when it is hit there
-    and on the key frame ``t - t % k`` (following finds only what a key frame found)."""
+    """An estimate of the best light recall following can reach at key frames every ``k``, from
+    every-frame ``(results, truth)`` of each drive: a gradable light counts on frame t when it is
+    hit there and on the key frame ``t - t % k`` (following finds what a key frame found, and a
+    light that a window around a neighbouring followed light holds, which this leaves out)."""
     got = total = 0
     for results, truth in runs:
         hit = []
