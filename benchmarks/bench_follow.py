@@ -66,6 +66,36 @@ def run(frames: list[Frame], follower: Follower) -> tuple[list, float]:
     return results, cpu
 
 
+def is_gradable(light: dict) -> bool:
+    """Whether ``light`` (one of ``truth.jsonl``'s) counts for recall (see the module notes)."""
+    return (
+        light["status"] == "in"
+        and light["visible"] >= MIN_VISIBLE
+        and light["radius"] >= MIN_RADIUS
+    )
+
+
+def ceiling(runs: list[tuple[list, list[dict]]], k: int) -> float:
+    """An estimate of the best light recall following can reach at key frames every ``k``, from
+    every-frame ``(results, truth)`` of each drive: a gradable light counts on frame t when it is
+    hit there and on the key frame ``t - t % k`` (following finds what a key frame found, and a
+    light that a window around a neighbouring followed light holds, which this leaves out)."""
+    got = total = 0
+    for results, truth in runs:
+        hit = []
+        for result, record in zip(results, truth, strict=True):
+            centres = [[d.candidate.x, d.candidate.y] for d in result.detections]
+            lights = [light for light in record["lights"] if is_gradable(light)]
+            boxes = [light["bbox"] for light in lights]
+            found = centre_hits(centres, boxes).any(axis=0) if centres and boxes else []
+            hit.append({light["id"]: bool(f) for light, f in zip(lights, found)})
+            total += len(lights)
+        got += sum(
+            ok and hit[t - t % k].get(i, False) for t in range(len(hit)) for i, ok in hit[t].items()
+        )
+    return got / max(total, 1)
+
+
 def score(results, truth: list[dict]) -> dict[str, float]:
     """Light recall, state accuracy and false lights per frame (see the module notes)."""
     gradable = hits = correct = false = 0
@@ -75,11 +105,7 @@ def score(results, truth: list[dict]) -> dict[str, float]:
         boxes = [light["bbox"] for light in lights]
         matrix = centre_hits(centres, boxes) if centres and boxes else None
         for j, light in enumerate(lights):
-            if not (
-                light["status"] == "in"
-                and light["visible"] >= MIN_VISIBLE
-                and light["radius"] >= MIN_RADIUS
-            ):
+            if not is_gradable(light):
                 continue
             gradable += 1
             hitting = [i for i in range(len(centres)) if matrix is not None and matrix[i, j]]
@@ -117,7 +143,7 @@ def main() -> None:
           "| false lights / frame | key / followed frames | regions |")  # fmt: skip
     print("|---|---:|---:|---:|---:|---:|---:|---:|---|---:|")
     for config in args.config.split(","):
-        base = None
+        base, every = None, None
         for k in keys:
             cpu, per_drive = 0.0, []
             calls = {"key": 0, "followed": 0, "regions": 0}
@@ -143,6 +169,15 @@ def main() -> None:
                     f"| {calls['regions']} |",
                     flush=True,
                 )
+            if k == 1:
+                every = per_drive
+        if every is not None:
+            ceilings = [ceiling(every, k) for k in keys]
+            print(
+                f"\n{config}: ceiling of light recall by K (a light hit on its frame and on the key"
+                " frame before, from K 1's results): "
+                + ", ".join(f"K {k} {c:.3f}" for k, c in zip(keys, ceilings))
+            )
 
 
 if __name__ == "__main__":

@@ -50,7 +50,9 @@ sizes a member was built for). Two keys belong to the union, not to the member:
 e.g. ``lab-frst top=15 scale=2 scale_top=0.6``. Centres map back with the pixel-centre
 convention ``x = (x' + 0.5) / s - 0.5`` (``s`` the exact per-axis factor), radii as
 ``r' / s``. The same detector may then appear twice, at two scales. Frame metadata passes
-unchanged (a member reading ``focal_px`` would see the unscaled focal length).
+unchanged (a member reading ``focal_px`` would see the unscaled focal length). On a window of a
+larger frame (``metadata[WINDOW]``, what :class:`tsrkit.runner.follow.Follower` searches between
+key frames) the band is the larger frame's.
 """
 
 from __future__ import annotations
@@ -70,6 +72,7 @@ from tsrkit.api import (
     circle_box,
     hookimpl,
 )
+from tsrkit.core.types import WINDOW
 
 DEFAULT_MEMBERS = (
     "lab-blob top=30 levels=2 scale_top=0.6; "
@@ -115,11 +118,20 @@ class ScaledMember:
     def __init__(self, detector: Detector, scale: float, top: float):
         self.detector, self.scale, self.top = detector, scale, top
 
+    def rows(self, frame: Frame) -> int:
+        """How many of ``frame``'s upper rows are in the band: its upper ``top`` share, or for
+        a window of a larger frame (``frame.metadata[WINDOW]``) those in the larger frame's
+        upper ``top`` share (0 for a window below it)."""
+        window = frame.metadata.get(WINDOW)
+        if window is None:
+            return max(1, int(round(frame.height * self.top)))
+        return min(frame.height, int(round(window[3] * self.top)) - window[1])
+
     def view(self, frame: Frame, shared: dict) -> Frame:
         """The frame the member runs on: ``frame``'s upper ``top`` share of rows
         (:meth:`Frame.band`, sharing ``frame``'s colour views), resized by ``scale``. Made once
         per band and size for all the members that ask with the same ``shared`` dict."""
-        rows = max(1, int(round(frame.height * self.top)))
+        rows = self.rows(frame)
         size = (max(1, int(round(frame.width * self.scale))), max(1, int(round(rows * self.scale))))
         if ("band", rows) not in shared:
             shared["band", rows] = frame if rows == frame.height else frame.band(rows)
@@ -133,9 +145,11 @@ class ScaledMember:
 
     def detect(self, frame: Frame, shared: dict | None = None) -> list[Candidate]:
         """The member's candidates on its :meth:`view` of ``frame``, in ``frame``'s pixels."""
+        rows = self.rows(frame)
+        if rows < 1:  # a window below the band
+            return []
         view = self.view(frame, {} if shared is None else shared)
         found = self.detector.detect(view)
-        rows = max(1, int(round(frame.height * self.top)))
         if (view.width, view.height) == (frame.width, rows):
             return found
         return [map_back(c, view.width / frame.width, view.height / rows) for c in found]

@@ -9,7 +9,7 @@ import pytest
 import tsrkit
 from tsrkit.core.types import Candidate, Frame
 from tsrkit.plugin.pipeline import Pipeline
-from tsrkit.runner.follow import Follower, region, shifted
+from tsrkit.runner.follow import Follower, region, shifted, windows
 
 
 class RedDiscs(tsrkit.Detector):
@@ -63,7 +63,7 @@ def test_lights_are_followed_between_key_frames_and_new_ones_wait_for_the_next()
     whole = [shape for shape in detector.searched if shape == (120, 160)]
     assert len(whole) == 3 and follower.calls["key"] == 3  # frames 0, 4, 8
     assert follower.calls["followed"] == 9
-    assert follower.calls["regions"] == 9  # one crop on each followed frame
+    assert follower.calls["regions"] == 18  # a window around each disc on each followed frame
 
 
 def test_another_video_or_a_jump_back_starts_with_a_key_frame():
@@ -102,3 +102,10 @@ def test_a_follower_refuses_a_tracker_and_bad_settings():
         Follower(tracked)
     with pytest.raises(ValueError, match="key_every >= 1"):
         Follower(Pipeline(RedDiscs()), key_every=0)
+
+
+def test_overlapping_windows_are_searched_as_one():
+    assert windows([(0, 0, 10, 10), (30, 0, 40, 10), (10, 5, 20, 20)]) == [
+        (0, 0, 20, 20),
+        (30, 0, 40, 10),
+    ]

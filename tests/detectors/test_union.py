@@ -5,7 +5,7 @@ import cv2
 import numpy as np
 import pytest
 
-from tsrkit.core.types import Candidate, Frame
+from tsrkit.core.types import WINDOW, Candidate, Frame
 from tsrkit.plugin.params import ParamError
 from tsrkit.plugin.registry import get_registry
 from tsrkit.synth.heads import background, render_head
@@ -154,6 +154,20 @@ def test_scale_top_searches_only_the_upper_rows():
     image[10:14, 50:54] = 255  # and one at rows 10-13
     (found,) = ScaledMember(Centroid(), 2.0, 0.6).detect(Frame(image, "two lamps"))
     assert (found.x, found.y) == pytest.approx((51.5, 11.5))
+
+
+def test_a_window_of_a_frame_keeps_the_frames_band():
+    """On a window (what key-frame following searches) the band is the whole frame's rows,
+    not the window's: a window holding the band's last rows searches them, one below finds
+    nothing."""
+    image = np.zeros((100, 80, 3), np.uint8)
+    image[54:58, 30:34] = 255  # a lamp at rows 54-57, inside the frame's upper 60 rows
+    member = ScaledMember(Centroid(), 1.0, 0.6)
+    window = Frame(image[40:80], "w", metadata={WINDOW: (0, 40, 80, 100)})
+    (found,) = member.detect(window)  # rows 54-57 are in the window's lower half
+    assert (found.x, found.y) == pytest.approx((31.5, 15.5))
+    below = Frame(image[60:100], "w", metadata={WINDOW: (0, 60, 80, 100)})
+    assert member.detect(below) == []
 
 
 def test_an_upscaled_member_finds_a_small_lamp_its_full_scale_twin_misses():

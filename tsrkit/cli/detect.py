@@ -223,9 +223,10 @@ def default_inputs() -> list[str]:
     type=click.IntRange(min=1),
     default=1,
     show_default=True,
-    help="Videos: the whole pipeline on every K-th kept frame only; in between, only around "
-    "the lights of the frame before (a light appearing meanwhile is found at most K-1 frames "
-    "late). 1: the whole pipeline on every frame.",
+    help="Videos: the whole pipeline on every K-th kept frame only; in between, the same "
+    "detector and verifier in a window around each light of the frame before (a light "
+    "appearing meanwhile is found at most K-1 frames late). 1: the whole pipeline on every "
+    "frame.",
 )
 @click.option(
     "--agree",

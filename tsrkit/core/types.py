@@ -21,6 +21,7 @@ from tsrkit.core.views import FrameViews
 
 __all__ = [
     "STATES",
+    "WINDOW",
     "Annotation",
     "Candidate",
     "Dataset",
@@ -33,6 +34,11 @@ __all__ = [
 #: The signal states every classifier and dataset reader maps its labels onto. ``red_yellow``
 #: is the red+amber phase (Germany, UK...) where a dataset labels it.
 STATES = ("red", "yellow", "green", "red_yellow", "off", "unknown")
+
+#: The :attr:`Frame.metadata` key of a frame that is a window of a larger frame (what
+#: :class:`tsrkit.runner.follow.Follower` searches between key frames): ``(x0, y0, width,
+#: height)``, the window's top-left corner in the larger frame and that frame's size, pixels.
+WINDOW = "window"
 
 
 @dataclass(frozen=True)

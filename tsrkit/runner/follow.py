@@ -1,14 +1,19 @@
 """Consecutive video frames that share work: the whole pipeline on key frames, and in between a
-search around each light of the frame before.
+search around each light already found.
 
 A lit lens moves a few pixels from one video frame to the next. :class:`Follower` runs its
 pipeline (detector, verifier, classifier) on the whole frame every ``key_every``-th frame (a key
-frame), and on each frame in between only on a region around every light the frame before
-reported: centred where the light's last step would carry it (constant velocity), of radius
-``reach`` lens radii (at least :data:`MIN_REACH_PX`), plus the context the detector and the
-housing fit need around a lens (:func:`region`). The nearest detection in reach is the light on
-this frame; a light not found there is dropped, and a light that appears between key frames is
-found at the next key frame, at most ``key_every - 1`` frames late.
+frame), and on each frame in between re-detects every followed light in a window around it with
+the same detector and verifier: centred where the light's last step would carry it (constant
+velocity), of radius ``reach`` lens radii (at least :data:`MIN_REACH_PX`), plus the context the
+detector and the housing fit need around a lens (:func:`region`); windows that overlap are
+searched as one (:func:`windows`). The detector sees each window as a window of the frame
+(``metadata["window"]``, :data:`WINDOW`), so a rule about the frame's rows (the union's band
+above the horizon) holds as on the whole frame. Each detection is matched to the nearest light
+within reach, closest pairs first. A light not found on a frame is dropped (following it on,
+along its last step, until the next key frame found no more lights and more false ones:
+``benchmarks/RESULTS.video.md``); a light that appears between key frames is found at the next
+key frame, at most ``key_every - 1`` frames late.
 
 Each key frame starts afresh (no light carried into it), so a run of frames after a key frame
 depends on that run alone: a video cut into chunks of a multiple of ``key_every`` frames gives
@@ -23,7 +28,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from tsrkit.core.types import Candidate, Frame
+from tsrkit.core.types import WINDOW, Candidate, Frame
 from tsrkit.plugin.pipeline import FrameResult, Pipeline
 
 __all__ = [
@@ -35,6 +40,7 @@ __all__ = [
     "light_of",
     "region",
     "shifted",
+    "windows",
 ]
 
 #: The smallest search radius around a light's predicted centre, pixels.
@@ -94,6 +100,38 @@ def shifted(candidate: Candidate, dx: float, dy: float) -> Candidate:
     return replace(c, x=c.x + dx, y=c.y + dy, bbox=move(c.bbox), housing=move(c.housing))
 
 
+Box = tuple[int, int, int, int]
+
+
+def windows(boxes: list[Box]) -> list[Box]:
+    """``boxes`` with every group of boxes that overlap (or touch) replaced by the box holding
+    the group, in sorted order.
+
+    >>> windows([(8, 8, 20, 20), (40, 0, 50, 10), (0, 0, 10, 10)])
+    [(0, 0, 20, 20), (40, 0, 50, 10)]
+    """
+    merged = sorted(boxes)
+    changed = True
+    while changed:
+        changed = False
+        out: list[Box] = []
+        for box in merged:
+            for k, o in enumerate(out):
+                if box[0] <= o[2] and o[0] <= box[2] and box[1] <= o[3] and o[1] <= box[3]:
+                    out[k] = (
+                        min(box[0], o[0]),
+                        min(box[1], o[1]),
+                        max(box[2], o[2]),
+                        max(box[3], o[3]),
+                    )
+                    changed = True
+                    break
+            else:
+                out.append(box)
+        merged = sorted(out)
+    return merged
+
+
 class Follower:
     """A pipeline run over one or more videos frame by frame, sharing work between frames.
 
@@ -121,7 +159,7 @@ class Follower:
         self.calls = {"key": 0, "followed": 0, "regions": 0}
 
     def process(self, frame: Frame) -> FrameResult:
-        """The frame's result: the whole pipeline on a key frame, else the regional searches.
+        """The frame's result: the whole pipeline on a key frame, else the windowed searches.
 
         A frame that does not follow the previous one of the same source (another video, a
         jump) is a key frame.
@@ -139,53 +177,53 @@ class Follower:
             return result
         self._since_key += 1
         self.calls["followed"] += 1
-        candidates = self._search(frame)
-        result = self.pipeline.finish(frame, candidates, start)
-        detections, lights, taken = [], [], set()
-        for light in self._lights:
-            x, y = light.predicted()
-            best, best_distance = None, self._reach(light)
-            for k, detection in enumerate(result.detections):
-                distance = math.hypot(detection.candidate.x - x, detection.candidate.y - y)
-                if k not in taken and distance <= best_distance:
-                    best, best_distance = k, distance
-            if best is not None:
-                taken.add(best)
-                detections.append(result.detections[best])
-                lights.append(light.moved_to(result.detections[best].candidate))
-        self._lights = lights
+        result = self.pipeline.finish(frame, self._search(frame), start)
+        pairs = sorted(
+            (math.dist(light.predicted(), (d.candidate.x, d.candidate.y)), j, k)
+            for j, light in enumerate(self._lights)
+            for k, d in enumerate(result.detections)
+        )
+        found: dict[int, int] = {}  # light -> detection
+        for distance, j, k in pairs:
+            if (
+                distance <= self._reach(self._lights[j])
+                and j not in found
+                and k not in found.values()
+            ):
+                found[j] = k
+        detections = tuple(result.detections[k] for _, k in sorted(found.items()))
+        self._lights = [
+            self._lights[j].moved_to(d.candidate) for j, d in zip(sorted(found), detections)
+        ]
         ms = (time.perf_counter() - start) * 1000.0
-        return replace(result, ms=ms, detections=tuple(detections))
+        return replace(result, ms=ms, detections=detections)
 
     def _reach(self, light: Light) -> float:
         return max(self.reach * light.radius, MIN_REACH_PX)
 
     def _search(self, frame: Frame) -> list[Candidate]:
-        """The detector's candidates within reach of a light's predicted centre, found on one
-        crop holding every light's :func:`region`, in the frame's coordinates."""
+        """The detector's candidates within reach of a light's predicted centre, found in the
+        :func:`windows` of the lights' :func:`region`, in the frame's coordinates."""
         boxes = []
         for light in self._lights:
             x, y = light.predicted()
             boxes.append(region(x, y, self._reach(light), light.radius, frame.width, frame.height))
         boxes = [b for b in boxes if b[2] - b[0] >= 4 and b[3] - b[1] >= 4]  # not outside
-        if not boxes:
-            return []
-        x0, y0 = min(b[0] for b in boxes), min(b[1] for b in boxes)
-        x1, y1 = max(b[2] for b in boxes), max(b[3] for b in boxes)
-        crop = np.ascontiguousarray(frame.image[y0:y1, x0:x1])
-        self.calls["regions"] += 1
-        found = [
-            shifted(c, x0, y0)
-            for c in self.pipeline.detector.detect(Frame(crop, frame.source, frame.index))
+        found = []
+        for x0, y0, x1, y1 in windows(boxes):
+            crop = np.ascontiguousarray(frame.image[y0:y1, x0:x1])
+            metadata = {**frame.metadata, WINDOW: (x0, y0, frame.width, frame.height)}
+            window = Frame(crop, frame.source, frame.index, frame.timestamp, metadata)
+            self.calls["regions"] += 1
+            found += [shifted(c, x0, y0) for c in self.pipeline.detector.detect(window)]
+        return [
+            c
+            for c in found
+            if any(
+                math.dist(light.predicted(), (c.x, c.y)) <= self._reach(light)
+                for light in self._lights
+            )
         ]
-        near = []
-        for c in found:
-            for light in self._lights:
-                x, y = light.predicted()
-                if math.hypot(c.x - x, c.y - y) <= self._reach(light):
-                    near.append(c)
-                    break
-        return near
 
 
 def light_of(candidate: Candidate) -> Light:
