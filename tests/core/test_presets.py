@@ -23,9 +23,11 @@ def test_every_preset_loads_and_names_installed_plugins():
         assert describe(name)
 
 
-def test_recommended_runs_the_learned_verifier_and_a_state_classifier():
+def test_recommended_runs_the_cnn_after_the_forest_and_a_state_classifier():
     chosen = tsrkit.select(config="recommended")
-    assert chosen.verifier is not None and chosen.verifier.name == "verifier"
+    assert chosen.verifier is not None and chosen.verifier.name == "cnn-verifier"
+    assert chosen.verifier.params["after"].plugin.name == "verifier"
+    assert tsrkit.select(config="recommended-forest").verifier.name == "verifier"
     assert chosen.classifier is not None
     # the command line overrides the preset, as with any config file
     assert tsrkit.select(detector="gray-tophat", config="recommended").detector.name == (
@@ -61,11 +63,15 @@ def test_presets_command_lists_and_shows():
     assert shown.output == preset_path("recommended").read_text(encoding="utf-8")
 
 
-def test_recommended_verifier_model_was_trained_on_the_presets_candidates():
+def test_the_presets_models_were_trained_for_them():
+    """The forest's model records the detector whose candidates it learned (the presets'
+    union), and the CNN's card names the preset it was trained for."""
     from tsrkit.plugin.models import load_model
+    from tsrkit_plugins.verifiers.cnn.plugin import DEFAULT_MODEL as CNN_MODEL
     from tsrkit_plugins.verifiers.learned import DEFAULT_MODEL
 
     preset = load_config("recommended")
+    assert preset["detector"] == load_config("recommended-forest")["detector"]
     training = load_model(DEFAULT_MODEL, "verifier").meta["training"]["detector"]
     assert training["name"] == preset["detector"]["name"]
     # the model records the detector's validated parameters (members: their specs)
@@ -73,6 +79,13 @@ def test_recommended_verifier_model_was_trained_on_the_presets_candidates():
     detector = get_registry().create("detector", name, params)
     for key in params:
         assert json.loads(json.dumps(detector.params[key], default=str)) == training["params"][key]
+    card = load_model(CNN_MODEL, "cnn-verifier")
+    assert card.info["preset"] == "recommended"
+    assert set(card.meta["training"]["licences"].values()) <= {
+        "CC BY 4.0",
+        "CC BY-SA 4.0",
+        "MIT (tsrkit)",
+    }
 
 
 def test_detect_runs_the_recommended_preset_on_a_video(tmp_path):
@@ -92,7 +105,7 @@ def test_detect_runs_the_recommended_preset_on_a_video(tmp_path):
     threshold = load_config("recommended")["verifier"]["params"]["threshold"]
     for record in records:
         for d in record["detections"]:
-            # kept at the preset's verifier threshold, then ordered by the box model
-            # (box_rank 0.5): the reported score is the decision x (0.5 + 0.5 x p_box)
-            assert threshold * 0.5 <= d["score"] <= 1.0
+            # kept at the network's threshold (its probability blended with the forest's
+            # score, itself ordered by the box model)
+            assert threshold <= d["score"] <= 1.0
             assert d["state"] in ("red", "yellow", "green", "unknown")
