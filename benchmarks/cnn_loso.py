@@ -507,7 +507,6 @@ def card(folder: Path, rule: str) -> None:
         "shipped_network": figures["cascade_shipped"],
         "command": "python benchmarks/cnn_loso.py --cascade [--model SHIPPED]",
     }
-    meta["info"].pop("history", None)
     with atomic_open(path, "w") as fh:
         fh.write(json.dumps(meta, indent=1) + "\n")
 

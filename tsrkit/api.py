@@ -19,7 +19,7 @@ The names, by what they are for:
   :func:`validate`, :func:`parse_assignments`;
 - types: :class:`Frame` (and its shared colour views, :class:`FrameViews`), :class:`Candidate`,
   :class:`Detection`, :class:`Annotation`, :class:`Sample`, :class:`Dataset`, :class:`Skipped`,
-  :data:`STATES`,
+  :data:`STATES`, :data:`WINDOW` (where a frame's window lies in a larger frame),
   :class:`FrameRecord`, :class:`DetectionRecord`, :class:`RunResult`;
 - geometry: :data:`Box`, :func:`box_centre`, :func:`circle_box`, :func:`clip_box`,
   :func:`iou_matrix`, :func:`xywh_to_xyxy`, :func:`xyxy_to_xywh`;

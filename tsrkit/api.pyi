@@ -39,6 +39,7 @@ from .core.results import (
 )
 from .core.types import (
     STATES as STATES,
+    WINDOW as WINDOW,
     Annotation as Annotation,
     Candidate as Candidate,
     Dataset as Dataset,

@@ -63,6 +63,7 @@ import cv2
 import numpy as np
 
 from tsrkit.api import (
+    WINDOW,
     Box,
     Candidate,
     Detector,
@@ -72,7 +73,6 @@ from tsrkit.api import (
     circle_box,
     hookimpl,
 )
-from tsrkit.core.types import WINDOW
 
 DEFAULT_MEMBERS = (
     "lab-blob top=30 levels=2 scale_top=0.6; "

@@ -62,8 +62,8 @@ def test_shell_completion_offers_plugin_dataset_and_preset_names():
     assert "gray-tophat" not in complete("tsrkit train ")
     assert complete("tsrkit benchmark --dataset roboflow_traffic") == ["roboflow_traffic_light_kr"]
     assert "sample" in complete("tsrkit datasets info ")
-    assert complete("tsrkit detect --config recomm") == ["recommended"]
-    assert complete("tsrkit presets --show recomm") == ["recommended"]
+    assert complete("tsrkit detect --config recomm") == ["recommended", "recommended-forest"]
+    assert complete("tsrkit presets --show recommended-f") == ["recommended-forest"]
     assert "yolo" in complete("tsrkit datasets convert x --to ")
     assert "plots" in complete("tsrkit benchmark --writer pl")
 

@@ -17,6 +17,7 @@ REAL = [
     "gtsrb_test_35px_subset",
     "dtld_fridtjofs",
     "iwai_japan_tl",
+    "traffic_pi_us",
 ]
 
 

@@ -30,7 +30,8 @@ VERBS = {
     "compare": Verb(
         "tsrkit.cli.benchmark",
         "compare_command",
-        "Benchmark several detectors on the same frames; one report side by side.",
+        "Benchmark several detectors (or whole pipelines: --configs) on the same frames; one "
+        "report side by side.",
     ),
     "datasets": Verb(
         "tsrkit.cli.datasets",

@@ -123,7 +123,7 @@ class Dilemma:
 
         >>> Dilemma().zone(12.0, 50.0, 3.0), Dilemma().zone(12.0, 10.0, 3.0)
         ('can_stop', 'can_clear')
-        >>> Dilemma().zone(12.0, 30.0, 3.0), Dilemma().zone(12.0, 20.0, 4.5)
+        >>> Dilemma().zone(12.0, 30.0, 3.0), Dilemma().zone(12.0, 40.0, 6.0)
         ('dilemma', 'option')
         """
         if amber_s is None or not speed > STOP_SPEED or not math.isfinite(distance):

@@ -51,7 +51,7 @@ class Window:
         Examples
         --------
         >>> from tsrkit.api import Candidate
-        >>> Window.around(Candidate.from_circle(100, 50, 2, 1.0))
+        >>> Window.around(Candidate.from_circle(100, 50, 1, 1.0))
         Window(x0=92, y0=42, side=16)
         >>> Window.around(Candidate.from_circle(100, 50, 5, 1.0))
         Window(x0=70, y0=20, side=60)
