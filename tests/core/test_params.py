@@ -99,3 +99,17 @@ def test_plugin_typed_values_are_checked_and_written_one_way():
             validate(schema, bad, "p")
     with pytest.raises(ValueError, match="only plugin types take options"):
         Param("k", "int", 1, options=(Param("scale", "float", 1.0),))
+
+
+def test_a_key_prefixed_with_a_selected_plugins_name_goes_to_that_plugin():
+    from tsrkit.plugin.selection import route_params
+
+    routed = route_params(
+        {"detector": "gray-tophat", "classifier": "ab-hist"},
+        {"gray-tophat.h_peak": 0.8, "ab-hist.model": "m.npz"},
+    )
+    assert routed == {"detector": {"h_peak": 0.8}, "classifier": {"model": "m.npz"}}
+    with pytest.raises(ParamError, match="selected as detector and classifier"):
+        route_params({"detector": "sun-pca", "classifier": "sun-pca"}, {"sun-pca.model": "x"})
+    with pytest.raises(ParamError, match=r"unknown parameter 'lab-frst\.top'"):
+        route_params({"detector": "gray-tophat"}, {"lab-frst.top": 3})

@@ -202,9 +202,10 @@ def route_params(
 ) -> dict[str, dict[str, Any]]:
     """Give each ``key: value`` to the selected plugin that declares ``key``.
 
-    A key may be prefixed with the plugin kind (``classifier.model``); an unprefixed key goes
-    to the only selected plugin that declares it. Config params come first (only for the
-    plugin the config names); ``assignments`` override them.
+    A key may be prefixed with the plugin kind (``classifier.model``) or with the selected
+    plugin's name (``onnx-detector.model``, as ``compare`` takes it); an unprefixed key goes to
+    the only selected plugin that declares it. Config params come first (only for the plugin
+    the config names); ``assignments`` override them.
     """
     registry = get_registry()
     routed: dict[str, dict[str, Any]] = {kind: {} for kind in selected}
@@ -216,6 +217,15 @@ def route_params(
         kind, dot, bare = key.partition(".")
         if dot and kind in selected:
             routed[kind][bare] = value
+            continue
+        named = [k for k, name in selected.items() if name == kind]
+        if dot and len(named) > 1:
+            raise ParamError(
+                f"parameter '{key}': '{kind}' is selected as {' and '.join(named)}; "
+                f"write {named[0]}.{bare}=..."
+            )
+        if dot and named:
+            routed[named[0]][bare] = value
             continue
         owners = [
             k
