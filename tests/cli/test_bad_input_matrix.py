@@ -1138,10 +1138,10 @@ def test_the_matrix_has_the_issues_142_cases():
 def test_bad_input(tmp_path, monkeypatch, build, code, fragment, request):
     if request.node.callspec.id == "image-max-pixels-env":
         monkeypatch.setenv("TSRKIT_MAX_PIXELS", "100")
-    run_row(tmp_path, build, code, fragment)
+    check_row(tmp_path, build, code, fragment)
 
 
-def run_row(tmp_path: Path, build: Callable[[Path], list[str]], code: int, fragment: str) -> None:
+def check_row(tmp_path: Path, build: Callable[[Path], list[str]], code: int, fragment: str) -> None:
     """Run one row through the command line: exit ``code``, ``fragment`` in the output (with
     the row's folder hidden, so that a fragment cannot match the path), no traceback."""
     args = build(tmp_path)

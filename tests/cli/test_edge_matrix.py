@@ -20,7 +20,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
-from test_bad_input_matrix import FAST, Row, norm_dataset, png, run_row, write
+from test_bad_input_matrix import FAST, Row, check_row, norm_dataset, png, write
 
 GOOD_SIZE = 32
 
@@ -897,7 +897,7 @@ def test_edge(tmp_path, monkeypatch, build, code, fragment, request):
     previous = signal.signal(signal.SIGALRM, blocked)
     signal.alarm(120)
     try:
-        run_row(tmp_path, build, code, fragment)
+        check_row(tmp_path, build, code, fragment)
     finally:
         signal.alarm(0)
         signal.signal(signal.SIGALRM, previous)

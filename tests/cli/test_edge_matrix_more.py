@@ -21,7 +21,7 @@ import cv2
 import numpy as np
 import pytest
 from click.testing import CliRunner
-from test_bad_input_matrix import BASES, FAST, Row, convert, norm_dataset, png, run_row, write
+from test_bad_input_matrix import BASES, FAST, Row, check_row, convert, norm_dataset, png, write
 from test_edge_matrix import FIXES, MAP, fifo, geo, link, tiny_drive, unix_socket, with_video
 
 from tsrkit.cli.main import cli
@@ -888,7 +888,7 @@ def test_more_edges(tmp_path, monkeypatch, build, code, fragment):
     previous = signal.signal(signal.SIGALRM, blocked)
     signal.alarm(120)
     try:
-        run_row(tmp_path, build, code, fragment)
+        check_row(tmp_path, build, code, fragment)
     finally:
         signal.alarm(0)
         signal.signal(signal.SIGALRM, previous)
